@@ -1,0 +1,33 @@
+"""Deterministic delivery of messages between nodes (robot <-> robot, robot <-> nest/server).
+
+A message sent while answering tick k is stamped k and handed to its receivers at tick k+1:
+a one-tick communication latency. In the graph the world's lockstep barrier guarantees every
+message stamped k has been published before tick k+1's observations go out, so a receiver
+that releases only messages stamped before the current tick, sorted by content, sees exactly
+what the batch runner hands it. Every message type has a ``stamp_ns`` field.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def _order(message: Any) -> tuple[int, str, str]:
+    return (message.stamp_ns, type(message).__name__, repr(message))
+
+
+class Mailbox:
+    """Collects incoming messages; releases those stamped before a tick in a fixed order."""
+
+    def __init__(self) -> None:
+        self._pending: list[Any] = []
+
+    def post(self, message: Any) -> None:
+        self._pending.append(message)
+
+    def take_before(self, stamp_ns: int) -> tuple[Any, ...]:
+        ready = [m for m in self._pending if m.stamp_ns < stamp_ns]
+        if not ready:
+            return ()
+        self._pending = [m for m in self._pending if m.stamp_ns >= stamp_ns]
+        return tuple(sorted(ready, key=_order))

@@ -1,0 +1,473 @@
+"""The scenario: the one place where every world fact and every parameter lives.
+
+A scenario is a YAML file (``swarm_sim/scenarios/<name>.yaml`` or any path) loaded into frozen
+dataclasses, one per concern. Every node of the graph and the batch runner load the same
+file with the same overrides, so the depot, the arena or a drop zone is described exactly once.
+
+Loading validates as it goes: unknown keys, wrong types and impossible geometry are refused
+with a `ScenarioError` naming the offending key (``resources.count: expected int, got 'many'``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, get_args, get_origin
+
+import yaml
+
+SCENARIO_DIR = Path(__file__).resolve().parent / "scenarios"
+
+
+class ScenarioError(ValueError):
+    """A scenario file or override is broken; the message names the key."""
+
+
+# --------------------------------------------------------------------------- concerns
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    dt: float = 0.1
+    """Control tick [s]: observations go out and commands come back once per tick."""
+    physics_substeps: int = 2
+    """pybullet steps per tick (each of dt / physics_substeps seconds)."""
+    duration: float = 1080.0
+    """Run length [s of sim time]."""
+
+
+@dataclass(frozen=True)
+class ArenaConfig:
+    size: float = 12.0
+    """Side L of the square arena [m]; the arena spans [-L/2, L/2] on both axes."""
+    wall_thickness: float = 0.1
+    """[m]; walls stand just outside the arena square."""
+
+
+@dataclass(frozen=True)
+class NoiseConfig:
+    linear_std: float = 0.0
+    """Encoder noise: std of the per-tick distance error as a fraction of distance travelled."""
+    angular_std: float = 0.0
+    """Std of the per-tick heading error as a fraction of the angle turned."""
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    count: int = 16
+    diameter: float = 0.17
+    """Foot-bot-like cylinder diameter [m]."""
+    height: float = 0.1
+    """[m]; only matters for pybullet's collision shapes."""
+    max_linear_speed: float = 0.16
+    """[m/s] (ARGoS CPFA foot-bot forward speed 16 cm/s)."""
+    max_angular_speed: float = 2.0
+    """[rad/s]."""
+    start_spacing: float = 0.3
+    """Robots start on a square grid of this pitch [m] centred on the depot."""
+    odometry_noise: NoiseConfig = field(default_factory=NoiseConfig)
+
+
+@dataclass(frozen=True)
+class ScanConfig:
+    rays: int = 24
+    fov: float = 2 * math.pi
+    """Field of view [rad], centred on the heading."""
+    range_max: float = 3.5
+    """[m]"""
+    range_min: float = 0.0
+    """[m], measured from the robot's centre."""
+    backend: Literal["analytic", "pybullet"] = "analytic"
+    """`analytic`: exact ray/circle and ray/segment intersection in numpy; `pybullet`:
+    rayTestBatch against the collision shapes (slower, kept to cross-check)."""
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    scan: ScanConfig = field(default_factory=ScanConfig)
+    resource_detection_radius: float = 0.13
+    """Resources whose centre is within this distance of the robot's centre are detected [m]."""
+    pickup_radius: float = 0.05
+    """An empty robot whose centre is within this distance of a resource picks it up [m]
+    (the ARGoS CPFA FoodRadius)."""
+
+
+@dataclass(frozen=True)
+class ResourceConfig:
+    distribution: Literal["clustered", "uniform", "powerlaw"] = "clustered"
+    count: int = 320
+    """Total resources; for `clustered` it must equal clusters * cluster_side**2."""
+    clusters: int = 5
+    cluster_side: int = 8
+    """Each cluster is a cluster_side x cluster_side grid (the queue paper's 8 x 8)."""
+    spacing: float = 0.1
+    """Grid pitch inside a cluster or power-law pile [m]."""
+    powerlaw_levels: int = 4
+    """`powerlaw`: pile sizes 4^j for j < levels, 4^(levels-1-j) piles of each (Hecker & Moses)."""
+    min_depot_clearance: float = 1.0
+    """Resources are placed at least this far from the depot's edge [m]."""
+    margin: float = 0.3
+    """Resources keep this distance from the walls [m]."""
+    respawn: bool = False
+    """When a resource is delivered, place a new one by the same distribution."""
+
+
+@dataclass(frozen=True)
+class DepotConfig:
+    center: tuple[float, float] = (0.0, 0.0)
+    """[m, world frame]"""
+    radius: float = 0.5
+    """Radius of the central depot disc (the CPFA nest) [m]."""
+
+
+@dataclass(frozen=True)
+class DropZoneConfig:
+    """Somewhere a carried resource is delivered.
+
+    `kind` is `depot` for the central depot disc (the default zone). Later kinds (docks with a
+    dwell time, regional centres) are just more zones: the world drops a resource once its
+    carrier has been inside a zone for `dwell` seconds without a break.
+    """
+
+    name: str
+    center: tuple[float, float]
+    radius: float
+    dwell: float = 0.0
+    kind: str = "depot"
+
+
+@dataclass(frozen=True)
+class ObstacleConfig:
+    shape: Literal["box", "cylinder"]
+    center: tuple[float, float]
+    """[m, world frame]"""
+    size: tuple[float, float] = (0.5, 0.5)
+    """Box: full side lengths along its own x and y [m]; cylinder: (diameter, diameter)."""
+    yaw: float = 0.0
+    """Box orientation [rad]."""
+
+
+@dataclass(frozen=True)
+class CpfaConfig:
+    """Central-place foraging algorithm parameters (Hecker & Moses 2015, Table 1/3).
+
+    Defaults are the values BCLab's CPFA implementation labels "according to Beyond
+    Pheromones"; probabilities are per control tick of the original 16 Hz controller and are
+    rescaled to our tick by the behaviour.
+    """
+
+    probability_of_switching_to_searching: float = 0.045
+    """p_s: per-tick chance that a departing robot stops travelling and starts searching."""
+    probability_of_returning_to_nest: float = 0.01
+    """p_r: per-tick chance that a searching robot gives up and returns."""
+    uninformed_search_variation: float = 0.4
+    """omega [rad]: std of the heading change of the correlated random walk."""
+    rate_of_informed_search_decay: float = 0.1666
+    """lambda_id [1/s]."""
+    rate_of_site_fidelity: float = 5.0
+    """lambda_sf: site fidelity with probability POIS(c, lambda_sf)."""
+    rate_of_laying_pheromone: float = 5.0
+    """lambda_lp: lay a pheromone waypoint with probability POIS(c, lambda_lp)."""
+    rate_of_pheromone_decay: float = 0.025
+    """lambda_pd [1/s]: strength exp(-lambda_pd * age)."""
+    pheromone_threshold: float = 0.001
+    """Waypoints weaker than this are forgotten."""
+    search_step: float = 0.08
+    """Distance between heading changes of the random walk [m]."""
+    original_tick_rate: float = 16.0
+    """Tick rate [Hz] the per-tick probabilities were evolved for (ARGoS CPFA: 16)."""
+
+
+@dataclass(frozen=True)
+class AvoidanceConfig:
+    distance: float = 0.3
+    """Obstacles within this range of the robot's centre in the front sector trigger avoidance [m]."""
+    front_fov: float = 2.0
+    """Width of the front sector watched for obstacles [rad]."""
+    turn_speed: float = 1.5
+    """[rad/s] while turning away."""
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    behaviour: str = "cpfa"
+    cpfa: CpfaConfig = field(default_factory=CpfaConfig)
+    avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
+    arrival_tolerance: float = 0.1
+    """A target counts as reached within this distance [m]."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str = "cpfa"
+    seed: int = 0
+    sim: SimConfig = field(default_factory=SimConfig)
+    arena: ArenaConfig = field(default_factory=ArenaConfig)
+    robots: RobotConfig = field(default_factory=RobotConfig)
+    sensors: SensorConfig = field(default_factory=SensorConfig)
+    resources: ResourceConfig = field(default_factory=ResourceConfig)
+    depot: DepotConfig = field(default_factory=DepotConfig)
+    drop_zones: tuple[DropZoneConfig, ...] = ()
+    """Extra drop zones; the depot disc is always one (see `all_drop_zones`)."""
+    obstacles: tuple[ObstacleConfig, ...] = ()
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+
+    @property
+    def dt_ns(self) -> int:
+        return round(self.sim.dt * 1e9)
+
+    @property
+    def ticks(self) -> int:
+        """Number of control ticks in a run."""
+        return round(self.sim.duration / self.sim.dt)
+
+    @property
+    def robot_names(self) -> list[str]:
+        return [f"robot_{i}" for i in range(self.robots.count)]
+
+    def all_drop_zones(self) -> tuple[DropZoneConfig, ...]:
+        depot = DropZoneConfig("depot", self.depot.center, self.depot.radius, 0.0, "depot")
+        return (depot, *self.drop_zones)
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", None) or str(tp).replace("typing.", "")
+
+
+def _convert(value: Any, tp: Any, key: str) -> Any:
+    """Convert a YAML value to the annotated type, or raise naming `key`."""
+    origin = get_origin(tp)
+    if tp is Any:
+        return value
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise ScenarioError(f"{key}: expected a mapping, got {value!r}")
+        return _build(tp, value, key)
+    if origin is Literal:
+        if value not in get_args(tp):
+            choices = ", ".join(repr(a) for a in get_args(tp))
+            raise ScenarioError(f"{key}: expected one of {choices}, got {value!r}")
+        return value
+    if origin in (typing.Union, types.UnionType):
+        errors = []
+        for arg in get_args(tp):
+            if arg is type(None):
+                if value is None:
+                    return None
+                continue
+            try:
+                return _convert(value, arg, key)
+            except ScenarioError as exc:
+                errors.append(str(exc))
+        raise ScenarioError(errors[0] if errors else f"{key}: bad value {value!r}")
+    if origin is tuple:
+        args = get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            raise ScenarioError(f"{key}: expected a list, got {value!r}")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(v, args[0], f"{key}[{i}]") for i, v in enumerate(value))
+        if len(value) != len(args):
+            raise ScenarioError(f"{key}: expected {len(args)} values, got {len(value)}")
+        return tuple(_convert(v, a, f"{key}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ScenarioError(f"{key}: expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ScenarioError(f"{key}: expected a finite number, got {value!r}")
+        return float(value)
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ScenarioError(f"{key}: expected int, got {value!r}")
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ScenarioError(f"{key}: expected true or false, got {value!r}")
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise ScenarioError(f"{key}: expected a string, got {value!r}")
+        return value
+    raise ScenarioError(f"{key}: unsupported type {_type_name(tp)}")
+
+
+def _build(cls: type, data: dict[str, Any], prefix: str) -> Any:
+    hints = typing.get_type_hints(cls)
+    names = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - names)
+    if unknown:
+        where = f"{prefix}." if prefix else ""
+        raise ScenarioError(
+            f"unknown key {where}{unknown[0]} (known keys: {', '.join(sorted(names))})"
+        )
+    kwargs = {}
+    for name, value in data.items():
+        key = f"{prefix}.{name}" if prefix else name
+        kwargs[name] = _convert(value, hints[name], key)
+    try:
+        return cls(**kwargs)
+    except TypeError as exc:  # a field without default left out
+        raise ScenarioError(f"{prefix or 'scenario'}: {exc}") from None
+
+
+def _set_path(data: dict[str, Any], dotted: str, value: Any) -> None:
+    parts = dotted.split(".")
+    node = data
+    for part in parts[:-1]:
+        child = node.setdefault(part, {})
+        if not isinstance(child, dict):
+            raise ScenarioError(f"--set {dotted}: {part} is not a mapping")
+        node = child
+    node[parts[-1]] = value
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """``"robots.count=8"`` -> ``("robots.count", 8)``; the value is parsed as YAML."""
+    key, sep, raw = text.partition("=")
+    if not sep or not key.strip():
+        raise ScenarioError(f"--set {text!r}: expected KEY=VALUE, e.g. robots.count=8")
+    try:
+        return key.strip(), yaml.safe_load(raw)
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f"--set {key}: cannot parse value {raw!r}: {exc}") from None
+
+
+def resolve_path(name_or_path: str) -> Path:
+    """A scenario name (``cpfa``) or a path to a YAML file."""
+    path = Path(name_or_path)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        if not path.is_file():
+            raise ScenarioError(f"scenario file {path} does not exist")
+        return path
+    candidate = SCENARIO_DIR / f"{name_or_path}.yaml"
+    if not candidate.is_file():
+        known = ", ".join(sorted(p.stem for p in SCENARIO_DIR.glob("*.yaml")))
+        raise ScenarioError(f"unknown scenario {name_or_path!r} (known: {known})")
+    return candidate
+
+
+def load_scenario(
+    name_or_path: str = "cpfa",
+    overrides: typing.Iterable[str] = (),
+    **fields: Any,
+) -> Scenario:
+    """Load, override, build and validate a scenario.
+
+    `overrides` are ``a.b=VALUE`` strings (the CLI's ``--set``); `fields` are dotted keys
+    with ``__`` for dots, e.g. ``robots__count=8`` (the CLI's ``--robots``).
+    """
+    path = resolve_path(name_or_path)
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f"{path}: not valid YAML: {exc}") from None
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: the top level must be a mapping")
+    for text in overrides:
+        _set_path(data, *parse_override(text))
+    for key, value in fields.items():
+        if value is not None:
+            _set_path(data, key.replace("__", "."), value)
+    scenario = _build(Scenario, data, "")
+    validate(scenario)
+    return scenario
+
+
+def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
+    """Plain-data form (for bag metadata and JSON results); `_build` accepts it back."""
+
+    def plain(value: Any) -> Any:
+        if isinstance(value, tuple):
+            return [plain(v) for v in value]
+        if isinstance(value, dict):
+            return {k: plain(v) for k, v in value.items()}
+        return value
+
+    return plain(dataclasses.asdict(scenario))
+
+
+def scenario_from_dict(data: dict[str, Any]) -> Scenario:
+    scenario = _build(Scenario, data, "")
+    validate(scenario)
+    return scenario
+
+
+# --------------------------------------------------------------------------- geometry checks
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise ScenarioError(message)
+
+
+def _inside(point: tuple[float, float], half: float, clearance: float) -> bool:
+    return abs(point[0]) + clearance <= half and abs(point[1]) + clearance <= half
+
+
+def validate(s: Scenario) -> None:
+    """Refuse impossible scenarios, naming the key at fault."""
+    _require(s.sim.dt > 0, "sim.dt: must be positive")
+    _require(s.sim.physics_substeps >= 1, "sim.physics_substeps: must be at least 1")
+    _require(s.sim.duration >= s.sim.dt, "sim.duration: must be at least one tick (sim.dt)")
+    _require(s.arena.size > 0, "arena.size: must be positive")
+    half = s.arena.size / 2
+    _require(
+        _inside(s.depot.center, half, s.depot.radius),
+        f"depot: a disc of radius {s.depot.radius} m at {s.depot.center} is outside the arena",
+    )
+    r = s.robots
+    _require(r.count >= 1, "robots.count: need at least one robot")
+    _require(r.diameter > 0, "robots.diameter: must be positive")
+    _require(r.max_linear_speed > 0, "robots.max_linear_speed: must be positive")
+    _require(r.max_angular_speed > 0, "robots.max_angular_speed: must be positive")
+    _require(
+        r.start_spacing >= r.diameter,
+        f"robots.start_spacing: {r.start_spacing} m is less than the robot diameter {r.diameter} m",
+    )
+    side = math.ceil(math.sqrt(r.count))
+    extent = (side - 1) * r.start_spacing / 2 + r.diameter / 2
+    _require(
+        _inside(s.depot.center, half, extent),
+        f"robots.count: {r.count} robots on a {side}x{side} grid of pitch {r.start_spacing} m "
+        f"do not fit in the {s.arena.size} m arena",
+    )
+    sc = s.sensors.scan
+    _require(sc.rays >= 1, "sensors.scan.rays: need at least one ray")
+    _require(0 < sc.fov <= 2 * math.pi + 1e-9, "sensors.scan.fov: must be in (0, 2*pi]")
+    _require(sc.range_max > sc.range_min >= 0, "sensors.scan.range_max: must exceed range_min")
+    _require(s.sensors.resource_detection_radius > 0, "sensors.resource_detection_radius: must be positive")
+    _require(s.sensors.pickup_radius > 0, "sensors.pickup_radius: must be positive")
+    res = s.resources
+    _require(res.count >= 0, "resources.count: must not be negative")
+    _require(res.spacing > 0, "resources.spacing: must be positive")
+    _require(res.margin >= 0, "resources.margin: must not be negative")
+    if res.distribution == "clustered":
+        _require(res.clusters >= 1 and res.cluster_side >= 1, "resources.clusters: need >= 1 cluster")
+        _require(
+            res.count == res.clusters * res.cluster_side**2,
+            f"resources.count: {res.count} != clusters * cluster_side^2 = "
+            f"{res.clusters * res.cluster_side ** 2}",
+        )
+        span = (res.cluster_side - 1) * res.spacing
+        _require(
+            span + 2 * res.margin < s.arena.size,
+            f"resources.cluster_side: a {span:.2f} m cluster does not fit in the arena",
+        )
+    if res.distribution == "powerlaw":
+        _require(res.powerlaw_levels >= 1, "resources.powerlaw_levels: need at least 1")
+    for i, z in enumerate(s.drop_zones):
+        _require(z.radius > 0, f"drop_zones[{i}].radius: must be positive")
+        _require(z.dwell >= 0, f"drop_zones[{i}].dwell: must not be negative")
+        _require(_inside(z.center, half, 0.0), f"drop_zones[{i}].center: {z.center} is outside the arena")
+    names = [z.name for z in s.all_drop_zones()]
+    _require(len(set(names)) == len(names), "drop_zones: zone names must be unique ('depot' is taken)")
+    for i, o in enumerate(s.obstacles):
+        _require(min(o.size) > 0, f"obstacles[{i}].size: must be positive")
+        _require(_inside(o.center, half, 0.0), f"obstacles[{i}].center: {o.center} is outside the arena")
+    _require(s.controller.arrival_tolerance > 0, "controller.arrival_tolerance: must be positive")

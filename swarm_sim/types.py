@@ -1,0 +1,174 @@
+"""Core data types shared by the world, the behaviours, the codecs and the analysis.
+
+ROS-free on purpose: the world core, every behaviour and the batch runner exchange these
+frozen dataclasses; only `swarm_msgs_py` converts them to and from ROS messages.
+
+Frames: "world" is the arena frame, origin at the arena centre, x east, y north, z up.
+Times are simulation time. A tick k happens at ``k * dt`` seconds; stamps are integer
+nanoseconds so that graph and batch runs compare exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+RobotId = str
+"""A robot's name, which is also its ROS namespace (``robot_0``, ``robot_1``, ...)."""
+
+NS_PER_S = 1_000_000_000
+
+
+def robot_name(index: int) -> RobotId:
+    return f"robot_{index}"
+
+
+def robot_index(robot: RobotId) -> int:
+    """Inverse of `robot_name`; raises ValueError naming the bad id."""
+    prefix, _, number = robot.rpartition("_")
+    if prefix != "robot" or not number.isdigit():
+        raise ValueError(f"unknown robot id {robot!r}: expected 'robot_<index>'")
+    return int(number)
+
+
+def tick_stamp_ns(tick: int, dt_ns: int) -> int:
+    return tick * dt_ns
+
+
+@dataclass(frozen=True, slots=True)
+class Pose2D:
+    """Planar pose. x, y [m, world frame]; yaw [rad, counter-clockwise from +x, in (-pi, pi]]."""
+
+    x: float
+    y: float
+    yaw: float
+
+
+@dataclass(frozen=True, slots=True)
+class Command:
+    """What a behaviour asks of its robot for one tick.
+
+    linear [m/s, body frame, forward positive]; angular [rad/s, counter-clockwise positive].
+    `messages` are sent to other nodes this tick and arrive at their receivers one tick later
+    (see `swarm_sim.messaging`).
+    """
+
+    linear: float = 0.0
+    angular: float = 0.0
+    messages: tuple[object, ...] = ()
+
+
+STOP = Command()
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Observation:
+    """Everything one robot senses at one tick, exactly as it arrives over ROS.
+
+    The world core already applies the wire's rounding (float32 ranges, yaw through a
+    quaternion) so that a batch run and a graph run feed behaviours bit-identical inputs.
+    """
+
+    robot: RobotId
+    stamp_ns: int
+    """Sim time of the tick [ns]."""
+    pose: Pose2D
+    """Odometry estimate [m, rad; world frame] (encoder noise included if configured)."""
+    linear_velocity: float
+    """Measured forward speed [m/s, body frame]."""
+    angular_velocity: float
+    """Measured turn rate [rad/s]."""
+    ranges: np.ndarray
+    """Laser scan ranges [m], float32, ray i at angle ``angle_min + i * angle_increment``
+    relative to the heading; ``inf`` where nothing is within range (REP 117)."""
+    resources: tuple[tuple[float, float], ...]
+    """Positions of resources within the detection radius [m, world frame], nearest first."""
+    carrying: bool
+    """True while the gripper holds a resource."""
+    messages: tuple[object, ...] = ()
+    """Messages from other nodes stamped before this tick, in a deterministic order."""
+
+    @property
+    def t(self) -> float:
+        """Sim time [s]."""
+        return self.stamp_ns / NS_PER_S
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Observation):
+            return NotImplemented
+        return (
+            self.robot == other.robot
+            and self.stamp_ns == other.stamp_ns
+            and self.pose == other.pose
+            and self.linear_velocity == other.linear_velocity
+            and self.angular_velocity == other.angular_velocity
+            and np.array_equal(self.ranges, other.ranges)
+            and self.resources == other.resources
+            and self.carrying == other.carrying
+            and self.messages == other.messages
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+@dataclass(frozen=True, slots=True)
+class PickupEvent:
+    """A robot's gripper took a resource. x, y: where the resource lay [m, world frame]."""
+
+    robot: RobotId
+    stamp_ns: int
+    resource: int
+    x: float
+    y: float
+
+
+@dataclass(frozen=True, slots=True)
+class DropEvent:
+    """A robot delivered its resource in drop zone `zone`. x, y: robot position [m, world]."""
+
+    robot: RobotId
+    stamp_ns: int
+    resource: int
+    zone: str
+    x: float
+    y: float
+
+
+@dataclass(slots=True)
+class RobotStats:
+    """Per-robot counters owned by the world (the behaviours own their own counters)."""
+
+    collision_time_s: float = 0.0
+    """Time spent in physical contact with another robot [s]."""
+    pickups: int = 0
+    deliveries: int = 0
+    clamped_commands: int = 0
+    """Commands that were NaN/inf or above the speed limits and had to be clamped."""
+    stale_ticks: int = 0
+    """Lockstep ticks for which the robot's controller did not answer in time."""
+
+
+@dataclass(frozen=True, slots=True)
+class PheromoneMessage:
+    """CPFA: a pheromone waypoint laid at the nest (Hecker & Moses 2015, sec. 2.3).
+
+    x, y: the resource site the waypoint points to [m, world frame]; stamp_ns: when it was laid.
+    Receivers compute its decayed strength from the time since `stamp_ns`.
+    """
+
+    stamp_ns: int
+    x: float
+    y: float
+
+
+@dataclass(frozen=True, slots=True)
+class BehaviourStatus:
+    """A behaviour's own counters and state, published when they change."""
+
+    robot: RobotId
+    stamp_ns: int
+    state: str
+    obstacle_avoidance_events: int
+    trips: int
+    extra: tuple[tuple[str, str], ...] = field(default=())
