@@ -1,0 +1,50 @@
+"""swarmforage: installable with pip (the README's way) or colcon in a ROS 2 Jazzy workspace."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "swarmforage"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    description="Swarm foraging methods on a ROS 2 Jazzy node graph with a pybullet world",
+    license="Apache-2.0",
+    python_requires=">=3.10",
+    packages=find_packages(include=["swarm_sim*", "swarm_controllers*", "swarm_msgs_py*",
+                                    "depot_manager*", "launch_py*"]),
+    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml"]},
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/launch", glob("launch_py/*.launch.py")),
+        (f"share/{PACKAGE}/scenarios", glob("swarm_sim/scenarios/*.yaml")),
+    ],
+    install_requires=[
+        "numpy",
+        "pybullet",
+        "pyyaml",
+        "mcap",
+        "mcap-ros2-support",
+        "rosbags",
+        "matplotlib",
+    ],
+    extras_require={
+        "ros": [
+            "ros-jazzy-rclpy",
+            "ros-jazzy-common-interfaces",
+            "ros-jazzy-rmw-fastrtps-cpp",
+        ],
+        "test": ["pytest", "hypothesis", "scipy"],
+    },
+    entry_points={
+        "console_scripts": [
+            "swarm-run = launch_py.run:main",
+            "swarm-batch = swarm_sim.batch:main",
+            "swarm-analyze = swarm_sim.analysis:main",
+            "swarm-world = swarm_sim.world_node:main",
+            "swarm-controllers = swarm_controllers.controller_node:main",
+        ],
+    },
+)

@@ -1,0 +1,134 @@
+"""A controller node: one robot's behaviour under the robot's namespace.
+
+The node caches the tick's four observation messages (odom, scan, resources, gripper) by
+stamp; when all four carry the same stamp it builds the `Observation`, hands it the messages
+from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviour, publishes
+the behaviour's outgoing messages, its status when it changed, and finally the command stamped
+with the tick it answers. The tick drives all work; there are no timers.
+
+``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import dataclass
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from swarm_controllers.api import Behaviour, behaviour_rng, make_behaviour
+from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_msgs_py.params import declare_config
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_sim.messaging import Mailbox
+from swarm_sim.scenario import load_scenario
+from swarm_sim.types import BehaviourStatus, Observation, PheromoneMessage, robot_index
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    scenario: str = "cpfa"
+    """Scenario name or YAML path (the same one the world loads)."""
+    overrides: tuple[str, ...] = ()
+    seed: int = 0
+
+
+class ControllerNode(Node):
+    def __init__(self, robot: str, config: ControllerConfig | None = None, **kwargs) -> None:
+        robot_index(robot)  # refuse names that are not robot ids
+        super().__init__(
+            "controller", namespace=robot, start_parameter_services=False,
+            parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
+        )
+        self.robot = robot
+        self.config = cfg = declare_config(self, ControllerConfig, config)
+        self.scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
+        self.behaviour: Behaviour = make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
+        self.mailbox = Mailbox()
+        self._latest: dict[str, tuple[int, object]] = {}
+        self._last_status: tuple | None = None
+        decoders = {
+            topics.ODOM: odometry.decode_odometry,
+            topics.SCAN: scan.decode_scan,
+            topics.RESOURCES: resources.decode_resources,
+            topics.GRIPPER: gripper.decode_gripper,
+        }
+        # Subscribe to other nodes' messages first: in a wait set where both are ready,
+        # rclpy runs the earlier subscription first.
+        self.create_subscription(
+            topics.type_of(topics.PHEROMONES), topics.PHEROMONES,
+            lambda data: self.mailbox.post(pheromone.decode_pheromone(data)), EVENTS, raw=True,
+        )
+        for name, decode in decoders.items():
+            self.create_subscription(
+                topics.type_of(name), name,
+                lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
+            )
+        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
+        self._pheromone_pub = self.create_publisher(
+            topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS
+        )
+
+    def _on_observation(self, name: str, decoded: tuple) -> None:
+        stamp = decoded[0]
+        self._latest[name] = decoded
+        if len(self._latest) == 4 and all(v[0] == stamp for v in self._latest.values()):
+            self._tick(stamp)
+
+    def _tick(self, stamp_ns: int) -> None:
+        _, pose, v, w = self._latest[topics.ODOM]
+        obs = Observation(
+            robot=self.robot, stamp_ns=stamp_ns, pose=pose, linear_velocity=v, angular_velocity=w,
+            ranges=self._latest[topics.SCAN][1], resources=self._latest[topics.RESOURCES][1],
+            carrying=self._latest[topics.GRIPPER][1], messages=self.mailbox.take_before(stamp_ns),
+        )
+        command = self.behaviour.step(obs)
+        for message in command.messages:
+            if isinstance(message, PheromoneMessage):
+                self._pheromone_pub.publish(pheromone.encode_pheromone(message))
+            else:
+                raise TypeError(f"{self.robot}: no topic for outgoing {type(message).__name__}")
+        status = self.behaviour.status(stamp_ns)
+        key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
+        if key != self._last_status:
+            self._last_status = key
+            self._status_pub.publish(diagnostics.encode_status(status))
+        self._cmd_pub.publish(twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular))
+
+
+def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:
+    parser = argparse.ArgumentParser(prog="swarm-controllers", description=__doc__.splitlines()[0])
+    parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
+    parser.add_argument("--scenario", default="cpfa")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument("--seed", type=int, default=0)
+    args, ros_args = parser.parse_known_args(argv)
+    return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args
+
+
+def main(argv: list[str] | None = None) -> int:
+    robots, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    rclpy.init(args=["swarm-controllers", *ros_args])
+    nodes: list[ControllerNode] = []
+    try:
+        executor = SingleThreadedExecutor()
+        for robot in robots:
+            nodes.append(ControllerNode(robot, config))
+            executor.add_node(nodes[-1])
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        for node in nodes:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,122 @@
+"""swarm-analyze: a run's metrics from its bag alone (no ROS running, no rclpy needed).
+
+``load_run(bag) -> RunTrace`` decodes the world's events and counters and the behaviours'
+status messages with the `swarm_msgs_py` codecs; the metric functions of `swarm_sim.metrics`
+then compute exactly what the batch runner computes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_msgs_py import clock as clock_codec
+from swarm_sim.bag import BagError, bag_info, read_bag
+from swarm_sim.metrics import RunTrace, delivered_over_time, summarize
+from swarm_sim.scenario import scenario_from_dict
+from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent, robot_index
+
+
+def load_run(path: Path | str) -> RunTrace:
+    """Build the trace of a recorded run; raises BagError naming what is missing."""
+    path = Path(path)
+    info = bag_info(path)
+    meta = info.metadata
+    if "scenario" not in meta:
+        raise BagError(f"{path}: no swarmforage scenario in the bag's metadata (not a swarm-run bag?)")
+    scenario = scenario_from_dict(json.loads(meta["scenario"]))
+    trace = RunTrace(
+        scenario=scenario.name, seed=scenario.seed, robots=tuple(scenario.robot_names),
+        sim_seconds=float(meta.get("sim_seconds", 0.0)), wall_seconds=float(meta.get("wall_seconds", 0.0)),
+        total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"),
+    )
+    last_clock = 0
+    for m in read_bag(path):
+        if m.topic == topics.CLOCK:
+            last_clock = max(last_clock, clock_codec.decode_clock(m.data))
+        elif m.topic == topics.WORLD_EVENTS:
+            for event in diagnostics.decode_events(m.data)[1]:
+                (trace.drops if isinstance(event, DropEvent) else trace.pickups).append(event)
+        elif m.topic == topics.WORLD_ROBOT_STATS:
+            trace.stats = diagnostics.decode_robot_stats(m.data)[1]
+        elif m.topic.endswith("/" + topics.STATUS):
+            status = diagnostics.decode_status(m.data)
+            trace.status[status.robot] = status
+    if not trace.sim_seconds:  # the run was cut off before it could write its totals
+        trace.sim_seconds = last_clock / NS_PER_S
+    return trace
+
+
+def load_odometry(path: Path | str) -> dict[str, np.ndarray]:
+    """Per robot, the (ticks, 4) array of odometry (t [s], x, y, yaw) the controllers received."""
+    rows: dict[str, list[tuple[float, float, float, float]]] = {}
+    for m in read_bag(Path(path)):
+        if m.topic.endswith("/" + topics.ODOM):
+            robot = m.topic.strip("/").split("/")[0]
+            stamp, pose, _, _ = odometry.decode_odometry(m.data)
+            rows.setdefault(robot, []).append((stamp / NS_PER_S, pose.x, pose.y, pose.yaw))
+    return {r: np.array(v) for r, v in sorted(rows.items(), key=lambda kv: robot_index(kv[0]))}
+
+
+def plot_run(trace: RunTrace, out: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    summary = summarize(trace)
+    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(15, 4))
+    times, counts = delivered_over_time(trace)
+    ax1.step(times, counts, where="post")
+    ax1.set(xlabel="sim time [s]", ylabel="resources delivered",
+            title=f"{trace.scenario}, {len(trace.robots)} robots, seed {trace.seed}")
+    names = list(trace.robots)
+    idx = np.arange(len(names))
+    ax2.bar(idx, [summary["collision_time_s_by_robot"][r] for r in names])
+    ax2.set(xlabel="robot", ylabel="collision time [s]", title="collision time per robot")
+    ax3.bar(idx, [summary["oae_by_robot"][r] for r in names], color="tab:orange")
+    ax3.bar(idx, [summary["trips_by_robot"][r] for r in names], color="tab:green", alpha=0.7)
+    ax3.set(xlabel="robot", ylabel="count", title="obstacle-avoidance events (orange), trips (green)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="swarm-analyze", description=__doc__.splitlines()[0])
+    parser.add_argument("bags", nargs="+", type=Path, help="bag directories written by swarm-run")
+    parser.add_argument("--json", action="store_true", help="print one JSON object per run")
+    parser.add_argument("--plot", type=Path, help="PNG path (default: <bag>/summary.png)")
+    parser.add_argument("--no-plot", action="store_true")
+    args = parser.parse_args(argv)
+    status = 0
+    for bag in args.bags:
+        try:
+            trace = load_run(bag)
+        except (BagError, ValueError) as exc:
+            print(f"swarm-analyze: {exc}", file=sys.stderr)
+            status = 1
+            continue
+        summary = summarize(trace)
+        if not args.no_plot:
+            summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
+        if args.json:
+            print(json.dumps(summary))
+        else:
+            print(f"{bag}:")
+            for key in ("scenario", "seed", "robots", "mode", "sim_seconds", "wall_seconds",
+                        "resources_delivered", "total_resources", "collision_time_per_robot_s",
+                        "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands", "plot"):
+                if key in summary:
+                    print(f"  {key:28s} {summary[key]}")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

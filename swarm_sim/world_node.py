@@ -1,0 +1,315 @@
+"""The world node: puts the `World` core on the ROS graph, owns sim time, records the run.
+
+Lockstep (default): for each tick k it publishes ``/clock`` and every robot's observations
+stamped k, waits until every live controller has answered with a ``cmd_vel`` stamped k (a
+controller silent for `tick_timeout` wall seconds is counted stale and keeps its last command;
+after `dead_after` stale ticks in a row it is no longer waited for until it answers again),
+then steps the core. Free-running (`realtime`): steps every dt / real_time_factor wall
+seconds with whatever commands have arrived.
+
+Observations are encoded straight to CDR bytes, published raw and written to the bag as the
+same bytes. Topics published by other nodes are discovered and recorded too (like
+``ros2 bag record -a``), stamped with the sim time at which they arrive.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+
+from swarm_msgs_py import clock as clock_codec
+from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
+from swarm_msgs_py.params import declare_config
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.bag import BagWriter
+from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
+from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
+from swarm_sim.world import World
+
+
+@dataclass(frozen=True)
+class WorldNodeConfig:
+    scenario: str = "cpfa"
+    """Scenario name or YAML path."""
+    overrides: tuple[str, ...] = ()
+    """``a.b=VALUE`` scenario overrides."""
+    seed: int = 0
+    mode: str = "lockstep"
+    """`lockstep` or `realtime`."""
+    tick_timeout: float = 2.0
+    """Lockstep: wall seconds to wait for a controller's answer before counting it stale."""
+    dead_after: int = 3
+    """Lockstep: stale ticks in a row after which a controller is no longer waited for."""
+    real_time_factor: float = 1.0
+    """Realtime mode: target sim seconds per wall second."""
+    bag: str = ""
+    """Bag directory to record to ('' records nothing)."""
+    startup_timeout: float = 120.0
+    """Wall seconds to wait for every controller to connect before starting anyway."""
+    progress_period: float = 2.0
+    """Wall seconds between progress lines."""
+    stats_period: float = 1.0
+    """Sim seconds between ``/world/robot_stats`` messages."""
+    markers_period: float = 5.0
+    """Sim seconds between ``/world/markers`` messages."""
+
+
+class WorldNode(Node):
+    def __init__(self, config: WorldNodeConfig | None = None, **kwargs) -> None:
+        super().__init__("world", **kwargs)
+        self.config = cfg = declare_config(self, WorldNodeConfig, config)
+        if cfg.mode not in ("lockstep", "realtime"):
+            raise ValueError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
+        self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
+        self.world = World(self.scenario, cfg.seed)
+        self.robots: tuple[RobotId, ...] = self.world.robots
+        self.bag = self._open_bag(cfg.bag) if cfg.bag else None
+        self._own_topics: set[str] = set()
+
+        self._clock_pub = self._publisher(Clock, topics.CLOCK, SENSOR_LOCKSTEP)
+        self._events_pub = self._publisher(*topics.world_topic(topics.EVENTS), EVENTS)
+        self._stats_pub = self._publisher(*topics.world_topic(topics.ROBOT_STATS), STATE_LATCHED)
+        self._markers_pub = self._publisher(*topics.world_topic(topics.MARKERS), STATE_LATCHED)
+        self._obs_pubs = {
+            r: {
+                name: self._publisher(*topics.robot_topic(r, name), SENSOR_LOCKSTEP)
+                for name in topics.OBSERVATION_TOPICS
+            }
+            for r in self.robots
+        }
+        self._commands: dict[RobotId, Command] = {}
+        self._answered: dict[RobotId, int] = {}
+        self._missed: dict[RobotId, int] = dict.fromkeys(self.robots, 0)
+        self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL)[0]: r for r in self.robots}
+        for topic, robot in self._cmd_topic.items():
+            msg_type = topics.robot_topic(robot, topics.CMD_VEL)[1]
+            self.create_subscription(
+                msg_type, topic, lambda data, r=robot: self._on_cmd(r, data), SENSOR_LOCKSTEP, raw=True
+            )
+        self._recorded: set[str] = set(self._own_topics) | set(self._cmd_topic)
+        self._warned_unknown: set[str] = set()
+        self._next_discovery = 0.0
+
+    # ------------------------------------------------------------------ plumbing
+
+    def _publisher(self, msg_type, topic: str, qos):
+        self._own_topics.add(topic)
+        if self.bag is not None:
+            self.bag.add_topic(topic, topics.type_name(msg_type), topics.qos_name(qos))
+        return self.create_publisher(msg_type, topic, qos)
+
+    def _open_bag(self, path: str) -> BagWriter:
+        meta = {
+            "scenario_name": self.scenario.name,
+            "scenario": json.dumps(scenario_to_dict(self.scenario)),
+            "seed": str(self.config.seed),
+            "mode": self.config.mode,
+            "robots": str(len(self.world.robots)),
+        }
+        return BagWriter(Path(path), metadata=meta)
+
+    def _publish(self, pub, data: bytes, topic: str) -> None:
+        pub.publish(data)
+        if self.bag is not None:
+            self.bag.write(topic, self.world.t_ns, data)
+
+    def _on_cmd(self, robot: RobotId, data: bytes) -> None:
+        if self.bag is not None:
+            self.bag.write(topics.robot_topic(robot, topics.CMD_VEL)[0], self.world.t_ns, data)
+        try:
+            stamp_ns, linear, angular = twist.decode_twist(data)
+        except ValueError as exc:
+            self.get_logger().warning(f"{robot}: dropping malformed cmd_vel: {exc}")
+            return
+        self._commands[robot] = Command(linear, angular)
+        self._answered[robot] = stamp_ns
+
+    def _discover(self) -> None:
+        """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self._recorded or not types:
+                continue
+            self._recorded.add(topic)
+            if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
+                self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
+            msg_type = topics.import_type(types[0])
+            if msg_type is None or self.bag is None:
+                continue
+            self.bag.add_topic(topic, types[0], "reliable")
+            self.create_subscription(
+                msg_type, topic, lambda data, t=topic: self.bag.write(t, self.world.t_ns, data),
+                EVENTS, raw=True,
+            )
+
+    # ------------------------------------------------------------------ the loop
+
+    def _publish_tick(self, obs: dict[RobotId, Observation]) -> None:
+        t_ns = self.world.t_ns
+        self._publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK)
+        sc = self.scenario.sensors.scan
+        for r, o in obs.items():
+            pubs = self._obs_pubs[r]
+            encoded = {
+                topics.ODOM: odometry.encode_odometry(r, t_ns, o.pose, o.linear_velocity, o.angular_velocity),
+                topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
+                topics.RESOURCES: resources.encode_resources(t_ns, o.resources),
+                topics.GRIPPER: gripper.encode_gripper(t_ns, o.carrying),
+            }
+            for name, data in encoded.items():
+                self._publish(pubs[name], data, topics.robot_topic(r, name)[0])
+
+    def _publish_world_state(self, final: bool = False) -> None:
+        t_ns = self.world.t_ns
+        events = self.world.drain_events()
+        if events:
+            self._publish(self._events_pub, diagnostics.encode_events(t_ns, events),
+                          topics.world_topic(topics.EVENTS)[1])
+        stats_every = max(1, round(self.config.stats_period / self.scenario.sim.dt))
+        if final or self.world.tick % stats_every == 0:
+            self._publish(self._stats_pub, diagnostics.encode_robot_stats(t_ns, self.world.stats),
+                          topics.world_topic(topics.ROBOT_STATS)[1])
+        markers_every = max(1, round(self.config.markers_period / self.scenario.sim.dt))
+        if final or self.world.tick % markers_every == 0:
+            data = markers.encode_markers(
+                self.scenario, t_ns, self.world.resource_positions(), self.world.true_poses()
+            )
+            self._publish(self._markers_pub, data, topics.world_topic(topics.MARKERS)[1])
+
+    def wait_for_controllers(self, executor: SingleThreadedExecutor) -> None:
+        deadline = time.monotonic() + self.config.startup_timeout
+        missing = list(self.robots)
+        while missing and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1)
+            missing = [
+                r for r in self.robots
+                if self.count_publishers(topics.robot_topic(r, topics.CMD_VEL)[0]) == 0
+                or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
+            ]
+        if missing:
+            self.get_logger().warning(
+                f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
+            )
+
+    def _await_commands(self, executor: SingleThreadedExecutor) -> None:
+        """Lockstep barrier: spin until every live controller answered this tick."""
+        stamp = self.world.t_ns
+        waiting = [r for r in self.robots if self._missed[r] < self.config.dead_after]
+        deadline = time.monotonic() + self.config.tick_timeout
+        while True:
+            waiting = [r for r in waiting if self._answered.get(r) != stamp]
+            if not waiting or time.monotonic() >= deadline:
+                break
+            executor.spin_once(timeout_sec=min(0.05, max(0.0, deadline - time.monotonic())))
+        for r in self.robots:
+            if self._answered.get(r) == stamp:
+                self._missed[r] = 0
+            else:
+                self._missed[r] += 1
+                self.world.stats[r].stale_ticks += 1
+                if self._missed[r] == self.config.dead_after:
+                    self.get_logger().warning(f"{r}: no answer for {self._missed[r]} ticks, not waiting for it")
+
+    def _await_wall(self, executor: SingleThreadedExecutor, until: float) -> None:
+        while (remaining := until - time.monotonic()) > 0:
+            executor.spin_once(timeout_sec=min(0.05, remaining))
+        stamp = self.world.t_ns
+        for r in self.robots:
+            if self._answered.get(r) != stamp:
+                self.world.stats[r].stale_ticks += 1
+
+    def run(self, executor: SingleThreadedExecutor) -> None:
+        cfg, sim = self.config, self.scenario.sim
+        self._discover()
+        self.wait_for_controllers(executor)
+        obs = self.world.reset()
+        wall0 = last_progress = time.monotonic()
+        self.wall_start = wall0
+        for k in range(self.scenario.ticks):
+            now = time.monotonic()
+            if now >= self._next_discovery:
+                self._discover()
+                self._next_discovery = now + 1.0
+            self._publish_tick(obs)
+            if cfg.mode == "lockstep":
+                self._await_commands(executor)
+            else:
+                self._await_wall(executor, wall0 + (k + 1) * sim.dt / cfg.real_time_factor)
+            obs = self.world.step({r: self._commands[r] for r in self.robots if r in self._commands})
+            self._publish_world_state()
+            if now - last_progress >= cfg.progress_period:
+                last_progress = now
+                self.print_progress(now - wall0)
+        self._publish_tick(obs)
+        self._publish_world_state(final=True)
+        # Let the controllers' last status messages reach the recorder.
+        end = time.monotonic() + 0.5
+        while time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.05)
+
+    def print_progress(self, wall: float) -> None:
+        t = self.world.t_ns / NS_PER_S
+        stale = sum(s.stale_ticks for s in self.world.stats.values())
+        print(
+            f"[world] t={t:7.1f}/{self.scenario.sim.duration:.0f} s  rtf={t / max(wall, 1e-9):5.2f}x  "
+            f"delivered={self.world.resources_delivered}  stale={stale}",
+            flush=True,
+        )
+
+    def close(self) -> None:
+        if self.bag is not None:
+            self.bag.set_metadata(
+                wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
+                sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
+            )
+            self.bag.close()
+            self.bag = None
+        self.world.close()
+
+
+def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
+    parser = argparse.ArgumentParser(prog="swarm-world", description=__doc__.splitlines()[0])
+    parser.add_argument("--scenario", default="cpfa")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
+    parser.add_argument("--tick-timeout", type=float, default=WorldNodeConfig.tick_timeout)
+    parser.add_argument("--real-time-factor", type=float, default=1.0)
+    parser.add_argument("--bag", default="")
+    args, ros_args = parser.parse_known_args(argv)
+    config = WorldNodeConfig(
+        scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
+        tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
+    )
+    return config, ros_args
+
+
+def main(argv: list[str] | None = None) -> int:
+    config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    rclpy.init(args=["swarm-world", *ros_args])
+    node = None
+    try:
+        node = WorldNode(config)
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        node.run(executor)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        print("[world] interrupted: closing the bag", flush=True)
+    finally:
+        if node is not None:
+            node.close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
