@@ -24,7 +24,6 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rosgraph_msgs.msg import Clock
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
@@ -75,13 +74,13 @@ class WorldNode(Node):
         self.bag = self._open_bag(cfg.bag) if cfg.bag else None
         self._own_topics: set[str] = set()
 
-        self._clock_pub = self._publisher(Clock, topics.CLOCK, SENSOR_LOCKSTEP)
-        self._events_pub = self._publisher(*topics.world_topic(topics.EVENTS), EVENTS)
-        self._stats_pub = self._publisher(*topics.world_topic(topics.ROBOT_STATS), STATE_LATCHED)
-        self._markers_pub = self._publisher(*topics.world_topic(topics.MARKERS), STATE_LATCHED)
+        self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
+        self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
+        self._stats_pub = self._publisher(topics.WORLD_ROBOT_STATS, STATE_LATCHED)
+        self._markers_pub = self._publisher(topics.WORLD_MARKERS, STATE_LATCHED)
         self._obs_pubs = {
             r: {
-                name: self._publisher(*topics.robot_topic(r, name), SENSOR_LOCKSTEP)
+                name: self._publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP)
                 for name in topics.OBSERVATION_TOPICS
             }
             for r in self.robots
@@ -89,11 +88,13 @@ class WorldNode(Node):
         self._commands: dict[RobotId, Command] = {}
         self._answered: dict[RobotId, int] = {}
         self._missed: dict[RobotId, int] = dict.fromkeys(self.robots, 0)
-        self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL)[0]: r for r in self.robots}
+        self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         for topic, robot in self._cmd_topic.items():
-            msg_type = topics.robot_topic(robot, topics.CMD_VEL)[1]
+            if self.bag is not None:
+                self.bag.add_topic(topic, topics.type_string(topic), "reliable")
             self.create_subscription(
-                msg_type, topic, lambda data, r=robot: self._on_cmd(r, data), SENSOR_LOCKSTEP, raw=True
+                topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
+                SENSOR_LOCKSTEP, raw=True,
             )
         self._recorded: set[str] = set(self._own_topics) | set(self._cmd_topic)
         self._warned_unknown: set[str] = set()
@@ -101,11 +102,11 @@ class WorldNode(Node):
 
     # ------------------------------------------------------------------ plumbing
 
-    def _publisher(self, msg_type, topic: str, qos):
+    def _publisher(self, topic: str, qos):
         self._own_topics.add(topic)
         if self.bag is not None:
-            self.bag.add_topic(topic, topics.type_name(msg_type), topics.qos_name(qos))
-        return self.create_publisher(msg_type, topic, qos)
+            self.bag.add_topic(topic, topics.type_string(topic), "latched" if qos is STATE_LATCHED else "reliable")
+        return self.create_publisher(topics.type_of(topic), topic, qos)
 
     def _open_bag(self, path: str) -> BagWriter:
         meta = {
@@ -124,7 +125,7 @@ class WorldNode(Node):
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
         if self.bag is not None:
-            self.bag.write(topics.robot_topic(robot, topics.CMD_VEL)[0], self.world.t_ns, data)
+            self.bag.write(topics.robot_topic(robot, topics.CMD_VEL), self.world.t_ns, data)
         try:
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
@@ -165,24 +166,23 @@ class WorldNode(Node):
                 topics.GRIPPER: gripper.encode_gripper(t_ns, o.carrying),
             }
             for name, data in encoded.items():
-                self._publish(pubs[name], data, topics.robot_topic(r, name)[0])
+                self._publish(pubs[name], data, topics.robot_topic(r, name))
 
     def _publish_world_state(self, final: bool = False) -> None:
         t_ns = self.world.t_ns
         events = self.world.drain_events()
         if events:
-            self._publish(self._events_pub, diagnostics.encode_events(t_ns, events),
-                          topics.world_topic(topics.EVENTS)[1])
+            self._publish(self._events_pub, diagnostics.encode_events(t_ns, events), topics.WORLD_EVENTS)
         stats_every = max(1, round(self.config.stats_period / self.scenario.sim.dt))
         if final or self.world.tick % stats_every == 0:
             self._publish(self._stats_pub, diagnostics.encode_robot_stats(t_ns, self.world.stats),
-                          topics.world_topic(topics.ROBOT_STATS)[1])
+                          topics.WORLD_ROBOT_STATS)
         markers_every = max(1, round(self.config.markers_period / self.scenario.sim.dt))
         if final or self.world.tick % markers_every == 0:
             data = markers.encode_markers(
                 self.scenario, t_ns, self.world.resource_positions(), self.world.true_poses()
             )
-            self._publish(self._markers_pub, data, topics.world_topic(topics.MARKERS)[1])
+            self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
 
     def wait_for_controllers(self, executor: SingleThreadedExecutor) -> None:
         deadline = time.monotonic() + self.config.startup_timeout
@@ -191,7 +191,7 @@ class WorldNode(Node):
             executor.spin_once(timeout_sec=0.1)
             missing = [
                 r for r in self.robots
-                if self.count_publishers(topics.robot_topic(r, topics.CMD_VEL)[0]) == 0
+                if self.count_publishers(topics.robot_topic(r, topics.CMD_VEL)) == 0
                 or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
             ]
         if missing:

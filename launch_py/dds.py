@@ -1,0 +1,95 @@
+"""Loopback-only DDS environment for every process swarmforage starts.
+
+rmw_fastrtps (Jazzy) reads discovery settings from the environment when a process
+creates its first rclpy context, so everything here is plain environment variables;
+this module never imports rclpy.
+
+* Up to ``LOCALHOST_MAX_PROCESSES`` processes: ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
+  rmw_fastrtps then announces only to 127.0.0.1 and only on the ports of the first
+  few participant ids (Fast DDS ``maxInitialPeersRange``), which is enough for a
+  handful of processes.
+* More processes (one per robot): the Fast DDS profile ``fastdds_loopback.xml``
+  (UDP bound to 127.0.0.1 plus shared memory, no multicast, SPDP sent to 256
+  participant ids on 127.0.0.1). The range must then be ``SYSTEM_DEFAULT``:
+  with ``LOCALHOST`` rmw_fastrtps overwrites the profile's metatraffic locators and
+  initial peers, with ``SUBNET`` it appends ``ROS_STATIC_PEERS``; only
+  ``SYSTEM_DEFAULT`` leaves the profile alone.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+PROFILE_PATH = Path(__file__).with_name("fastdds_loopback.xml")
+LOCALHOST_MAX_PROCESSES = 24
+"""Largest process count for which plain LOCALHOST discovery is trusted."""
+PROFILE_MAX_PROCESSES = 256
+"""Participants per domain the profile can discover (its maxInitialPeersRange)."""
+DOMAIN_RANGE = (100, 200)
+"""Inclusive range of private ROS_DOMAIN_IDs: clear of the default 0 and, at the
+RTPS port formula 7400 + 250 * domain, of the ports of domains below 100."""
+
+_DROPPED = (
+    # Each of these would override or extend the discovery chosen here.
+    "ROS_LOCALHOST_ONLY",  # Jazzy: if 1, wins over ROS_AUTOMATIC_DISCOVERY_RANGE
+    "ROS_STATIC_PEERS",  # extra (possibly remote) initial peers
+    "ROS_DISCOVERY_SERVER",  # Fast DDS turns SIMPLE into a discovery-server client
+    "ROS_SUPER_CLIENT",
+    "FASTDDS_BUILTIN_TRANSPORTS",
+    "FASTRTPS_DEFAULT_PROFILES_FILE",
+    "FASTDDS_DEFAULT_PROFILES_FILE",
+    "RMW_FASTRTPS_USE_QOS_FROM_XML",
+    "FASTDDS_ENVIRONMENT_FILE",
+)
+
+
+def loopback_env(
+    domain_id: int, processes: int, base: Mapping[str, str] | None = None
+) -> dict[str, str]:
+    """Environment for a child process of a graph of ``processes`` DDS processes.
+
+    ``base`` defaults to ``os.environ``; discovery-related variables in it are
+    replaced, everything else is kept.
+    """
+    if not 0 <= domain_id <= 232:
+        raise ValueError(f"ROS_DOMAIN_ID {domain_id} outside 0..232")
+    if processes > PROFILE_MAX_PROCESSES:
+        raise ValueError(f"{processes} processes exceed the profile's {PROFILE_MAX_PROCESSES}")
+    env = {k: v for k, v in (os.environ if base is None else base).items() if k not in _DROPPED}
+    env["RMW_IMPLEMENTATION"] = "rmw_fastrtps_cpp"
+    env["ROS_DOMAIN_ID"] = str(domain_id)
+    if processes <= LOCALHOST_MAX_PROCESSES:
+        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    else:
+        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
+        env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # Fast DDS 2.x name
+        env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # Fast DDS 3.x name
+        # No DEFAULT_FASTRTPS_PROFILES.xml from the working directory on top of ours.
+        env["SKIP_DEFAULT_XML_FILE"] = "1"
+    return env
+
+
+def private_domain_id(seed: int | None = None) -> int:
+    """ROS_DOMAIN_ID for one run: the user's ``ROS_DOMAIN_ID`` if set, else one
+    derived from ``seed`` (default: this pid) in ``DOMAIN_RANGE``, so concurrent
+    runs and tests rarely share a domain."""
+    user = os.environ.get("ROS_DOMAIN_ID", "").strip()
+    if user:
+        return int(user)
+    lo, hi = DOMAIN_RANGE
+    return lo + (os.getpid() if seed is None else seed) % (hi - lo + 1)
+
+
+def apply_to_current_process(env: Mapping[str, str]) -> None:
+    """Make ``env`` the environment of this process.
+
+    Call it BEFORE ``import rclpy`` (and before any other module that imports it):
+    the rmw reads these variables when the first context is initialised, and Fast DDS
+    loads its XML profile only once per process, so later changes have no effect.
+    """
+    for key in _DROPPED:
+        if key not in env:
+            os.environ.pop(key, None)
+    os.environ.update(env)

@@ -1,0 +1,133 @@
+"""Reactive obstacle avoidance from the laser scan.
+
+The scan sees walls, obstacles and other robots alike, so one rule covers all three: when a
+ray in the front sector reads closer than `AvoidanceConfig.distance`, the robot stops driving
+and turns toward the side with more free space until the front sector is clear again. This is
+the role the foot-bot proximity ring plays in the ARGoS CPFA; the behaviour that owns this
+object gives it priority over its state machine's motion.
+
+An obstacle-avoidance *event* is one such episode: it is counted on the tick avoidance starts
+after at least one clear tick (the state before the first tick counts as clear), not once per
+tick spent turning. The turn direction is chosen when the episode starts and kept until it
+ends, so a symmetric obstacle (a wall met head on) cannot make the robot dither left and right.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from swarm_sim.geometry import wrap_angle
+from swarm_sim.scenario import AvoidanceConfig, ScanConfig
+from swarm_sim.types import Command
+
+_FULL_CIRCLE_TOLERANCE = 1e-9
+
+
+def ray_angles(scan: ScanConfig) -> list[float]:
+    """Angle of each ray relative to the heading [rad, counter-clockwise, wrapped to (-pi, pi]].
+
+    Ray i is at ``-fov/2 + i * inc`` with ``inc = fov / rays`` for a full circle (the last ray
+    stops one increment short of the first) and ``fov / (rays - 1)`` otherwise (both ends
+    included), the convention the world's scan uses.
+    """
+    n = scan.rays
+    if scan.fov >= 2.0 * math.pi - _FULL_CIRCLE_TOLERANCE:
+        inc = scan.fov / n
+    else:
+        inc = scan.fov / (n - 1) if n > 1 else 0.0
+    return [wrap_angle(-scan.fov / 2.0 + i * inc) for i in range(n)]
+
+
+class ObstacleAvoidance:
+    """Turns away from whatever the front sector of the scan sees too close; counts episodes."""
+
+    def __init__(
+        self, config: AvoidanceConfig, scan: ScanConfig, max_angular: float | None = None
+    ) -> None:
+        self.config = config
+        self.scan = scan
+        self._rays = scan.rays
+        self._distance = config.distance
+        self._range_max = scan.range_max
+        angles = ray_angles(scan)
+        half_front = config.front_fov / 2.0 + 1e-12
+        front = [i for i, a in enumerate(angles) if abs(a) <= half_front]
+        # Contiguous in every sane configuration (angles are monotonic around the heading);
+        # an index list covers anything else.
+        self._front: slice | list[int]
+        if front and front == list(range(front[0], front[-1] + 1)):
+            self._front = slice(front[0], front[-1] + 1)
+        else:
+            self._front = front
+        # Free space is compared over the forward half-plane only: what lies behind the robot
+        # does not matter for where it can turn to and drive.
+        self._left = [i for i, a in enumerate(angles) if 0.0 < a <= math.pi / 2 + 1e-12]
+        self._right = [i for i, a in enumerate(angles) if -math.pi / 2 - 1e-12 <= a < 0.0]
+        turn = config.turn_speed if max_angular is None else min(config.turn_speed, max_angular)
+        self._turn_left = Command(0.0, turn)
+        self._turn_right = Command(0.0, -turn)
+        self._active = False
+        self._command: Command = self._turn_left
+        self._events = 0
+
+    @property
+    def events(self) -> int:
+        """Obstacle-avoidance episodes so far."""
+        return self._events
+
+    @property
+    def active(self) -> bool:
+        """True while the last `update` returned a turn."""
+        return self._active
+
+    @property
+    def front_rays(self) -> tuple[int, ...]:
+        """Indices of the rays watched for obstacles."""
+        f = self._front
+        return tuple(range(f.start, f.stop)) if isinstance(f, slice) else tuple(f)
+
+    def update(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
+        """A turn-away command if the front sector is blocked, else None.
+
+        `ranges` [m] are the scan's rays in order (float32 array or any float sequence; inf
+        where nothing was hit). A NaN ray is ignored.
+        """
+        values = ranges.tolist() if isinstance(ranges, np.ndarray) else list(ranges)
+        if len(values) != self._rays:
+            raise ValueError(
+                f"scan has {len(values)} rays, the scenario says sensors.scan.rays={self._rays}"
+            )
+        f = self._front
+        front = values[f] if isinstance(f, slice) else [values[i] for i in f]
+        if not front:
+            self._active = False
+            return None
+        nearest = min(front)
+        if nearest != nearest:  # NaN poisoned min(); look again without NaNs
+            nearest = min((v for v in front if v == v), default=math.inf)
+        if not nearest < self._distance:
+            self._active = False
+            return None
+        if not self._active:
+            self._active = True
+            self._events += 1
+            self._command = self._turn_left if self._free_side(values) >= 0.0 else self._turn_right
+        return self._command
+
+    def _free_side(self, values: list[float]) -> float:
+        """Mean free range left minus right [m]: positive = more room to the left (ties left)."""
+        rmax = self._range_max
+
+        def mean_free(indices: list[int]) -> float:
+            if not indices:
+                return 0.0
+            total = 0.0
+            for i in indices:
+                v = values[i]
+                total += v if v < rmax else rmax  # inf and NaN count as free to range_max
+            return total / len(indices)
+
+        return mean_free(self._left) - mean_free(self._right)

@@ -1,0 +1,463 @@
+"""The central-place foraging algorithm (CPFA) baseline.
+
+J. P. Hecker and M. E. Moses, "Beyond pheromones: evolving error-tolerant, flexible, and
+scalable ant-inspired robot swarms", Swarm Intelligence 9:43-70, 2015 ("H&M" below): the
+CPFA state diagram (Fig. 1), its pseudocode (Algorithm 1) and the behaviour descriptions in
+the methods section. Where the paper leaves a detail open, the choice follows BCLab's ARGoS
+CPFA controller (``CPFA_controller.cpp`` in BCLab-UNM/CPFA-ARGoS, "ARGoS" below) and says so.
+
+Rules, in the paper's words, and how they are realised here:
+
+* **Set search location / travel to search site** (H&M Fig. 1, Algorithm 1: disperse from
+  the nest). Every robot starts at the nest (the depot disc) in DEPARTING toward a site drawn
+  uniformly in the arena, a margin ``max(resources.margin, robots.diameter)`` inside the walls
+  and outside the nest. The paper draws a dispersal direction U(0, 2 pi) and ARGoS a point on
+  the arena border; a uniform site gives every direction as well and also ends a trip that
+  reaches it. An *uninformed* traveller switches to SEARCHING with probability p_s each tick
+  ("probability of switching to searching"); reaching the site starts an uninformed search.
+  Informed travellers (site fidelity, pheromone) ignore p_s and search once they arrive.
+* **Search with uninformed walk** (H&M: correlated random walk): every `search_step` metres of
+  travel the heading becomes the current heading plus N(0, sigma), sigma = omega. As in ARGoS
+  the turn is drawn relative to the robot's current yaw and wrapped to (-pi, pi]. Each tick
+  the searcher gives up with probability p_r ("probability of returning to nest") and returns
+  without a resource. Staying inside the arena (not specified by the paper): a leg whose end
+  would leave the margin is redrawn, at most 8 times, then the robot heads for the arena
+  centre; the scan avoidance handles whatever is left.
+* **Search with informed walk** (H&M informed-walk equation):
+  sigma = omega + (4 pi - omega) exp(-lambda_id t), t = time since the informed search began
+  [s]. Searches at a remembered site (site fidelity) or at a pheromone waypoint are informed:
+  they start almost undirected and relax to the uninformed walk. ARGoS counts t in search
+  steps, CPFA-ROS in seconds; seconds match `CpfaConfig.rate_of_informed_search_decay` [1/s].
+* **Find resource, sense local density** (H&M Algorithm 1: count the resources c near the
+  find): the world picks a resource up when an empty robot reaches it; on the tick
+  `obs.carrying` turns True the robot records the site (its own position) and
+  c = len(obs.resources), the *other* resources within the detection radius (the carried one
+  no longer lies on the floor). ARGoS counts the found one as well (its density starts at 1).
+  No survey pause: sensing the neighbourhood is instantaneous here (later ARGoS versions
+  disable their 4 s survey wait too). Then RETURNING.
+* **Return to nest**: straight for the depot centre. The world drops the resource when the
+  carrier enters a drop zone; `obs.carrying` turning False completes a trip (trips += 1). A
+  robot that gave up has arrived when it is inside the depot disc.
+* **Lay pheromone** (H&M: with probability POIS(c, lambda_lp)): after a delivery the robot
+  sends a `PheromoneMessage` (the site, stamped now) with that tick's command. POIS is the
+  Poisson CDF e^-lambda sum_{i<=c} lambda^i / i!, as in the paper's equation and ARGoS.
+* **Site fidelity** (H&M: with probability POIS(c, lambda_sf)): after a delivery, travel back
+  to the site and search informed there.
+* **Follow pheromone**: otherwise, if the robot knows waypoints, pick one with probability
+  proportional to its strength exp(-lambda_pd * age) (ARGoS's roulette wheel), travel there and
+  search informed; waypoints weaker than `pheromone_threshold` are forgotten. Otherwise a new
+  uniform site, uninformed. After a give-up return only these last two choices apply (site
+  fidelity needs a find, as in ARGoS). Waypoints arrive as `PheromoneMessage`s in
+  `obs.messages`, other robots' and the robot's own, one tick after sending. In ARGoS the
+  layer's new waypoint is in the shared list before it chooses, so here it is added locally
+  when laid and its echo is not counted twice.
+* **Travel to an informed site** ends within `controller.arrival_tolerance`, or when the scan
+  is blocked within one robot diameter of it (someone stands on the site; CPFA-ROS likewise
+  starts searching when its travel is interrupted).
+
+Per-tick probabilities: p_s and p_r are taken as per tick of a controller ticking at
+`CpfaConfig.original_tick_rate` (16 Hz; the early ARGoS controller draws them every control
+step, later versions only every 0.5 s, CPFA-ROS per 0.5 m waypoint). With our tick dt the
+same hazard per second is p' = 1 - (1 - p) ** (original_tick_rate * dt).
+
+Obstacle avoidance has priority over every state's motion; the state machine still runs (and
+draws) on avoidance ticks, as in ARGoS where the CPFA step and the collision-avoiding move are
+separate. When an avoidance episode ends the robot first drives straight ahead for one
+`search_step` (ARGoS pushes a FORWARD move of SearchStepSize after its avoidance turn) before
+its state steers again; without that, a goal just beside an obstacle makes the avoidance turn
+and the goal turn undo each other forever with the robot standing still.
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+
+import numpy as np
+
+from swarm_controllers.avoidance import ObstacleAvoidance
+from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
+from swarm_sim.scenario import Scenario
+from swarm_sim.types import (
+    NS_PER_S,
+    BehaviourStatus,
+    Command,
+    Observation,
+    PheromoneMessage,
+    RobotId,
+)
+
+_TWO_PI = 2.0 * math.pi
+_FOUR_PI = 4.0 * math.pi
+_LEG_REDRAWS = 8
+_SITE_REDRAWS = 16
+
+
+class CpfaState(Enum):
+    """H&M Fig. 1, folded into the three states a robot can be observed in."""
+
+    DEPARTING = "departing"
+    """Set search location and travel to it (random site, remembered site or waypoint)."""
+    SEARCHING = "searching"
+    """Correlated random walk, uninformed or informed."""
+    RETURNING = "returning"
+    """Back to the nest, with a resource or after giving up."""
+
+
+class SearchMode(Enum):
+    """Where the current trip's search location came from (H&M: the information used)."""
+
+    UNINFORMED = "uninformed"
+    SITE_FIDELITY = "site_fidelity"
+    PHEROMONE = "pheromone"
+
+
+def poisson_cdf(k: int, lam: float) -> float:
+    """POIS(k, lambda) = P(X <= k), X ~ Poisson(lambda): e^-lambda sum_{i=0}^{k} lambda^i / i!.
+
+    Summed in log space so that large rates neither underflow nor overflow.
+    """
+    k = math.floor(k)
+    if k < 0:
+        return 0.0
+    if lam <= 0.0:
+        return 1.0
+    log_lam = math.log(lam)
+    total = 0.0
+    for i in range(k + 1):
+        total += math.exp(i * log_lam - math.lgamma(i + 1) - lam)
+    return min(total, 1.0)
+
+
+def per_tick_probability(p: float, original_tick_rate: float, dt: float) -> float:
+    """Rescale a per-tick probability evolved at `original_tick_rate` [Hz] to a tick of `dt` [s]:
+    the same hazard per second, p' = 1 - (1 - p)^(rate * dt)."""
+    if p <= 0.0:
+        return 0.0
+    if p >= 1.0:
+        return 1.0
+    return -math.expm1(original_tick_rate * dt * math.log1p(-p))
+
+
+def informed_search_sigma(omega: float, lambda_id: float, t_search: float) -> float:
+    """Std [rad] of an informed walk's turn after `t_search` [s] of informed search:
+    omega + (4 pi - omega) exp(-lambda_id t) (H&M informed-walk equation)."""
+    return omega + (_FOUR_PI - omega) * math.exp(-lambda_id * t_search)
+
+
+class CpfaBehaviour:
+    """One robot running the CPFA. See the module docstring for the rules and their sources."""
+
+    def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
+        cfg = scenario.controller.cpfa
+        dt = scenario.sim.dt
+        self.robot = robot
+        self._rng = rng
+        self._limits = DriveLimits.from_scenario(scenario)
+        self._avoidance = ObstacleAvoidance(
+            scenario.controller.avoidance, scenario.sensors.scan, scenario.robots.max_angular_speed
+        )
+        self._p_switch = per_tick_probability(
+            cfg.probability_of_switching_to_searching, cfg.original_tick_rate, dt
+        )
+        self._p_return = per_tick_probability(
+            cfg.probability_of_returning_to_nest, cfg.original_tick_rate, dt
+        )
+        self._omega = cfg.uninformed_search_variation
+        self._lambda_id = cfg.rate_of_informed_search_decay
+        self._lambda_sf = cfg.rate_of_site_fidelity
+        self._lambda_lp = cfg.rate_of_laying_pheromone
+        self._lambda_pd = cfg.rate_of_pheromone_decay
+        self._threshold = cfg.pheromone_threshold
+        self._step2 = cfg.search_step**2
+        self._search_step = cfg.search_step
+        arrival = scenario.controller.arrival_tolerance
+        self._arrival2 = arrival**2
+        self._blocked2 = (arrival + scenario.robots.diameter) ** 2
+        self._nest = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
+        self._nest_r2 = scenario.depot.radius**2
+        margin = max(scenario.resources.margin, scenario.robots.diameter)
+        half = scenario.arena.size / 2.0
+        self._bound = half - margin if half > margin else half / 2.0
+        self._site_clearance2 = (scenario.depot.radius + margin) ** 2
+        self._escape_ticks = max(
+            1, math.ceil(cfg.search_step / (scenario.robots.max_linear_speed * dt) - 1e-9)
+        )
+        self._escape_left = 0
+        """Ticks left of the straight run that follows an avoidance episode."""
+        self._was_avoiding = False
+
+        self._state = CpfaState.DEPARTING
+        self._mode = SearchMode.UNINFORMED
+        self._carrying = False
+        self._trips = 0
+        self._stamp_ns = 0
+        self._target = self._random_site()
+        self._heading = 0.0
+        """Current walk leg's heading [rad, world frame]."""
+        self._leg_x = 0.0
+        self._leg_y = 0.0
+        self._search_t0 = 0.0
+        """When the current search began [s]."""
+        self._site: tuple[float, float] | None = None
+        """Where the last resource was found, until used for site fidelity or given up."""
+        self._site_count = 0
+        self._pheromones: list[tuple[int, float, float]] = []
+        """Known waypoints as (stamp_ns, x, y), in arrival order."""
+        self._own_unechoed: set[PheromoneMessage] = set()
+
+    # ------------------------------------------------------------------ read-only views
+
+    @property
+    def state(self) -> CpfaState:
+        return self._state
+
+    @property
+    def search_mode(self) -> SearchMode:
+        return self._mode
+
+    @property
+    def informed(self) -> bool:
+        return self._mode is not SearchMode.UNINFORMED
+
+    @property
+    def target(self) -> tuple[float, float]:
+        """Search location of the current trip [m, world frame]."""
+        return self._target
+
+    @property
+    def site(self) -> tuple[float, float] | None:
+        """Remembered site of the last find [m, world frame], if any."""
+        return self._site
+
+    @property
+    def site_count(self) -> int:
+        """c of the last find: other resources sensed at pickup."""
+        return self._site_count
+
+    @property
+    def pheromones(self) -> tuple[PheromoneMessage, ...]:
+        """Waypoints currently remembered (some may since have decayed below threshold)."""
+        return tuple(PheromoneMessage(s, x, y) for s, x, y in self._pheromones)
+
+    @property
+    def trips(self) -> int:
+        return self._trips
+
+    @property
+    def obstacle_avoidance_events(self) -> int:
+        return self._avoidance.events
+
+    @property
+    def switch_probability(self) -> float:
+        """p_s per tick of our dt."""
+        return self._p_switch
+
+    @property
+    def return_probability(self) -> float:
+        """p_r per tick of our dt."""
+        return self._p_return
+
+    def status(self, stamp_ns: int | None = None) -> BehaviourStatus:
+        return BehaviourStatus(
+            robot=self.robot,
+            stamp_ns=self._stamp_ns if stamp_ns is None else stamp_ns,
+            state=self._state.name,
+            obstacle_avoidance_events=self._avoidance.events,
+            trips=self._trips,
+            extra=(("search", self._mode.value),),
+        )
+
+    # ------------------------------------------------------------------ the tick
+
+    def step(self, obs: Observation) -> Command:
+        self._stamp_ns = obs.stamp_ns
+        if obs.messages:
+            self._receive(obs.messages, obs.stamp_ns)
+        out: tuple[object, ...] = ()
+        carrying = bool(obs.carrying)
+        if carrying != self._carrying:
+            self._carrying = carrying
+            if carrying:
+                self._found_resource(obs)
+            else:
+                self._trips += 1
+                out = self._at_nest(obs, delivered=True)
+        avoid = self._avoidance.update(obs.ranges)
+        if avoid is None and self._was_avoiding:
+            self._escape_left = self._escape_ticks
+        self._was_avoiding = avoid is not None
+        state = self._state
+        if state is CpfaState.DEPARTING:
+            linear, angular = self._departing(obs)
+        elif state is CpfaState.SEARCHING:
+            linear, angular = self._searching(obs)
+        else:
+            linear, angular = self._returning(obs)
+        if avoid is not None:
+            if not out:
+                return avoid
+            linear, angular = avoid.linear, avoid.angular
+        elif self._escape_left:
+            self._escape_left -= 1
+            linear, angular = self._limits.max_linear, 0.0
+        return Command(linear, angular, out)
+
+    # ------------------------------------------------------------------ states
+
+    def _departing(self, obs: Observation) -> tuple[float, float]:
+        pose = obs.pose
+        x, y = pose.x, pose.y
+        tx, ty = self._target
+        d2 = (tx - x) ** 2 + (ty - y) ** 2
+        if self._mode is SearchMode.UNINFORMED:
+            # H&M: an uninformed traveller starts searching with probability p_s per tick.
+            if self._rng.random() < self._p_switch or d2 < self._arrival2:
+                return self._start_search(obs)
+        elif d2 < self._arrival2 or (self._avoidance.active and d2 < self._blocked2):
+            return self._start_search(obs)
+        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+
+    def _start_search(self, obs: Observation) -> tuple[float, float]:
+        self._state = CpfaState.SEARCHING
+        self._search_t0 = obs.t
+        self._new_leg(obs)
+        return self._walk(obs)
+
+    def _searching(self, obs: Observation) -> tuple[float, float]:
+        # H&M: a searcher gives up and returns with probability p_r per tick.
+        if self._rng.random() < self._p_return:
+            self._state = CpfaState.RETURNING
+            return self._returning(obs)
+        pose = obs.pose
+        if (pose.x - self._leg_x) ** 2 + (pose.y - self._leg_y) ** 2 >= self._step2:
+            self._new_leg(obs)
+        return self._walk(obs)
+
+    def _walk(self, obs: Observation) -> tuple[float, float]:
+        error = math.remainder(self._heading - obs.pose.yaw, _TWO_PI)
+        return steer(error, math.inf, self._limits)
+
+    def _new_leg(self, obs: Observation) -> None:
+        """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
+        pose = obs.pose
+        x, y, yaw = pose.x, pose.y, pose.yaw
+        if self._mode is SearchMode.UNINFORMED:
+            sigma = self._omega
+        else:
+            sigma = informed_search_sigma(self._omega, self._lambda_id, obs.t - self._search_t0)
+        step, bound = self._search_step, self._bound
+        normal = self._rng.normal
+        for _ in range(_LEG_REDRAWS):
+            heading = yaw + normal(0.0, sigma)
+            end_x = x + step * math.cos(heading)
+            end_y = y + step * math.sin(heading)
+            if abs(end_x) <= bound and abs(end_y) <= bound:
+                break
+        else:
+            heading = math.atan2(-y, -x)  # back toward the arena centre (the world origin)
+        self._heading = math.remainder(heading, _TWO_PI)
+        self._leg_x, self._leg_y = x, y
+
+    def _returning(self, obs: Observation) -> tuple[float, float]:
+        pose = obs.pose
+        x, y = pose.x, pose.y
+        nx, ny = self._nest
+        d2 = (nx - x) ** 2 + (ny - y) ** 2
+        if not self._carrying and d2 < self._nest_r2:
+            self._at_nest(obs, delivered=False)  # gave up; no messages on this path
+            return self._departing(obs)
+        if d2 < self._arrival2:
+            return 0.0, 0.0  # at the centre, waiting for the drop
+        return go_to_point_twist(x, y, pose.yaw, nx, ny, self._limits)
+
+    # ------------------------------------------------------------------ events
+
+    def _found_resource(self, obs: Observation) -> None:
+        """Record the site and the local density c, then head home (H&M Alg. 1)."""
+        self._site = (obs.pose.x, obs.pose.y)
+        self._site_count = len(obs.resources)
+        self._state = CpfaState.RETURNING
+
+    def _at_nest(self, obs: Observation, delivered: bool) -> tuple[object, ...]:
+        """Lay pheromone, then choose site fidelity, a waypoint or a random site (H&M Alg. 1)."""
+        out: tuple[object, ...] = ()
+        site = self._site
+        self._site = None
+        self._state = CpfaState.DEPARTING
+        rng = self._rng
+        if delivered and site is not None:
+            c = self._site_count
+            if rng.random() < poisson_cdf(c, self._lambda_lp):
+                message = PheromoneMessage(obs.stamp_ns, site[0], site[1])
+                out = (message,)
+                self._pheromones.append((obs.stamp_ns, site[0], site[1]))
+                self._own_unechoed.add(message)
+            if rng.random() < poisson_cdf(c, self._lambda_sf):
+                self._target = site
+                self._mode = SearchMode.SITE_FIDELITY
+                return out
+        waypoint = self._choose_pheromone(obs.stamp_ns)
+        if waypoint is not None:
+            self._target = waypoint
+            self._mode = SearchMode.PHEROMONE
+        else:
+            self._target = self._random_site()
+            self._mode = SearchMode.UNINFORMED
+        return out
+
+    def _random_site(self) -> tuple[float, float]:
+        """Uniform in the arena inside the wall margin, redrawn if it falls by the nest."""
+        b = self._bound
+        uniform = self._rng.uniform
+        nx, ny = self._nest
+        x = y = 0.0
+        for _ in range(_SITE_REDRAWS):
+            x = float(uniform(-b, b))
+            y = float(uniform(-b, b))
+            if (x - nx) ** 2 + (y - ny) ** 2 > self._site_clearance2:
+                break
+        return (x, y)
+
+    # ------------------------------------------------------------------ pheromones
+
+    def _strength(self, stamp_ns: int, now_ns: int) -> float:
+        age = (now_ns - stamp_ns) / NS_PER_S
+        return math.exp(-self._lambda_pd * age) if age > 0.0 else 1.0
+
+    def _receive(self, messages: tuple[object, ...], now_ns: int) -> None:
+        changed = False
+        for message in messages:
+            if isinstance(message, PheromoneMessage):
+                if message in self._own_unechoed:
+                    self._own_unechoed.discard(message)
+                    continue
+                self._pheromones.append((message.stamp_ns, message.x, message.y))
+                changed = True
+        if changed:
+            self._forget(now_ns)
+
+    def _forget(self, now_ns: int) -> None:
+        """Drop waypoints whose strength fell below the threshold."""
+        threshold = self._threshold
+        self._pheromones = [
+            p for p in self._pheromones if self._strength(p[0], now_ns) >= threshold
+        ]
+        if self._own_unechoed:
+            self._own_unechoed = {
+                m for m in self._own_unechoed if self._strength(m.stamp_ns, now_ns) >= threshold
+            }
+
+    def _choose_pheromone(self, now_ns: int) -> tuple[float, float] | None:
+        """A waypoint drawn with probability proportional to its decayed strength."""
+        self._forget(now_ns)
+        if not self._pheromones:
+            return None
+        weights = [self._strength(p[0], now_ns) for p in self._pheromones]
+        u = self._rng.random() * sum(weights)
+        for weight, (_, x, y) in zip(weights, self._pheromones):
+            if u < weight:
+                return (x, y)
+            u -= weight
+        _, x, y = self._pheromones[-1]  # float round-off at the top end
+        return (x, y)

@@ -1,0 +1,120 @@
+"""Topic names and their ROS types: the one list the nodes, the recorder and analysis share.
+
+Robot topics are relative names (``odom``) so that a controller node started in namespace
+``/robot_3`` resolves them to ``/robot_3/odom`` and remapping works; nodes that serve every
+robot (the world, the recorder) use `robot_topic`. Global topics are absolute.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterable
+from typing import Any
+
+from swarm_sim.types import RobotId
+
+# Relative names under a robot's namespace.
+ODOM = "odom"
+SCAN = "scan"
+RESOURCES = "resources"
+GRIPPER = "gripper"
+CMD_VEL = "cmd_vel"
+STATUS = "status"
+OBSERVATION_TOPICS = (ODOM, SCAN, RESOURCES, GRIPPER)
+"""What the world publishes to each robot every tick; a controller steps once it has all four
+stamped with the same tick."""
+
+# Absolute names.
+CLOCK = "/clock"
+WORLD_EVENTS = "/world/events"
+WORLD_ROBOT_STATS = "/world/robot_stats"
+WORLD_MARKERS = "/world/markers"
+PHEROMONES = "/nest/pheromones"
+
+ROBOT_TOPIC_TYPES: dict[str, str] = {
+    ODOM: "nav_msgs/msg/Odometry",
+    SCAN: "sensor_msgs/msg/LaserScan",
+    RESOURCES: "geometry_msgs/msg/PoseArray",
+    GRIPPER: "sensor_msgs/msg/JointState",
+    CMD_VEL: "geometry_msgs/msg/TwistStamped",
+    STATUS: "diagnostic_msgs/msg/DiagnosticArray",
+}
+"""Relative robot topic -> ROS type string."""
+
+GLOBAL_TOPIC_TYPES: dict[str, str] = {
+    CLOCK: "rosgraph_msgs/msg/Clock",
+    WORLD_EVENTS: "diagnostic_msgs/msg/DiagnosticArray",
+    WORLD_ROBOT_STATS: "diagnostic_msgs/msg/DiagnosticArray",
+    WORLD_MARKERS: "visualization_msgs/msg/MarkerArray",
+    PHEROMONES: "geometry_msgs/msg/PointStamped",
+}
+"""Absolute topic -> ROS type string."""
+
+
+def type_string(topic: str) -> str:
+    """ROS type string of a relative robot topic (``odom``), an absolute global topic
+    (``/clock``) or an absolute robot topic (``/robot_3/odom``); ValueError if unknown."""
+    if topic in ROBOT_TOPIC_TYPES:
+        return ROBOT_TOPIC_TYPES[topic]
+    return topic_type(topic)
+
+
+def import_type(type_name: str) -> Any | None:
+    """``"nav_msgs/msg/Odometry"`` -> the rclpy message class, None if it is not installed.
+
+    Imports on call, so this module stays importable without ROS.
+    """
+    package, _, name = type_name.replace("/msg/", "/").partition("/")
+    try:
+        return getattr(importlib.import_module(f"{package}.msg"), name)
+    except (ImportError, AttributeError):
+        return None
+
+
+def type_of(topic: str) -> Any:
+    """The rclpy message class to create a publisher or (raw) subscription for `topic`."""
+    type_name = type_string(topic)
+    cls = import_type(type_name)
+    if cls is None:
+        raise ImportError(f"{topic}: message type {type_name} is not installed")
+    return cls
+
+
+def type_name(msg_class: Any) -> str:
+    """rclpy message class -> ``"pkg/msg/Name"`` (what rosbag2 metadata wants)."""
+    package = msg_class.__module__.split(".")[0]
+    return f"{package}/msg/{msg_class.__name__}"
+
+
+def robot_topic(robot: RobotId, name: str) -> str:
+    """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"``."""
+    if name not in ROBOT_TOPIC_TYPES:
+        raise ValueError(f"unknown robot topic {name!r} (known: {', '.join(ROBOT_TOPIC_TYPES)})")
+    return f"/{robot}/{name}"
+
+
+def split_robot_topic(topic: str) -> tuple[RobotId, str] | None:
+    """``"/robot_3/odom"`` -> ``("robot_3", "odom")``; None for anything else."""
+    parts = topic.split("/")
+    if len(parts) == 3 and parts[0] == "" and parts[1] and parts[2] in ROBOT_TOPIC_TYPES:
+        return parts[1], parts[2]
+    return None
+
+
+def topic_type(topic: str) -> str:
+    """ROS type string of an absolute topic name; ValueError naming it if unknown."""
+    if topic in GLOBAL_TOPIC_TYPES:
+        return GLOBAL_TOPIC_TYPES[topic]
+    split = split_robot_topic(topic)
+    if split is None:
+        raise ValueError(f"unknown topic {topic!r}")
+    return ROBOT_TOPIC_TYPES[split[1]]
+
+
+def all_topics(robots: Iterable[RobotId]) -> dict[str, str]:
+    """Every topic of a run with `robots` -> its ROS type (what the recorder subscribes)."""
+    out = dict(GLOBAL_TOPIC_TYPES)
+    for robot in robots:
+        for name, type_name in ROBOT_TOPIC_TYPES.items():
+            out[robot_topic(robot, name)] = type_name
+    return out

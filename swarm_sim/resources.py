@@ -1,0 +1,200 @@
+"""Where the resources lie at the start of a run, and where a respawned one reappears.
+
+Every placement draws only from the `numpy.random.Generator` it is given, so the same seed gives
+the same layout. All positions are [m, world frame]. A position is *valid* when it keeps
+``resources.margin`` from the walls (``|x|, |y| <= L/2 - margin``) and lies at least
+``resources.min_depot_clearance`` outside the depot disc.
+
+Distributions:
+
+- ``clustered``: ``clusters`` square grids of ``cluster_side x cluster_side`` resources (pitch
+  ``spacing``), e.g. the queue paper's five 8 x 8 clusters; cluster squares never touch (at least one
+  pitch between them) and every resource of a cluster is valid.
+- ``uniform``: every resource independently uniform over the valid region.
+- ``powerlaw``: Hecker & Moses (2015): piles of 4^j resources (a 2^j x 2^j grid) for
+  ``j < powerlaw_levels``, with 4^(levels-1-j) piles of each size (so each size holds the same
+  number of resources); piles of one resource are scattered uniformly, and so is whatever
+  ``count`` holds beyond the piles.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
+
+MAX_ATTEMPTS = 2000
+"""Random draws per cluster/pile before a placement restarts from scratch."""
+MAX_RESTARTS = 20
+"""Fresh starts before a placement gives up with a ScenarioError."""
+
+
+def _half_extent(cfg: ResourceConfig, arena: ArenaConfig) -> float:
+    """Resource coordinates must satisfy |x|, |y| <= this [m]."""
+    return arena.size / 2 - cfg.margin
+
+
+def _keep_out(cfg: ResourceConfig, depot: DepotConfig) -> float:
+    """Resources stay at least this far from the depot centre [m]."""
+    return depot.radius + cfg.min_depot_clearance
+
+
+def _grid(side: int, spacing: float) -> np.ndarray:
+    """(side^2, 2) offsets of a side x side grid centred on the origin, row by row."""
+    ticks = (np.arange(side) - (side - 1) / 2) * spacing
+    gx, gy = np.meshgrid(ticks, ticks)
+    return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+def _square_clear_of_depot(center: np.ndarray, half_span: float, depot: DepotConfig, keep_out: float) -> bool:
+    """True if every point of the square [center +- half_span] is >= keep_out from the depot."""
+    cx, cy = depot.center
+    nx = min(max(cx, center[0] - half_span), center[0] + half_span)
+    ny = min(max(cy, center[1] - half_span), center[1] + half_span)
+    return math.hypot(nx - cx, ny - cy) >= keep_out
+
+
+def _place_squares(
+    half_spans: list[float],
+    cfg: ResourceConfig,
+    arena: ArenaConfig,
+    depot: DepotConfig,
+    rng: np.random.Generator,
+    key: str,
+) -> np.ndarray:
+    """Centres (K, 2) for squares of the given half spans: valid and at least one pitch apart.
+
+    Rejection sampling, largest square first; after MAX_ATTEMPTS failed draws for one square the
+    whole layout restarts; after MAX_RESTARTS it raises ScenarioError naming `key`.
+    """
+    half = _half_extent(cfg, arena)
+    keep_out = _keep_out(cfg, depot)
+    order = sorted(range(len(half_spans)), key=lambda i: -half_spans[i])
+    for _ in range(MAX_RESTARTS):
+        centres = np.zeros((len(half_spans), 2))
+        placed: list[int] = []
+        for i in order:
+            hs = half_spans[i]
+            room = half - hs
+            if room < 0:
+                raise ScenarioError(
+                    f"{key}: a square of side {2 * hs:.2f} m does not fit in the arena "
+                    f"(arena.size {arena.size} m, resources.margin {cfg.margin} m)"
+                )
+            for _ in range(MAX_ATTEMPTS):
+                c = rng.uniform(-room, room, size=2)
+                if not _square_clear_of_depot(c, hs, depot, keep_out):
+                    continue
+                if all(
+                    max(abs(c[0] - centres[j, 0]), abs(c[1] - centres[j, 1]))
+                    >= hs + half_spans[j] + cfg.spacing
+                    for j in placed
+                ):
+                    centres[i] = c
+                    placed.append(i)
+                    break
+            else:
+                break  # this square found no room: restart the whole layout
+        else:
+            return centres
+    raise ScenarioError(
+        f"{key}: cannot place {len(half_spans)} non-overlapping groups of resources in the "
+        f"{arena.size} m arena (margin {cfg.margin} m, {cfg.min_depot_clearance} m clear of the "
+        f"depot) after {MAX_RESTARTS} attempts"
+    )
+
+
+def _uniform(
+    n: int, cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator
+) -> np.ndarray:
+    """(n, 2) independent uniform valid positions (vectorised rejection sampling)."""
+    half = _half_extent(cfg, arena)
+    keep_out = _keep_out(cfg, depot)
+    if half < 0:
+        raise ScenarioError(f"resources.margin: {cfg.margin} m leaves no room in the {arena.size} m arena")
+    out = np.empty((n, 2))
+    filled = 0
+    for _ in range(MAX_ATTEMPTS):
+        if filled == n:
+            return out
+        batch = rng.uniform(-half, half, size=(max(2 * (n - filled), 16), 2))
+        ok = np.hypot(batch[:, 0] - depot.center[0], batch[:, 1] - depot.center[1]) >= keep_out
+        take = batch[ok][: n - filled]
+        out[filled : filled + len(take)] = take
+        filled += len(take)
+    if filled == n:
+        return out
+    raise ScenarioError(
+        f"resources.min_depot_clearance: no room for resources {cfg.min_depot_clearance} m clear of "
+        f"the depot inside the {arena.size} m arena (margin {cfg.margin} m)"
+    )
+
+
+def powerlaw_pile_sizes(levels: int) -> list[int]:
+    """Pile sizes of the power-law distribution, largest first, piles of one included."""
+    return [4**j for j in reversed(range(levels)) for _ in range(4 ** (levels - 1 - j))]
+
+
+def place_resources(
+    cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator
+) -> np.ndarray:
+    """Initial resource positions, (cfg.count, 2) [m, world frame], deterministic per `rng`.
+
+    Raises ScenarioError naming the key when the layout cannot be placed.
+    """
+    if cfg.count == 0:
+        return np.zeros((0, 2))
+    if cfg.distribution == "uniform":
+        return _uniform(cfg.count, cfg, arena, depot, rng)
+    if cfg.distribution == "clustered":
+        if cfg.count != cfg.clusters * cfg.cluster_side**2:
+            raise ScenarioError(
+                f"resources.count: {cfg.count} != clusters * cluster_side^2 = "
+                f"{cfg.clusters * cfg.cluster_side ** 2}"
+            )
+        half_span = (cfg.cluster_side - 1) * cfg.spacing / 2
+        centres = _place_squares([half_span] * cfg.clusters, cfg, arena, depot, rng, "resources.clusters")
+        grid = _grid(cfg.cluster_side, cfg.spacing)
+        return (centres[:, None, :] + grid[None, :, :]).reshape(-1, 2)
+    if cfg.distribution == "powerlaw":
+        sizes = powerlaw_pile_sizes(cfg.powerlaw_levels)
+        if sum(sizes) > cfg.count:
+            raise ScenarioError(
+                f"resources.count: the power law with powerlaw_levels={cfg.powerlaw_levels} needs at "
+                f"least {sum(sizes)} resources, got {cfg.count}"
+            )
+        piles = [s for s in sizes if s > 1]
+        sides = [math.isqrt(s) for s in piles]
+        centres = _place_squares(
+            [(side - 1) * cfg.spacing / 2 for side in sides], cfg, arena, depot, rng,
+            "resources.powerlaw_levels",
+        )
+        parts = [c[None, :] + _grid(side, cfg.spacing) for c, side in zip(centres, sides)]
+        parts.append(_uniform(cfg.count - sum(piles), cfg, arena, depot, rng))
+        return np.concatenate(parts, axis=0)
+    raise ScenarioError(f"resources.distribution: unknown distribution {cfg.distribution!r}")
+
+
+def place_one(
+    cfg: ResourceConfig,
+    arena: ArenaConfig,
+    depot: DepotConfig,
+    rng: np.random.Generator,
+    avoid: np.ndarray | None = None,
+) -> np.ndarray:
+    """One replacement resource (2,) [m, world frame] for respawn.
+
+    A single resource drawn "by the distribution" is a 1 x 1 cluster or a pile of one, i.e. a
+    uniform valid position for every distribution. It keeps at least one `spacing` from the
+    positions in `avoid` (the resources on the ground) when it can within MAX_ATTEMPTS draws.
+    """
+    candidate = _uniform(1, cfg, arena, depot, rng)[0]
+    if avoid is None or len(avoid) == 0:
+        return candidate
+    for _ in range(MAX_ATTEMPTS):
+        if np.min(np.hypot(avoid[:, 0] - candidate[0], avoid[:, 1] - candidate[1])) >= cfg.spacing:
+            return candidate
+        candidate = _uniform(1, cfg, arena, depot, rng)[0]
+    return candidate

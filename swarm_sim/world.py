@@ -1,0 +1,536 @@
+"""The world core: one pybullet client, the whole swarm, stepped one control tick at a time.
+
+Shaped like Crazyswarm2's simulation backend and PettingZoo's parallel API:
+``step(commands) -> observations``, both dicts keyed by robot. No ROS here; the world node and
+the batch runner both drive this class.
+
+Physics. The arena is a square of side L centred at the origin, closed by four static box
+walls just outside it, with optional static box/cylinder obstacles. There is no gravity and no
+ground: robots are upright cylinders floating at z = height/2 under kinematic-ish velocity
+control. Every physics substep sets each robot's base velocity to (v cos yaw, v sin yaw, vz) and
+(0, 0, w) and lets pybullet resolve contacts, so robots push each other and stop at walls.
+Tipping is prevented by a huge roll/pitch inertia and zero friction/damping; contact normals are
+horizontal so yaw changes only by the commanded turn rate, which is why the heading of later
+substeps is predicted (yaw + w * j * dt_sub) instead of read back. The tiny z drift that
+contact solving leaves (measured: ~1e-5 m per second of crowding) is cancelled by a vz that
+returns the body to z = height/2 over the first substep of each tick.
+
+Determinism. Everything random comes from ``numpy.random.SeedSequence(seed)``, split into
+independent streams (resources, start headings, odometry noise, respawns), so switching
+odometry noise on does not move the resources. pybullet runs with deterministic overlapping
+pairs and a fresh simulation per `reset`, so the same seed and the same command sequence give
+bit-identical observations.
+
+Order within a tick: commands are applied (missing robot: previous command; NaN/inf -> 0 and
+above-limit -> limit, both counted in ``stats.clamped_commands``), the physics substeps run
+(robot-robot contacts counted each substep), the pose is read, odometry is integrated, then
+robots are processed in index order: a carrying robot may drop, an empty one may pick up.
+Events are stamped with the new tick's time, which is also the stamp of the observations
+`step` returns.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+import pybullet as p
+
+from swarm_sim.geometry import wire_yaw, wrap_angle, yaw_to_quaternion
+from swarm_sim.raycast import StaticScene, cast_scan, cast_scan_pybullet
+from swarm_sim.resources import place_one, place_resources
+from swarm_sim.scenario import Scenario
+from swarm_sim.types import (
+    Command,
+    DropEvent,
+    Observation,
+    PickupEvent,
+    Pose2D,
+    RobotId,
+    RobotStats,
+)
+
+ROBOT_MASS = 1.0
+"""[kg]; only the ratio between robots matters (they all weigh the same)."""
+TILT_INERTIA = 1e6
+"""Roll and pitch inertia [kg m^2]: large enough that contacts never tip a robot."""
+CONTACT_TOLERANCE = 1e-3
+"""Two robots whose pybullet contact distance is at most this [m] are in contact (pybullet also
+reports points a few mm apart that it merely watches)."""
+TILT_RESET = 1e-6
+"""If a robot's orientation quaternion x or y component exceeds this it is reset upright."""
+ROBOT_COLLISION_SHAPE = "cylinder"
+SOLVER_ITERATIONS = 10
+"""pybullet constraint solver iterations per substep (its default, 50, buys nothing here)."""
+
+
+class World:
+    """One object owns the pybullet client (p.DIRECT) and passes its id to every call.
+
+    Crazyswarm2-like backend: ``step(commands) -> observations``; PettingZoo-like dicts keyed by
+    robot. `scan_threads` is rayTestBatch's numThreads for the pybullet scan backend.
+    """
+
+    def __init__(self, scenario: Scenario, seed: int | None = None, *, scan_threads: int = 1) -> None:
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else seed
+        self.robots: tuple[RobotId, ...] = tuple(scenario.robot_names)
+        self._index = {r: i for i, r in enumerate(self.robots)}
+        self._n = len(self.robots)
+        self._dt = scenario.sim.dt
+        self._dt_ns = scenario.dt_ns
+        self._substeps = scenario.sim.physics_substeps
+        self._h = self._dt / self._substeps
+        rc = scenario.robots
+        self._radius = rc.diameter / 2
+        self._z0 = rc.height / 2
+        self._vmax = rc.max_linear_speed
+        self._wmax = rc.max_angular_speed
+        noise = rc.odometry_noise
+        self._noisy = noise.linear_std != 0.0 or noise.angular_std != 0.0
+        self._scene = StaticScene.from_scenario(scenario)
+        self._scan_threads = scan_threads
+        zones = scenario.all_drop_zones()
+        self._zones = zones
+        self._zone_xy = np.array([z.center for z in zones], dtype=float).reshape(-1, 2)
+        self._zone_r2 = np.array([z.radius**2 for z in zones])
+        self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
+        self._client: int | None = p.connect(p.DIRECT)
+        self._build()
+
+    # ------------------------------------------------------------------ building
+
+    def _build(self) -> None:
+        """(Re)create the whole simulation for tick 0 from the seed."""
+        cid = self._cid
+        s = self.scenario
+        p.resetSimulation(physicsClientId=cid)
+        p.setGravity(0, 0, 0, physicsClientId=cid)
+        p.setTimeStep(self._h, physicsClientId=cid)
+        p.setPhysicsEngineParameter(
+            deterministicOverlappingPairs=1, numSolverIterations=SOLVER_ITERATIONS, physicsClientId=cid
+        )
+        seeds = np.random.SeedSequence(self.seed).spawn(4)
+        rng_resources, rng_start, self._rng_odometry, self._rng_respawn = (
+            np.random.default_rng(x) for x in seeds
+        )
+
+        # Robots first, so their body ids are 0..n-1.
+        n = self._n
+        side = math.ceil(math.sqrt(n))
+        cx, cy = s.depot.center
+        pitch = s.robots.start_spacing
+        yaws = rng_start.uniform(-math.pi, math.pi, size=n)
+        if ROBOT_COLLISION_SHAPE == "sphere":
+            shape = p.createCollisionShape(p.GEOM_SPHERE, radius=self._radius, physicsClientId=cid)
+        else:
+            shape = p.createCollisionShape(
+                p.GEOM_CYLINDER, radius=self._radius, height=s.robots.height, physicsClientId=cid
+            )
+        izz = 0.5 * ROBOT_MASS * self._radius**2
+        self._bodies: list[int] = []
+        for i in range(n):
+            x = cx + (i % side - (side - 1) / 2) * pitch
+            y = cy + (i // side - (side - 1) / 2) * pitch
+            body = p.createMultiBody(
+                ROBOT_MASS, shape, -1, [x, y, self._z0], yaw_to_quaternion(float(yaws[i])),
+                physicsClientId=cid,
+            )
+            p.changeDynamics(
+                body, -1, lateralFriction=0.0, spinningFriction=0.0, rollingFriction=0.0,
+                restitution=0.0, linearDamping=0.0, angularDamping=0.0,
+                localInertiaDiagonal=[TILT_INERTIA, TILT_INERTIA, izz],
+                activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=cid,
+            )
+            self._bodies.append(body)
+        if self._bodies != list(range(n)):
+            raise RuntimeError(f"pybullet gave robot bodies ids {self._bodies[:3]}..., expected 0..n-1")
+
+        # Walls just outside the arena, long enough to close the corners.
+        half, t, height = s.arena.size / 2, s.arena.wall_thickness, s.robots.height
+        for (x, y), extents in (
+            ((half + t / 2, 0.0), (t / 2, half + t, height / 2)),
+            ((-half - t / 2, 0.0), (t / 2, half + t, height / 2)),
+            ((0.0, half + t / 2), (half + t, t / 2, height / 2)),
+            ((0.0, -half - t / 2), (half + t, t / 2, height / 2)),
+        ):
+            self._static_box((x, y), extents, 0.0)
+        for o in s.obstacles:
+            if o.shape == "box":
+                self._static_box(o.center, (o.size[0] / 2, o.size[1] / 2, height / 2), o.yaw)
+            else:
+                col = p.createCollisionShape(
+                    p.GEOM_CYLINDER, radius=o.size[0] / 2, height=height, physicsClientId=cid
+                )
+                p.createMultiBody(0.0, col, -1, [o.center[0], o.center[1], self._z0], physicsClientId=cid)
+
+        # Resources: every resource ever placed keeps its index; `_on_ground` says where it is.
+        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources)
+        self._on_ground = np.ones(len(self._res_xy), dtype=bool)
+        self._ground_changed()
+
+        self._v = np.zeros(n)
+        self._w = np.zeros(n)
+        self._carrying = np.full(n, -1, dtype=np.int64)
+        self._inside_ticks = np.zeros((n, len(self._zones)), dtype=np.int64)
+        self._contact_substeps = np.zeros(n, dtype=np.int64)
+        self.stats: dict[RobotId, RobotStats] = {r: RobotStats() for r in self.robots}
+        self._events: list[PickupEvent | DropEvent] = []
+        self.resources_delivered = 0
+        self.tick = 0
+        self._read_state()
+        self._odo = np.column_stack([self._pos, self._yaw])
+        self._meas_v = np.zeros(n)
+        self._meas_w = np.zeros(n)
+        self._obs_cache: dict[RobotId, Observation] | None = None
+        self._near_cache: tuple[int, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._fresh = True
+
+    def _static_box(self, center: tuple[float, float], half_extents: tuple[float, float, float], yaw: float) -> None:
+        cid = self._cid
+        col = p.createCollisionShape(p.GEOM_BOX, halfExtents=list(half_extents), physicsClientId=cid)
+        p.createMultiBody(
+            0.0, col, -1, [center[0], center[1], self._z0], yaw_to_quaternion(yaw), physicsClientId=cid
+        )
+
+    @property
+    def _cid(self) -> int:
+        if self._client is None:
+            raise RuntimeError("the world is closed")
+        return self._client
+
+    @property
+    def client(self) -> int:
+        """The pybullet client id (for cross-checks and debugging)."""
+        return self._cid
+
+    # ------------------------------------------------------------------ state
+
+    def _read_state(self) -> None:
+        """Read every robot's true pose from pybullet into `_pos` (n, 2), `_z`, `_yaw`."""
+        cid = self._cid
+        get = p.getBasePositionAndOrientation
+        flat: list[float] = []
+        extend = flat.extend
+        for body in self._bodies:
+            pos, orn = get(body, physicsClientId=cid)
+            extend(pos)
+            extend(orn)
+        a = np.array(flat).reshape(self._n, 7)
+        qx, qy, qz, qw = a[:, 3], a[:, 4], a[:, 5], a[:, 6]
+        self._pos = a[:, :2].copy()
+        self._z = a[:, 2].copy()
+        self._yaw = np.arctan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+        tilted = np.nonzero((np.abs(qx) > TILT_RESET) | (np.abs(qy) > TILT_RESET))[0]
+        for i in tilted.tolist():
+            p.resetBasePositionAndOrientation(
+                self._bodies[i], [self._pos[i, 0], self._pos[i, 1], self._z0],
+                yaw_to_quaternion(float(self._yaw[i])), physicsClientId=cid,
+            )
+            self._z[i] = self._z0
+
+    def _ground_changed(self) -> None:
+        """Refresh the ground index after a pick-up or a respawn."""
+        self._ground_ids = np.nonzero(self._on_ground)[0]
+        self._ground_xy = self._res_xy[self._ground_ids]
+        self._ground_by_x = np.argsort(self._ground_xy[:, 0], kind="stable")
+        self._ground_x_sorted = self._ground_xy[self._ground_by_x, 0]
+        self._ground_version = getattr(self, "_ground_version", 0) + 1
+        self._near_cache = None
+
+    @property
+    def t_ns(self) -> int:
+        """Sim time of the current tick [ns]."""
+        return self.tick * self._dt_ns
+
+    # ------------------------------------------------------------------ API
+
+    def reset(self) -> dict[RobotId, Observation]:
+        """Back to tick 0 (same seed, fresh pybullet simulation); observations with messages=()."""
+        if not self._fresh:
+            self._build()
+        return self.observe()
+
+    def step(self, commands: Mapping[RobotId, Command]) -> dict[RobotId, Observation]:
+        """Apply `commands`, advance one tick, return the new tick's observations."""
+        for robot in commands:
+            if robot not in self._index:
+                raise ValueError(
+                    f"unknown robot id {robot!r} (this world has robot_0..robot_{self._n - 1})"
+                )
+        if commands:
+            self._apply_commands(commands)
+        self._fresh = False
+        self._obs_cache = None
+        pos0, yaw0 = self._pos, self._yaw
+        self._physics()
+        self._read_state()
+        self._odometry(pos0, yaw0)
+        self._gripper((self.tick + 1) * self._dt_ns)
+        self.tick += 1
+        return self.observe()
+
+    def _apply_commands(self, commands: Mapping[RobotId, Command]) -> None:
+        idx = np.fromiter((self._index[r] for r in commands), dtype=np.int64, count=len(commands))
+        cmds = list(commands.values())
+        lin = np.array([c.linear for c in cmds], dtype=float)
+        ang = np.array([c.angular for c in cmds], dtype=float)
+        bad = ~np.isfinite(lin) | ~np.isfinite(ang)
+        bad |= (np.abs(lin) > self._vmax) | (np.abs(ang) > self._wmax)
+        if bad.any():
+            lin[~np.isfinite(lin)] = 0.0
+            ang[~np.isfinite(ang)] = 0.0
+            np.clip(lin, -self._vmax, self._vmax, out=lin)
+            np.clip(ang, -self._wmax, self._wmax, out=ang)
+            for i in idx[bad].tolist():
+                self.stats[self.robots[i]].clamped_commands += 1
+        self._v[idx] = lin
+        self._w[idx] = ang
+
+    def _physics(self) -> None:
+        """Run the substeps; count robot-robot contact per substep."""
+        cid = self._cid
+        n, h = self._n, self._h
+        reset_velocity = p.resetBaseVelocity
+        step = p.stepSimulation
+        contacts = p.getContactPoints
+        bodies = self._bodies
+        w = self._w.tolist()
+        zeros = [0.0] * n
+        touched_any: set[int] = set()
+        for j in range(self._substeps):
+            yaw = self._yaw + self._w * (j * h) if j else self._yaw
+            vx = (self._v * np.cos(yaw)).tolist()
+            vy = (self._v * np.sin(yaw)).tolist()
+            vz = ((self._z0 - self._z) / h).tolist() if j == 0 else zeros
+            for body, a, b, c, d in zip(bodies, vx, vy, vz, w):
+                reset_velocity(body, (a, b, c), (0.0, 0.0, d), physicsClientId=cid)
+            step(physicsClientId=cid)
+            touched: set[int] = set()
+            for cp in contacts(physicsClientId=cid):
+                a_body, b_body = cp[1], cp[2]
+                if a_body < n and b_body < n and cp[8] <= CONTACT_TOLERANCE:
+                    touched.add(a_body)
+                    touched.add(b_body)
+            for i in touched:
+                self._contact_substeps[i] += 1
+            touched_any |= touched
+        for i in touched_any:
+            self.stats[self.robots[i]].collision_time_s = float(self._contact_substeps[i]) * h
+
+    def _odometry(self, pos0: np.ndarray, yaw0: np.ndarray) -> None:
+        """Odometry estimate and measured velocities for the tick just simulated.
+
+        The true motion is expressed in the body frame at the tick's start (forward, lateral,
+        turn). With noise, distance and turn are scaled by (1 + N(0, linear_std)) and
+        (1 + N(0, angular_std)) per robot and tick - an error proportional to what was travelled -
+        and dead-reckoned from the previous estimate. Without noise the estimate is the truth.
+        """
+        d = self._pos - pos0
+        c, s = np.cos(yaw0), np.sin(yaw0)
+        forward = d[:, 0] * c + d[:, 1] * s
+        lateral = -d[:, 0] * s + d[:, 1] * c
+        turn = np.remainder(self._yaw - yaw0 + math.pi, 2 * math.pi) - math.pi
+        if not self._noisy:
+            self._odo = np.column_stack([self._pos, self._yaw])
+        else:
+            noise = self.scenario.robots.odometry_noise
+            scale = 1.0 + self._rng_odometry.normal(0.0, noise.linear_std, self._n)
+            turn = turn * (1.0 + self._rng_odometry.normal(0.0, noise.angular_std, self._n))
+            forward = forward * scale
+            lateral = lateral * scale
+            yaw = self._odo[:, 2]
+            ce, se = np.cos(yaw), np.sin(yaw)
+            self._odo[:, 0] += forward * ce - lateral * se
+            self._odo[:, 1] += forward * se + lateral * ce
+            self._odo[:, 2] = np.remainder(yaw + turn + math.pi, 2 * math.pi) - math.pi
+        self._meas_v = forward / self._dt
+        self._meas_w = turn / self._dt
+
+    def _near_resources(self, radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(robot index, ground index, squared distance) of ground resources within `radius` of a
+        robot centre, sorted by robot, then distance, then resource index."""
+        if len(self._ground_ids) == 0:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, empty, np.zeros(0)
+        rx = self._pos[:, 0]
+        lo = np.searchsorted(self._ground_x_sorted, rx - radius, side="left")
+        hi = np.searchsorted(self._ground_x_sorted, rx + radius, side="right")
+        count = hi - lo
+        total = int(count.sum())
+        if total == 0:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, empty, np.zeros(0)
+        robot = np.repeat(np.arange(self._n), count)
+        starts = np.cumsum(count) - count
+        g = self._ground_by_x[np.arange(total) - starts[robot] + lo[robot]]
+        dx = self._ground_xy[g, 0] - rx[robot]
+        dy = self._ground_xy[g, 1] - self._pos[robot, 1]
+        d2 = dx * dx + dy * dy
+        keep = d2 <= radius * radius
+        robot, g, d2 = robot[keep], g[keep], d2[keep]
+        order = np.lexsort((g, d2, robot))  # ground order is resource-index order
+        return robot[order], g[order], d2[order]
+
+    def _near_cached(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`_near_resources` for the larger of the detection and pick-up radii, once per state."""
+        key = self._ground_version
+        if self._near_cache is None or self._near_cache[0] != key:
+            sensors = self.scenario.sensors
+            radius = max(sensors.resource_detection_radius, sensors.pickup_radius)
+            self._near_cache = (key, *self._near_resources(radius))
+        return self._near_cache[1:]
+
+    def _gripper(self, stamp_ns: int) -> None:
+        """Drops and pick-ups for the tick that ends at `stamp_ns`, robots in index order."""
+        self._near_cache = None  # the robots moved
+        carrying = self._carrying >= 0
+        # Dwell: consecutive ticks a carrying robot has been seen inside each zone.
+        dz = self._pos[:, None, :] - self._zone_xy[None, :, :]
+        inside = (dz[..., 0] ** 2 + dz[..., 1] ** 2 <= self._zone_r2[None, :]) & carrying[:, None]
+        self._inside_ticks = np.where(inside, self._inside_ticks + 1, 0)
+        ready = (self._inside_ticks > 0) & ((self._inside_ticks - 1) * self._dt_ns >= self._zone_dwell_ns)
+        droppers = np.nonzero(ready.any(axis=1))[0]
+
+        pickup_r2 = self.scenario.sensors.pickup_radius ** 2
+        robot, g, d2 = self._near_cached()
+        candidate = (d2 <= pickup_r2) & ~carrying[robot]
+        pickers = np.unique(robot[candidate])
+        if len(droppers) == 0 and len(pickers) == 0:
+            return
+
+        taken: set[int] = set()
+        changed = False
+        for i in sorted(set(droppers.tolist()) | set(pickers.tolist())):
+            name = self.robots[i]
+            x, y = float(self._pos[i, 0]), float(self._pos[i, 1])
+            if carrying[i]:
+                zone = self._zones[int(np.argmax(ready[i]))]
+                resource = int(self._carrying[i])
+                self._carrying[i] = -1
+                self._inside_ticks[i] = 0
+                self._events.append(DropEvent(name, stamp_ns, resource, zone.name, x, y))
+                self.resources_delivered += 1
+                self.stats[name].deliveries += 1
+                if self.scenario.resources.respawn:
+                    s = self.scenario
+                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy)
+                    self._res_xy = np.vstack([self._res_xy, new[None, :]])
+                    self._on_ground = np.append(self._on_ground, True)
+                    changed = True
+            else:
+                mine = np.nonzero((robot == i) & candidate)[0]
+                for k in mine.tolist():
+                    resource = int(self._ground_ids[g[k]])
+                    if resource in taken:
+                        continue
+                    taken.add(resource)
+                    self._carrying[i] = resource
+                    self._on_ground[resource] = False
+                    rx, ry = self._res_xy[resource]
+                    self._events.append(PickupEvent(name, stamp_ns, resource, float(rx), float(ry)))
+                    self.stats[name].pickups += 1
+                    changed = True
+                    break
+        if changed:
+            self._ground_changed()
+
+    def observe(self) -> dict[RobotId, Observation]:
+        """Observations for the current tick (wire-rounded; messages=())."""
+        if self._obs_cache is not None:
+            return dict(self._obs_cache)
+        sc = self.scenario.sensors.scan
+        if sc.backend == "pybullet":
+            ranges = cast_scan_pybullet(
+                self._cid, self._pos, self._yaw, self._z0, self._radius, sc, self._scan_threads
+            )
+        else:
+            ranges = cast_scan(
+                self._pos, self._yaw, self._radius, self._scene, sc.rays, sc.fov, sc.range_max, sc.range_min
+            )
+        ranges.flags.writeable = False
+        rows = list(ranges)
+
+        detected: list[tuple[tuple[float, float], ...]] = [()] * self._n
+        robot, g, d2 = self._near_cached()
+        if len(robot):
+            keep = d2 <= self.scenario.sensors.resource_detection_radius ** 2
+            robot, g = robot[keep].tolist(), self._ground_xy[g[keep]].tolist()
+            start = 0
+            for k in range(1, len(robot) + 1):
+                if k == len(robot) or robot[k] != robot[start]:
+                    detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
+                    start = k
+
+        stamp = self.t_ns
+        xs = self._odo[:, 0].tolist()
+        ys = self._odo[:, 1].tolist()
+        yaws = self._odo[:, 2].tolist()
+        vs = self._meas_v.tolist()
+        ws = self._meas_w.tolist()
+        carrying = (self._carrying >= 0).tolist()
+        obs = {
+            r: Observation(
+                r, stamp, Pose2D(xs[i], ys[i], wire_yaw(yaws[i])), vs[i], ws[i], rows[i],
+                detected[i], carrying[i],
+            )
+            for i, r in enumerate(self.robots)
+        }
+        self._obs_cache = obs
+        return dict(obs)
+
+    def drain_events(self) -> list[PickupEvent | DropEvent]:
+        """Pick-up and drop events since the last drain, in the order they happened."""
+        events, self._events = self._events, []
+        return events
+
+    def resource_positions(self) -> np.ndarray:
+        """(M, 2) positions of the resources lying on the ground [m, world frame]."""
+        return self._ground_xy.copy()
+
+    def true_poses(self) -> dict[RobotId, Pose2D]:
+        """Ground-truth poses [m, rad; world frame] (the observed odometry may be noisy)."""
+        xs, ys, yaws = self._pos[:, 0].tolist(), self._pos[:, 1].tolist(), self._yaw.tolist()
+        return {r: Pose2D(xs[i], ys[i], wrap_angle(yaws[i])) for i, r in enumerate(self.robots)}
+
+    def carried_resource(self, robot: RobotId) -> int | None:
+        """Index of the resource `robot` holds, or None."""
+        k = int(self._carrying[self._index[robot]])
+        return None if k < 0 else k
+
+    def teleport(self, poses: Mapping[RobotId, Pose2D]) -> None:
+        """Put robots at `poses` (at rest), for tests and scripted set-ups; odometry follows."""
+        cid = self._cid
+        for robot, pose in poses.items():
+            i = self._index[robot]
+            p.resetBasePositionAndOrientation(
+                self._bodies[i], [pose.x, pose.y, self._z0], yaw_to_quaternion(pose.yaw), physicsClientId=cid
+            )
+            p.resetBaseVelocity(self._bodies[i], (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=cid)
+        self._read_state()
+        for robot in poses:
+            i = self._index[robot]
+            self._odo[i] = (self._pos[i, 0], self._pos[i, 1], self._yaw[i])
+        self._obs_cache = None
+        self._near_cache = None
+
+    def close(self) -> None:
+        """Disconnect from pybullet (idempotent)."""
+        if self._client is not None:
+            try:
+                p.disconnect(physicsClientId=self._client)
+            finally:
+                self._client = None
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: pybullet may already be gone
+            pass

@@ -1,0 +1,171 @@
+"""Node tests: the world node and a controller node, each in its own rclpy context, talking to
+a scripted peer node in the same executor (no subprocesses)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+
+from swarm_controllers.controller_node import ControllerConfig, ControllerNode
+from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_sim.analysis import load_run
+from swarm_sim.bag import bag_info
+from swarm_sim.scenario import load_scenario
+from swarm_sim.types import PheromoneMessage, Pose2D
+from swarm_sim.world_node import WorldNode, WorldNodeConfig
+
+SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
+         "resources.count=20", "resources.min_depot_clearance=0.3")
+
+
+@pytest.fixture
+def context():
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx)
+    yield ctx
+    ctx.try_shutdown()
+
+
+class ScriptedControllers(Node):
+    """Answers every robot's observations with a command chosen by `policy(robot, stamp)`."""
+
+    def __init__(self, robots, policy, context, skip=()):
+        super().__init__("scripted", context=context)
+        self.pubs = {}
+        self.seen = {r: [] for r in robots}
+        for r in robots:
+            self.pubs[r] = self.create_publisher(
+                topics.type_of(topics.CMD_VEL), f"/{r}/{topics.CMD_VEL}", SENSOR_LOCKSTEP)
+            if r in skip:
+                continue
+            self.create_subscription(
+                topics.type_of(topics.ODOM), f"/{r}/{topics.ODOM}",
+                lambda data, r=r: self._answer(r, data), SENSOR_LOCKSTEP, raw=True)
+            for name in (topics.SCAN, topics.RESOURCES, topics.GRIPPER):
+                self.create_subscription(topics.type_of(name), f"/{r}/{name}", lambda d: None,
+                                         SENSOR_LOCKSTEP, raw=True)
+        self.policy = policy
+
+    def _answer(self, robot, data):
+        stamp, pose, _, _ = odometry.decode_odometry(data)
+        self.seen[robot].append(stamp)
+        linear, angular = self.policy(robot, stamp)
+        self.pubs[robot].publish(twist.encode_twist(robot, stamp, linear, angular))
+
+
+def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), **config):
+    cfg = WorldNodeConfig(overrides=overrides, bag=str(tmp_path / "bag"), startup_timeout=10.0, **config)
+    world = WorldNode(cfg, context=context)
+    peer = ScriptedControllers(world.robots, policy, context, skip=skip)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(world)
+    executor.add_node(peer)
+    try:
+        world.run(executor)
+    finally:
+        world.close()
+        executor.shutdown()
+        world.destroy_node()
+        peer.destroy_node()
+    return world, peer, tmp_path / "bag"
+
+
+def test_world_node_lockstep_records_every_tick(context, tmp_path):
+    world, peer, bag = run_world(context, tmp_path, lambda r, s: (0.1, 0.0))
+    ticks = 10
+    assert world.world.tick == ticks
+    for r in world.robots:
+        assert peer.seen[r] == [k * world.scenario.dt_ns for k in range(ticks + 1)]
+        assert world.world.stats[r].stale_ticks == 0
+    counts = bag_info(bag).message_counts
+    assert counts["/clock"] == ticks + 1 and counts["/robot_0/cmd_vel"] >= ticks
+    trace = load_run(bag)
+    assert trace.sim_seconds == pytest.approx(1.0)
+    assert set(trace.stats) == set(world.robots)
+
+
+def test_world_node_clamps_nan_and_counts_stale(context, tmp_path):
+    def policy(robot, stamp):
+        return (math.nan, math.inf) if robot == "robot_0" else (0.0, 0.0)
+
+    world, _, bag = run_world(context, tmp_path, policy, skip=("robot_1",), tick_timeout=0.05)
+    assert world.world.stats["robot_0"].clamped_commands == 10
+    stale = world.world.stats["robot_1"].stale_ticks
+    assert stale == 10  # never answered: counted every tick, waited for only `dead_after` times
+    trace = load_run(bag)
+    assert trace.stats["robot_1"].stale_ticks == 10
+
+
+def test_world_node_warns_and_ignores_unknown_robot(context, tmp_path):
+    stranger = Node("stranger", context=context)
+    pub = stranger.create_publisher(topics.type_of(topics.CMD_VEL), "/robot_99/cmd_vel", SENSOR_LOCKSTEP)
+    pub.publish(twist.encode_twist("robot_99", 0, 1.0, 0.0))
+    try:
+        world, _, _ = run_world(context, tmp_path, lambda r, s: (0.0, 0.0))
+    finally:
+        stranger.destroy_node()
+    assert "/robot_99/cmd_vel" in world._recorded
+    assert "robot_99" not in world.world.stats
+
+
+def _observation_bytes(scenario, robot, stamp, carrying=False):
+    return {
+        topics.ODOM: odometry.encode_odometry(robot, stamp, Pose2D(2.0, 0.0, 0.0), 0.0, 0.0),
+        topics.SCAN: scan.encode_scan(robot, stamp, np.full(scenario.sensors.scan.rays, np.inf, np.float32),
+                                      scenario.sensors.scan),
+        topics.RESOURCES: resources.encode_resources(stamp, ()),
+        topics.GRIPPER: gripper.encode_gripper(stamp, carrying),
+    }
+
+
+def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(context):
+    scenario = load_scenario("cpfa", SMALL)
+    node = ControllerNode("robot_0", ControllerConfig(overrides=SMALL), context=context)
+    peer = Node("peer", context=context)
+    received, statuses, inbox = [], [], []
+    peer.create_subscription(topics.type_of(topics.CMD_VEL), "/robot_0/cmd_vel",
+                             lambda d: received.append(twist.decode_twist(d)), SENSOR_LOCKSTEP, raw=True)
+    peer.create_subscription(topics.type_of(topics.STATUS), "/robot_0/status",
+                             lambda d: statuses.append(diagnostics.decode_status(d)), EVENTS, raw=True)
+    pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
+            for n in topics.OBSERVATION_TOPICS}
+    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS)
+    original_step = node.behaviour.step
+    node.behaviour.step = lambda obs: (inbox.append(obs.messages), original_step(obs))[1]
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(peer)
+    try:
+        for _ in range(100):  # let discovery settle
+            executor.spin_once(timeout_sec=0.02)
+            if all(p.get_subscription_count() for p in pubs.values()) and laid.get_subscription_count():
+                break
+        dt = scenario.dt_ns
+        laid.publish(pheromone.encode_pheromone(PheromoneMessage(stamp_ns=0, x=1.0, y=2.0)))
+        for k in range(3):
+            for name, data in _observation_bytes(scenario, "robot_0", k * dt).items():
+                pubs[name].publish(data)
+            for _ in range(200):
+                executor.spin_once(timeout_sec=0.02)
+                if len(received) > k:
+                    break
+        assert [r[0] for r in received] == [0, dt, 2 * dt]
+        assert all(abs(r[1]) <= scenario.robots.max_linear_speed for r in received)
+        # stamped 0 -> not visible at tick 0, visible (once) at tick 1
+        assert inbox[0] == () and inbox[1] == (PheromoneMessage(0, 1.0, 2.0),) and inbox[2] == ()
+        assert statuses and statuses[0].robot == "robot_0"
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        peer.destroy_node()
+
+
+def test_controller_node_refuses_bad_robot_id(context):
+    with pytest.raises(ValueError, match="unknown robot id"):
+        ControllerNode("rover-1", ControllerConfig(overrides=SMALL), context=context)

@@ -1,0 +1,139 @@
+"""Resource placement: counts, validity, cluster geometry, determinism, impossible layouts."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from swarm_sim.resources import place_one, place_resources, powerlaw_pile_sizes
+from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
+
+ARENA = ArenaConfig(size=12.0)
+DEPOT = DepotConfig(center=(0.0, 0.0), radius=0.5)
+
+
+def rng(seed: int = 0) -> np.random.Generator:
+    return np.random.default_rng(seed)
+
+
+def assert_valid(xy: np.ndarray, cfg: ResourceConfig, arena: ArenaConfig = ARENA, depot: DepotConfig = DEPOT):
+    half = arena.size / 2 - cfg.margin
+    assert np.all(np.abs(xy) <= half + 1e-9), "outside the arena margin"
+    d = np.hypot(xy[:, 0] - depot.center[0], xy[:, 1] - depot.center[1])
+    assert np.all(d >= depot.radius + cfg.min_depot_clearance - 1e-9), "too close to the depot"
+
+
+def test_clustered_default_is_five_disjoint_8x8_grids():
+    cfg = ResourceConfig()
+    xy = place_resources(cfg, ARENA, DEPOT, rng())
+    assert xy.shape == (320, 2)
+    assert_valid(xy, cfg)
+    clusters = xy.reshape(5, 64, 2)
+    boxes = []
+    for c in clusters:
+        # an 8 x 8 grid of pitch 0.1 m: 8 distinct x and 8 distinct y values, 0.1 m apart
+        for axis in (0, 1):
+            values = np.unique(np.round(c[:, axis], 9))
+            assert len(values) == 8
+            np.testing.assert_allclose(np.diff(values), 0.1, atol=1e-9)
+        boxes.append((c.min(axis=0), c.max(axis=0)))
+    for a in range(5):
+        for b in range(a + 1, 5):
+            (lo_a, hi_a), (lo_b, hi_b) = boxes[a], boxes[b]
+            gap = np.maximum(lo_b - hi_a, lo_a - hi_b)  # per-axis separation
+            assert gap.max() >= 0.1 - 1e-9, f"clusters {a} and {b} overlap"
+
+
+def test_placement_is_deterministic_per_rng():
+    cfg = ResourceConfig()
+    a = place_resources(cfg, ARENA, DEPOT, rng(7))
+    b = place_resources(cfg, ARENA, DEPOT, rng(7))
+    c = place_resources(cfg, ARENA, DEPOT, rng(8))
+    assert np.array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_uniform():
+    cfg = ResourceConfig(distribution="uniform", count=500)
+    xy = place_resources(cfg, ARENA, DEPOT, rng())
+    assert xy.shape == (500, 2)
+    assert_valid(xy, cfg)
+    assert len(np.unique(xy, axis=0)) == 500
+    # spread over the whole arena, not bunched in one corner
+    assert xy[:, 0].min() < -4 and xy[:, 0].max() > 4 and xy[:, 1].min() < -4 and xy[:, 1].max() > 4
+
+
+def test_powerlaw_piles():
+    assert powerlaw_pile_sizes(4) == [64] + [16] * 4 + [4] * 16 + [1] * 64
+    cfg = ResourceConfig(distribution="powerlaw", count=320, powerlaw_levels=4)
+    xy = place_resources(cfg, ARENA, DEPOT, rng(3))
+    assert xy.shape == (320, 2)
+    assert_valid(xy, cfg)
+    big = xy[:64]
+    assert np.ptp(big[:, 0]) == pytest.approx(0.7) and np.ptp(big[:, 1]) == pytest.approx(0.7)
+    for k in range(4):
+        pile = xy[64 + 16 * k : 64 + 16 * (k + 1)]
+        assert np.ptp(pile[:, 0]) == pytest.approx(0.3) and np.ptp(pile[:, 1]) == pytest.approx(0.3)
+
+
+def test_powerlaw_needs_enough_resources():
+    cfg = ResourceConfig(distribution="powerlaw", count=100, powerlaw_levels=4)
+    with pytest.raises(ScenarioError, match="resources.count"):
+        place_resources(cfg, ARENA, DEPOT, rng())
+    assert len(place_resources(ResourceConfig(distribution="powerlaw", count=12, powerlaw_levels=2), ARENA, DEPOT, rng())) == 12
+
+
+def test_clusters_that_cannot_fit_raise_naming_the_key():
+    cfg = ResourceConfig(clusters=5, cluster_side=8, count=320, min_depot_clearance=1.0)
+    with pytest.raises(ScenarioError, match="resources.clusters"):
+        place_resources(cfg, ArenaConfig(size=4.0), DEPOT, rng())
+
+
+def test_no_room_outside_the_depot_raises_naming_the_key():
+    cfg = ResourceConfig(distribution="uniform", count=10, min_depot_clearance=10.0)
+    with pytest.raises(ScenarioError, match="resources.min_depot_clearance"):
+        place_resources(cfg, ARENA, DEPOT, rng())
+
+
+def test_place_one_is_valid_and_keeps_away_from_ground_resources():
+    cfg = ResourceConfig()
+    ground = place_resources(cfg, ARENA, DEPOT, rng())
+    g = rng(5)
+    for _ in range(50):
+        q = place_one(cfg, ARENA, DEPOT, g, ground)
+        assert q.shape == (2,)
+        assert_valid(q[None, :], cfg)
+        assert np.min(np.hypot(*(ground - q).T)) >= cfg.spacing
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    distribution=st.sampled_from(["clustered", "uniform", "powerlaw"]),
+    clusters=st.integers(1, 6),
+    side=st.integers(1, 6),
+    depot_x=st.floats(-3.0, 3.0),
+    clearance=st.floats(0.0, 1.5),
+)
+def test_every_layout_is_valid(seed, distribution, clusters, side, depot_x, clearance):
+    cfg = ResourceConfig(
+        distribution=distribution,
+        count=clusters * side**2 if distribution == "clustered" else 100,
+        clusters=clusters,
+        cluster_side=side,
+        powerlaw_levels=3,
+        min_depot_clearance=clearance,
+    )
+    depot = DepotConfig(center=(depot_x, 0.5), radius=0.5)
+    xy = place_resources(cfg, ARENA, depot, rng(seed))
+    assert xy.shape == (cfg.count, 2)
+    assert_valid(xy, cfg, ARENA, depot)
+    if distribution == "clustered" and side > 1:
+        # every resource's nearest neighbour is one pitch away (grids, none merged or stacked)
+        d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+        np.fill_diagonal(d, math.inf)
+        np.testing.assert_allclose(d.min(axis=1), cfg.spacing, atol=1e-9)

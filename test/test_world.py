@@ -1,0 +1,346 @@
+"""The world core: observations, gripper, contacts, command clamping, determinism."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pybullet as p
+import pytest
+
+from swarm_sim.geometry import wire_yaw, wrap_angle
+from swarm_sim.scenario import DropZoneConfig, NoiseConfig, Scenario, load_scenario
+from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
+from swarm_sim.world import World
+
+
+def scenario(robots: int = 4, **fields) -> Scenario:
+    return load_scenario("cpfa", robots__count=robots, **fields)
+
+
+@pytest.fixture
+def make_world():
+    worlds: list[World] = []
+
+    def make(s: Scenario, seed: int | None = None) -> World:
+        worlds.append(World(s, seed))
+        return worlds[-1]
+
+    yield make
+    for w in worlds:
+        w.close()
+
+
+def go_to(obs: Observation, target: tuple[float, float], speed: float = 0.16) -> Command:
+    """Turn towards `target`, drive when roughly facing it (a test controller, not a behaviour)."""
+    dx, dy = target[0] - obs.pose.x, target[1] - obs.pose.y
+    error = wrap_angle(math.atan2(dy, dx) - obs.pose.yaw)
+    return Command(speed if abs(error) < 0.3 else 0.0, max(-2.0, min(2.0, 4.0 * error)))
+
+
+# --------------------------------------------------------------------------- observations
+
+
+def test_reset_observations_at_tick_zero(make_world):
+    w = make_world(scenario(5))
+    obs = w.reset()
+    assert w.robots == ("robot_0", "robot_1", "robot_2", "robot_3", "robot_4")
+    assert list(obs) == list(w.robots) and w.tick == 0 and w.t_ns == 0
+    truth = w.true_poses()
+    for r, o in obs.items():
+        assert o.robot == r and o.stamp_ns == 0 and o.messages == () and not o.carrying
+        assert type(o.pose.x) is float and type(o.pose.yaw) is float and type(o.linear_velocity) is float
+        assert o.pose.x == truth[r].x and o.pose.y == truth[r].y
+        assert o.pose.yaw == wire_yaw(truth[r].yaw)
+        assert o.ranges.dtype == np.float32 and o.ranges.shape == (24,)
+        assert o.linear_velocity == 0.0 and o.angular_velocity == 0.0
+    assert len({o.pose.yaw for o in obs.values()}) == 5  # random headings
+
+
+def test_robots_start_on_a_grid_around_the_depot(make_world):
+    s = load_scenario("cpfa", robots__count=9, robots__start_spacing=0.4, depot__center=[1.0, -2.0])
+    w = make_world(s)
+    xy = sorted((round(q.x, 6), round(q.y, 6)) for q in w.true_poses().values())
+    want = sorted((1.0 + 0.4 * a, -2.0 + 0.4 * b) for a in (-1, 0, 1) for b in (-1, 0, 1))
+    np.testing.assert_allclose(xy, want, atol=1e-9)
+
+
+def test_time_advances_one_tick_per_step(make_world):
+    w = make_world(scenario(2))
+    w.reset()
+    obs = w.step({})
+    assert w.tick == 1 and w.t_ns == 100_000_000
+    assert all(o.stamp_ns == 100_000_000 for o in obs.values())
+    assert w.observe() == obs
+
+
+def test_a_robot_drives_forward_at_the_commanded_speed(make_world):
+    w = make_world(scenario(1))
+    w.reset()
+    w.teleport({"robot_0": Pose2D(2.0, 2.0, 0.5)})
+    for _ in range(10):
+        obs = w.step({"robot_0": Command(0.1, 0.0)})
+    o = obs["robot_0"]
+    assert o.pose.x == pytest.approx(2.0 + 0.1 * math.cos(0.5), abs=1e-6)
+    assert o.pose.y == pytest.approx(2.0 + 0.1 * math.sin(0.5), abs=1e-6)
+    assert o.linear_velocity == pytest.approx(0.1, abs=1e-6)
+    for _ in range(10):
+        obs = w.step({"robot_0": Command(0.0, 1.0)})
+    assert obs["robot_0"].pose.yaw == pytest.approx(1.5, abs=1e-6)
+    assert obs["robot_0"].angular_velocity == pytest.approx(1.0, abs=1e-6)
+
+
+def test_walls_stop_robots(make_world):
+    w = make_world(scenario(1))
+    w.teleport({"robot_0": Pose2D(5.5, 0.0, 0.0)})
+    for _ in range(40):
+        w.step({"robot_0": Command(0.16, 0.0)})
+    x = w.true_poses()["robot_0"].x
+    assert 6.0 - 0.085 - 0.01 < x <= 6.0 - 0.085 + 0.002
+
+
+def test_robots_stay_upright_at_fixed_height(make_world):
+    """Crowd the swarm: contacts must not tip robots or let them drift in z."""
+    w = make_world(scenario(16))
+    rng = np.random.default_rng(0)
+    for _ in range(150):
+        w.step({r: Command(0.16, float(rng.uniform(-2, 2))) for r in w.robots})
+    for body in range(16):
+        pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=w.client)
+        assert abs(pos[2] - 0.05) < 1e-4
+        assert abs(orn[0]) < 1e-6 and abs(orn[1]) < 1e-6
+
+
+def test_detected_resources_are_nearest_first(make_world):
+    w = make_world(scenario(1))
+    xy = w.resource_positions()
+    corner = xy[np.lexsort((xy[:, 1], xy[:, 0]))[0]]  # the lower-left corner of a cluster
+    at = (float(corner[0]) + 0.04, float(corner[1]) + 0.03)
+    w.teleport({"robot_0": Pose2D(*at, 0.0)})
+    found = w.observe()["robot_0"].resources
+    # grid neighbours at offsets (-0.04,-0.03) (0.06,-0.03) (-0.04,0.07) (0.06,0.07) are within 0.13 m
+    assert len(found) == 4
+    d = [math.hypot(x - at[0], y - at[1]) for x, y in found]
+    assert d == sorted(d) and d[-1] <= 0.13
+    assert found[0] == (float(corner[0]), float(corner[1]))
+    assert all(type(v) is float for xy in found for v in xy)
+
+
+# --------------------------------------------------------------------------- gripper
+
+
+def test_pick_up_and_drop_at_the_depot(make_world):
+    w = make_world(scenario(1))
+    obs = w.reset()
+    xy = w.resource_positions()
+    n_ground = len(xy)
+    target = xy[np.argmin(np.hypot(xy[:, 0], xy[:, 1]))]
+    start = target * (1 - 0.4 / np.hypot(*target))  # 0.4 m short of it, towards the depot
+    w.teleport({"robot_0": Pose2D(float(start[0]), float(start[1]), 0.0)})
+    obs = w.observe()
+    events = []
+    for _ in range(300):
+        obs = w.step({"robot_0": go_to(obs["robot_0"], (float(target[0]), float(target[1])))})
+        events += w.drain_events()
+        if obs["robot_0"].carrying:
+            break
+    assert obs["robot_0"].carrying
+    (pick,) = events
+    assert isinstance(pick, PickupEvent) and pick.robot == "robot_0" and pick.stamp_ns == w.t_ns
+    assert math.hypot(pick.x - obs["robot_0"].pose.x, pick.y - obs["robot_0"].pose.y) <= 0.05 + 1e-9
+    assert len(w.resource_positions()) == n_ground - 1
+    assert w.carried_resource("robot_0") == pick.resource
+    assert w.stats["robot_0"].pickups == 1
+
+    for _ in range(1000):
+        obs = w.step({"robot_0": go_to(obs["robot_0"], (0.0, 0.0))})
+        if not obs["robot_0"].carrying:
+            break
+    assert not obs["robot_0"].carrying
+    (drop,) = w.drain_events()
+    assert isinstance(drop, DropEvent) and drop.zone == "depot" and drop.resource == pick.resource
+    assert math.hypot(drop.x, drop.y) <= 0.5
+    assert w.resources_delivered == 1 and w.stats["robot_0"].deliveries == 1
+    assert len(w.resource_positions()) == n_ground - 1  # no respawn by default
+    assert w.drain_events() == []
+
+
+def test_an_empty_robot_in_the_depot_drops_nothing(make_world):
+    w = make_world(scenario(4))
+    for _ in range(20):
+        w.step({})
+    assert w.drain_events() == [] and w.resources_delivered == 0
+
+
+def test_dwell_time_and_respawn(make_world):
+    dock = DropZoneConfig("dock_0", (3.0, 3.0), 0.3, dwell=1.0, kind="dock")
+    s = dataclasses.replace(
+        scenario(1), drop_zones=(dock,), resources=dataclasses.replace(scenario(1).resources, respawn=True)
+    )
+    w = make_world(s)
+    n_ground = len(w.resource_positions())
+    r = w.resource_positions()[5]
+    w.teleport({"robot_0": Pose2D(float(r[0]), float(r[1]), 0.0)})
+    w.step({})
+    assert w.observe()["robot_0"].carrying
+    w.teleport({"robot_0": Pose2D(3.1, 3.0, 0.0)})
+    first_inside = w.tick + 1
+    ticks = 0
+    while w.observe()["robot_0"].carrying:
+        w.step({})
+        ticks += 1
+        assert ticks < 50
+    events = w.drain_events()
+    assert [type(e) for e in events] == [PickupEvent, DropEvent]
+    assert events[1].zone == "dock_0"
+    assert events[1].stamp_ns == (first_inside + 10) * s.dt_ns  # inside for 1.0 s = 10 ticks
+    assert len(w.resource_positions()) == n_ground  # one new resource replaced the delivered one
+    assert w.resources_delivered == 1
+
+
+def test_leaving_the_zone_restarts_the_dwell(make_world):
+    dock = DropZoneConfig("dock_0", (3.0, 3.0), 0.3, dwell=1.0, kind="dock")
+    w = make_world(dataclasses.replace(scenario(1), drop_zones=(dock,)))
+    r = w.resource_positions()[0]
+    w.teleport({"robot_0": Pose2D(float(r[0]), float(r[1]), 0.0)})
+    w.step({})
+    for _ in range(3):
+        w.teleport({"robot_0": Pose2D(3.0, 3.0, 0.0)})
+        for _ in range(8):  # 0.8 s inside
+            w.step({})
+        w.teleport({"robot_0": Pose2D(4.0, 4.0, 0.0)})
+        w.step({})
+    assert w.observe()["robot_0"].carrying and w.resources_delivered == 0
+
+
+# --------------------------------------------------------------------------- contacts
+
+
+def head_on(make_world, towards: bool) -> World:
+    w = make_world(scenario(2))
+    w.teleport({"robot_0": Pose2D(-0.5, 0.0, 0.0), "robot_1": Pose2D(0.5, 0.0, math.pi)})
+    speed = 0.16 if towards else -0.16
+    for _ in range(60):
+        w.step({"robot_0": Command(speed, 0.0), "robot_1": Command(speed, 0.0)})
+    return w
+
+
+def test_collision_time_accrues_when_robots_push_each_other(make_world):
+    w = head_on(make_world, towards=True)
+    # they touch after (1 - 0.17) / 0.32 = 2.6 s and push for the remaining ~3.4 s
+    for r in w.robots:
+        t = w.stats[r].collision_time_s
+        assert 3.0 < t < 3.6
+        assert t / 0.05 == pytest.approx(round(t / 0.05))  # whole substeps of dt / 2
+    assert w.stats["robot_0"].collision_time_s == w.stats["robot_1"].collision_time_s
+    gap = w.true_poses()["robot_1"].x - w.true_poses()["robot_0"].x
+    assert gap > 0.17 - 0.01  # they pushed but did not pass through each other
+
+
+def test_no_collision_time_when_apart(make_world):
+    w = head_on(make_world, towards=False)
+    assert all(s.collision_time_s == 0.0 for s in w.stats.values())
+
+
+def test_touching_a_wall_is_not_a_robot_collision(make_world):
+    w = make_world(scenario(1))
+    w.teleport({"robot_0": Pose2D(5.8, 0.0, 0.0)})
+    for _ in range(20):
+        w.step({"robot_0": Command(0.16, 0.0)})
+    assert w.stats["robot_0"].collision_time_s == 0.0
+
+
+# --------------------------------------------------------------------------- commands
+
+
+def test_nan_and_too_fast_commands_are_clamped_and_counted(make_world):
+    w = make_world(scenario(3))
+    w.teleport({"robot_0": Pose2D(-3.0, 3.0, 0.0), "robot_1": Pose2D(3.0, 3.0, 0.0), "robot_2": Pose2D(0.0, -3.0, 0.0)})
+    before = w.true_poses()
+    w.step({
+        "robot_0": Command(math.nan, 0.0),
+        "robot_1": Command(5.0, math.inf),
+        "robot_2": Command(0.1, -1.0),
+    })
+    after = w.true_poses()
+    assert after["robot_0"] == pytest.approx(before["robot_0"])  # NaN -> 0, no motion
+    assert after["robot_1"].yaw == pytest.approx(0.0)  # inf turn rate -> 0
+    assert after["robot_1"].x - before["robot_1"].x == pytest.approx(0.016, abs=1e-6)  # 0.16 m/s
+    assert [w.stats[r].clamped_commands for r in w.robots] == [1, 1, 0]
+    w.step({"robot_2": Command(-1.0, 9.0)})
+    assert w.stats["robot_2"].clamped_commands == 1
+    assert after["robot_2"].x + 0.01 > w.true_poses()["robot_2"].x  # moved backwards
+
+
+def test_a_missing_robot_keeps_its_previous_command(make_world):
+    w = make_world(scenario(1))
+    w.teleport({"robot_0": Pose2D(0.0, 3.0, 0.0)})
+    w.step({"robot_0": Command(0.1, 0.0)})
+    x1 = w.true_poses()["robot_0"].x
+    w.step({})
+    assert w.true_poses()["robot_0"].x - x1 == pytest.approx(0.01, abs=1e-6)
+    assert w.stats["robot_0"].clamped_commands == 0
+
+
+def test_unknown_robot_id_raises_naming_it(make_world):
+    w = make_world(scenario(2))
+    with pytest.raises(ValueError, match="robot_7"):
+        w.step({"robot_0": Command(0.1, 0.0), "robot_7": Command(0.1, 0.0)})
+    with pytest.raises(ValueError, match="'bob'"):
+        w.step({"bob": Command()})
+    assert w.tick == 0
+
+
+# --------------------------------------------------------------------------- odometry
+
+
+def test_noisy_odometry_drifts_from_the_truth_deterministically(make_world):
+    s = load_scenario("cpfa", robots__count=2)
+    s = dataclasses.replace(s, robots=dataclasses.replace(s.robots, odometry_noise=NoiseConfig(0.1, 0.1)))
+    runs = []
+    for _ in range(2):
+        w = make_world(s)
+        w.reset()
+        for _ in range(100):
+            obs = w.step({r: Command(0.16, 0.5) for r in w.robots})
+        runs.append(obs)
+        truth = w.true_poses()
+        errors = [math.hypot(obs[r].pose.x - truth[r].x, obs[r].pose.y - truth[r].y) for r in w.robots]
+        assert 1e-4 < max(errors) < 1.0
+    assert runs[0] == runs[1]
+    # noise does not change where the resources are
+    assert np.array_equal(make_world(s).resource_positions(), make_world(scenario(2)).resource_positions())
+
+
+# --------------------------------------------------------------------------- determinism
+
+
+def random_commands(robots, rng: np.random.Generator) -> dict:
+    return {r: Command(float(rng.uniform(-0.05, 0.2)), float(rng.uniform(-2.5, 2.5))) for r in robots}
+
+
+def run(w: World, ticks: int, seed: int):
+    rng = np.random.default_rng(seed)
+    trace = [w.reset()]
+    for _ in range(ticks):
+        trace.append(w.step(random_commands(w.robots, rng)))
+    return trace, w.drain_events(), {r: dataclasses.replace(s) for r, s in w.stats.items()}
+
+
+def test_same_seed_same_commands_identical_observations(make_world):
+    s = load_scenario("cpfa", robots__count=12)
+    a = run(make_world(s), 200, seed=1)
+    b = run(make_world(s), 200, seed=1)
+    assert a[0] == b[0]
+    assert a[1] == b[1] and a[2] == b[2]
+    assert sum(st.collision_time_s for st in a[2].values()) > 0  # a run where robots interact
+    c = run(make_world(s, seed=5), 200, seed=1)
+    assert c[0][0] != a[0][0]
+
+
+def test_reset_replays_the_run(make_world):
+    w = make_world(load_scenario("cpfa", robots__count=6))
+    first = run(w, 50, seed=2)
+    second = run(w, 50, seed=2)
+    assert first == second
