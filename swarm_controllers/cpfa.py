@@ -375,7 +375,9 @@ class CpfaBehaviour:
 
     def _found_resource(self, obs: Observation) -> None:
         """Record the site and the local density c, then head home (H&M Alg. 1)."""
-        self._site = (obs.pose.x, obs.pose.y)
+        # Plain floats: the site travels in a PheromoneMessage, whose repr orders the mailbox;
+        # a numpy scalar would print differently from the float a graph receiver decodes.
+        self._site = (float(obs.pose.x), float(obs.pose.y))
         self._site_count = len(obs.resources)
         self._state = CpfaState.RETURNING
 
@@ -389,9 +391,9 @@ class CpfaBehaviour:
         if delivered and site is not None:
             c = self._site_count
             if rng.random() < poisson_cdf(c, self._lambda_lp):
-                message = PheromoneMessage(obs.stamp_ns, site[0], site[1])
+                message = PheromoneMessage(int(obs.stamp_ns), site[0], site[1])
                 out = (message,)
-                self._pheromones.append((obs.stamp_ns, site[0], site[1]))
+                self._pheromones.append((message.stamp_ns, site[0], site[1]))
                 self._own_unechoed.add(message)
             if rng.random() < poisson_cdf(c, self._lambda_sf):
                 self._target = site

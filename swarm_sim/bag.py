@@ -403,11 +403,12 @@ class BagWriter:
             self._channels = {}
             if stats.message_count == 0 and self._finished:  # opened by a split, never used
                 stream.close()
+                self._write_metadata_yaml()  # unlist it first: a listed file must exist
                 (self.path / stats.name).unlink()
             else:
                 self._finished.append(stats)
                 self._finalize(writer, stream)
-            self._write_metadata_yaml()
+                self._write_metadata_yaml()
             self._closed = True
 
     def __enter__(self) -> BagWriter:
@@ -930,8 +931,8 @@ def bag_info(path: Path | str) -> BagInfo:
     topics: dict[str, tuple[str, int]] = {}
     if meta is not None:  # topics registered but never written still belong to the bag
         for entry in meta.get("topics_with_message_count") or []:
-            tm = entry.get("topic_metadata", {}) if isinstance(entry, dict) else {}
-            if "name" in tm:
+            tm = entry.get("topic_metadata") if isinstance(entry, dict) else None
+            if isinstance(tm, dict) and "name" in tm:
                 topics[str(tm["name"])] = (str(tm.get("type", "")), 0)
     for f in files:
         for name, (type_name, count) in f.topics().items():

@@ -67,7 +67,7 @@ class RobotConfig:
     """[m/s] (ARGoS CPFA foot-bot forward speed 16 cm/s)."""
     max_angular_speed: float = 2.0
     """[rad/s]."""
-    start_spacing: float = 0.3
+    start_spacing: float = 0.4
     """Robots start on a square grid of this pitch [m] centred on the depot."""
     odometry_noise: NoiseConfig = field(default_factory=NoiseConfig)
 

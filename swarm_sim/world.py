@@ -37,7 +37,7 @@ from collections.abc import Mapping
 import numpy as np
 import pybullet as p
 
-from swarm_sim.geometry import wire_yaw, wrap_angle, yaw_to_quaternion
+from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.resources import place_one, place_resources
 from swarm_sim.scenario import Scenario
@@ -63,6 +63,16 @@ TILT_RESET = 1e-6
 ROBOT_COLLISION_SHAPE = "cylinder"
 SOLVER_ITERATIONS = 10
 """pybullet constraint solver iterations per substep (its default, 50, buys nothing here)."""
+
+
+_TWO_PI = 2.0 * math.pi
+
+
+def _wire_yaw(yaw: float, sin=math.sin, cos=math.cos, atan2=math.atan2, remainder=math.remainder) -> float:
+    """`geometry.wire_yaw` inlined (the same operations in the same order, so bit-identical) -
+    it runs for every robot on every tick."""
+    wrapped = remainder(2.0 * atan2(sin(yaw / 2), cos(yaw / 2)), _TWO_PI)
+    return math.pi if wrapped == -math.pi else wrapped
 
 
 class World:
@@ -214,7 +224,7 @@ class World:
         flat: list[float] = []
         extend = flat.extend
         for body in self._bodies:
-            pos, orn = get(body, physicsClientId=cid)
+            pos, orn = get(body, cid)
             extend(pos)
             extend(orn)
         a = np.array(flat).reshape(self._n, 7)
@@ -305,7 +315,7 @@ class World:
             vy = (self._v * np.sin(yaw)).tolist()
             vz = ((self._z0 - self._z) / h).tolist() if j == 0 else zeros
             for body, a, b, c, d in zip(bodies, vx, vy, vz, w):
-                reset_velocity(body, (a, b, c), (0.0, 0.0, d), physicsClientId=cid)
+                reset_velocity(body, (a, b, c), (0.0, 0.0, d), cid)  # positional: cheaper
             step(physicsClientId=cid)
             touched: set[int] = set()
             for cp in contacts(physicsClientId=cid):
@@ -472,7 +482,7 @@ class World:
         carrying = (self._carrying >= 0).tolist()
         obs = {
             r: Observation(
-                r, stamp, Pose2D(xs[i], ys[i], wire_yaw(yaws[i])), vs[i], ws[i], rows[i],
+                r, stamp, Pose2D(xs[i], ys[i], _wire_yaw(yaws[i])), vs[i], ws[i], rows[i],
                 detected[i], carrying[i],
             )
             for i, r in enumerate(self.robots)
@@ -508,6 +518,7 @@ class World:
                 self._bodies[i], [pose.x, pose.y, self._z0], yaw_to_quaternion(pose.yaw), physicsClientId=cid
             )
             p.resetBaseVelocity(self._bodies[i], (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=cid)
+        self._fresh = False
         self._read_state()
         for robot in poses:
             i = self._index[robot]

@@ -575,3 +575,12 @@ def test_after_avoiding_it_drives_one_search_step_straight_before_steering_again
     b.step(obs(21, yaw=away))
     cmd = b.step(obs(22, yaw=away, ranges=wall))
     assert cmd.linear == 0.0 and b.obstacle_avoidance_events == 3
+
+
+def test_pheromone_fields_are_plain_python_numbers():
+    """The mailbox orders messages by repr; numpy scalars would print unlike decoded floats."""
+    b = behaviour(scenario(rate_of_laying_pheromone=0.0))
+    b.step(obs(0, np.float64(1.25), np.float64(-0.5), carrying=True))
+    (m,) = b.step(obs(1, 0.1, 0.0)).messages
+    assert type(m.x) is float and type(m.y) is float and type(m.stamp_ns) is int
+    assert repr(m) == "PheromoneMessage(stamp_ns=100000000, x=1.25, y=-0.5)"

@@ -23,6 +23,8 @@ from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
@@ -31,6 +33,7 @@ from launch_py import dds  # noqa: E402
 
 TOPIC = "dds_probe"
 SCALE = 40
+DDS_MULTICAST_HEX = "0100FFEF"  # 239.255.0.1 as /proc/net/igmp prints it
 
 
 # --------------------------------------------------------------------------- children
@@ -229,13 +232,61 @@ def test_private_domain_id_is_deterministic_and_in_range(monkeypatch) -> None:
     assert dds.private_domain_id(42) == 7
 
 
-def test_profile_carries_messages_between_two_processes() -> None:
+def _rss_mib(pid: int) -> float:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    return 0.0
+
+
+def _assert_loopback_only(pids: list[int], igmp_before: set[tuple[str, str]]) -> None:
+    """Every UDP socket of ``pids`` is IPv4 bound to 127.0.0.1 (so it can neither receive
+    from nor send to another host), and no multicast group was joined."""
+    bound = _bound_udp(pids)
+    assert bound, "no UDP socket found: the processes are not running DDS over UDP"
+    assert {ip for ip, _ in bound} == {"127.0.0.1"}, sorted(set(bound))
+    joined = _igmp_groups() - igmp_before
+    assert not joined, f"multicast groups joined: {joined}"
+    assert not any(group == DDS_MULTICAST_HEX for _, group in _igmp_groups())
+
+
+def test_profile_carries_messages_between_two_processes_over_loopback_only() -> None:
+    igmp_before = _igmp_groups()
     env = dds.loopback_env(_domain(1), dds.LOCALHOST_MAX_PROCESSES + 1)
+    plain = dds.loopback_env(_domain(2), 1)  # LOCALHOST range, no profile: the control
     with _children() as procs:
-        procs.append(_spawn(env, "worker", 0, 30.0))
+        procs.append(worker := _spawn(env, "worker", 0, 30.0))
         procs.append(checker := _spawn(env, "checker", 1, 20.0))
+        procs.append(control := _spawn(plain, "checker", 1, 8.0))
         result = _result(checker, timeout=25.0)
-    assert result["missing"] == [], result
+        assert result["missing"] == [], result
+        _assert_loopback_only([worker.pid], igmp_before)
+        # The check can fail: without the profile Fast DDS binds to every interface.
+        assert {ip for ip, _ in _bound_udp([control.pid])} - {"127.0.0.1"}
+
+
+@pytest.mark.skipif(
+    os.environ.get("SWARMFORAGE_SKIP_DDS_SCALE") == "1",
+    reason="SWARMFORAGE_SKIP_DDS_SCALE=1 (machine overloaded)",
+)
+def test_profile_discovers_40_processes_over_loopback_only(record_property) -> None:
+    igmp_before = _igmp_groups()
+    env = dds.loopback_env(_domain(3), SCALE + 1)
+    with _children() as procs:
+        t0 = time.monotonic()
+        workers = [_spawn(env, "worker", i, 90.0) for i in range(SCALE)]
+        procs.extend(workers)
+        procs.append(checker := _spawn(env, "checker", SCALE, 60.0))
+        result = _result(checker, timeout=70.0)
+        discovery_s = time.monotonic() - t0
+        assert result["missing"] == [], result
+        assert all(w.poll() is None for w in workers), "a worker died"
+        _assert_loopback_only([w.pid for w in workers], igmp_before)
+        rss = [_rss_mib(w.pid) for w in workers]
+    record_property("discovery_s", round(discovery_s, 2))
+    record_property("rss_mib_mean", round(sum(rss) / len(rss), 1))
+    print(f"{SCALE} processes: all heard after {discovery_s:.1f} s; "
+          f"RSS mean {sum(rss) / len(rss):.1f} MiB, max {max(rss):.1f} MiB")
 
 
 if __name__ == "__main__":

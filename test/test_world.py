@@ -58,6 +58,21 @@ def test_reset_observations_at_tick_zero(make_world):
     assert len({o.pose.yaw for o in obs.values()}) == 5  # random headings
 
 
+def test_inlined_wire_yaw_is_bit_identical():
+    from swarm_sim.world import _wire_yaw
+
+    rng = np.random.default_rng(0)
+    values = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-17, 7.0, -20.0, *rng.uniform(-10, 10, 2000)]
+    assert all(_wire_yaw(float(y)) == wire_yaw(float(y)) for y in values)
+
+
+def test_reset_after_teleport_restores_the_start(make_world):
+    w = make_world(scenario(3))
+    start = w.reset()
+    w.teleport({"robot_0": Pose2D(3.0, 3.0, 1.0)})
+    assert w.reset() == start
+
+
 def test_robots_start_on_a_grid_around_the_depot(make_world):
     s = load_scenario("cpfa", robots__count=9, robots__start_spacing=0.4, depot__center=[1.0, -2.0])
     w = make_world(s)
