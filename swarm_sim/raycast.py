@@ -83,6 +83,16 @@ class StaticScene:
 # --------------------------------------------------------------------------- analytic
 
 
+_UPPER_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _upper_pairs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j) for all i < j < n, cached per swarm size."""
+    if n not in _UPPER_PAIRS:
+        _UPPER_PAIRS[n] = np.triu_indices(n, 1)
+    return _UPPER_PAIRS[n]
+
+
 def _expand(lo: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For windows (lo, count): (window index, ray index) of every ray in every window."""
     total = int(count.sum())
@@ -109,17 +119,18 @@ def _ray_windows(
     """
     rel = _wrap_positive(rel)
     if full_circle:
+        # alpha <= pi/2, so a window never holds more than rays/2 + 1 rays (no wrap-around twice)
         scale = 1.0 / inc
         lo = np.ceil((rel - alpha) * scale - _WINDOW_EPS).astype(np.int64)
-        hi = np.floor((rel + alpha) * scale + _WINDOW_EPS).astype(np.int64)
-        count = np.clip(hi - lo + 1, 0, rays)
+        count = np.floor((rel + alpha) * scale + _WINDOW_EPS).astype(np.int64) - lo + 1
         if everything.any():
             lo[everything] = 0
             count[everything] = rays
-        owner, k = _expand(lo, count)
+        some = np.flatnonzero(count)  # most distant pairs fall between two rays
+        owner, k = _expand(lo[some], np.minimum(count[some], rays))
         k[k < 0] += rays
         k[k >= rays] -= rays
-        return owner, k
+        return some[owner], k
     # A partial fov covers angles [0, fov] from ray 0; a window may also match after a +-2 pi
     # shift. A single ray only needs lo <= 0 <= hi, for which any positive inc will do.
     inc = inc if inc > 0 else 1.0
@@ -266,13 +277,14 @@ def cast_scan(
 
     # Other robots: each unordered pair once (the bearing from j to i is the one from i to j + pi).
     if n > 1:
-        dx = ox[None, :] - ox[:, None]
-        dy = oy[None, :] - oy[:, None]
+        iu, ju = _upper_pairs(n)
+        dx = ox[ju] - ox[iu]
+        dy = oy[ju] - oy[iu]
         d2 = dx * dx + dy * dy
         reach = range_max + robot_radius
-        i, j = np.nonzero(np.triu(d2 < reach * reach, 1))
-        if len(i):
-            dx, dy, d2 = dx[i, j], dy[i, j], d2[i, j]
+        near = np.flatnonzero(d2 < reach * reach)
+        if len(near):
+            i, j, dx, dy, d2 = iu[near], ju[near], dx[near], dy[near], d2[near]
             bearing = np.arctan2(dy, dx)
             _cast_circles(
                 best, ux, uy, np.concatenate([i, j]), np.concatenate([dx, -dx]),

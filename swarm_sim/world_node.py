@@ -188,7 +188,7 @@ class WorldNode(Node):
         deadline = time.monotonic() + self.config.startup_timeout
         missing = list(self.robots)
         while missing and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.1)
+            self._spin(executor, 0.1)
             missing = [
                 r for r in self.robots
                 if self.count_publishers(topics.robot_topic(r, topics.CMD_VEL)) == 0
@@ -199,6 +199,11 @@ class WorldNode(Node):
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
 
+    def _spin(self, executor: SingleThreadedExecutor, timeout: float) -> None:
+        executor.spin_once(timeout_sec=timeout)
+        if self.bag is not None:
+            self.bag.poll()  # flush/split on time even while the run is stalled
+
     def _await_commands(self, executor: SingleThreadedExecutor) -> None:
         """Lockstep barrier: spin until every live controller answered this tick."""
         stamp = self.world.t_ns
@@ -208,7 +213,7 @@ class WorldNode(Node):
             waiting = [r for r in waiting if self._answered.get(r) != stamp]
             if not waiting or time.monotonic() >= deadline:
                 break
-            executor.spin_once(timeout_sec=min(0.05, max(0.0, deadline - time.monotonic())))
+            self._spin(executor, min(0.05, max(0.0, deadline - time.monotonic())))
         for r in self.robots:
             if self._answered.get(r) == stamp:
                 self._missed[r] = 0
@@ -220,7 +225,7 @@ class WorldNode(Node):
 
     def _await_wall(self, executor: SingleThreadedExecutor, until: float) -> None:
         while (remaining := until - time.monotonic()) > 0:
-            executor.spin_once(timeout_sec=min(0.05, remaining))
+            self._spin(executor, min(0.05, remaining))
         stamp = self.world.t_ns
         for r in self.robots:
             if self._answered.get(r) != stamp:
@@ -253,7 +258,7 @@ class WorldNode(Node):
         # Let the controllers' last status messages reach the recorder.
         end = time.monotonic() + 0.5
         while time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.05)
+            self._spin(executor, 0.05)
 
     def print_progress(self, wall: float) -> None:
         t = self.world.t_ns / NS_PER_S

@@ -50,7 +50,14 @@ def _child(role: str, number: int, seconds: float) -> int:
     start = time.monotonic()
     context = Context()
     rclpy.init(context=context)
-    node = rclpy.create_node(f"dds_probe_{role}_{number}", context=context)
+    # Lean node (no parameter services, no rosout): the test is about discovery and
+    # transport, and each service adds two endpoints to the N x N endpoint discovery.
+    node = rclpy.create_node(
+        f"dds_probe_{role}_{number}",
+        context=context,
+        start_parameter_services=False,
+        enable_rosout=False,
+    )
     # Transient local: a late checker still gets each worker's samples after matching.
     # Deep: one keyless reader history holds the samples of every writer.
     qos = QoSProfile(
@@ -133,6 +140,8 @@ def _children() -> Iterator[list[subprocess.Popen[str]]]:
             try:
                 p.wait(timeout=max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
+                print("DEBUG kill", p.args[2:], file=sys.stderr)
+                subprocess.run(["gdb", "-p", str(p.pid), "-batch", "-ex", "thread apply all bt 12"], stdout=open(f"/tmp/dds_exp/bt_{p.pid}.txt", "w"), stderr=subprocess.STDOUT)
                 p.kill()
                 p.wait()
         for p in procs:
