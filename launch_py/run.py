@@ -19,7 +19,7 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import loopback_env, private_domain_id
-from swarm_sim.batch import add_scenario_arguments, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 

@@ -147,6 +147,11 @@ class BagInfo:
     end_ns: int
     """Last log time [ns, sim time]; 0 for an empty bag."""
 
+    @property
+    def message_counts(self) -> dict[str, int]:
+        """Topic name -> messages recorded."""
+        return {name: t.message_count for name, t in self.topics.items()}
+
 
 # ------------------------------------------------------------------------------------- shared
 

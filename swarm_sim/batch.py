@@ -20,10 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_controllers.api import behaviour_rng, make_behaviour
+from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.messaging import Mailbox
 from swarm_sim.metrics import RunTrace, summarize
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, RobotId
+from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent, RobotId
 from swarm_sim.world import World
 
 
@@ -73,8 +74,6 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
 
 
 def _collect_events(world: World, trace: RunTrace) -> None:
-    from swarm_sim.types import DropEvent, PickupEvent
-
     for event in world.drain_events():
         if isinstance(event, DropEvent):
             trace.drops.append(event)
@@ -96,20 +95,6 @@ def run_many(name: str, overrides: Iterable[str], fields: dict, seeds: list[int]
         return
     with multiprocessing.get_context("fork").Pool(jobs) as pool:
         yield from pool.imap(_run_one, work)
-
-
-def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options `swarm-run` and `swarm-batch` share."""
-    parser.add_argument("--scenario", default="cpfa", help="scenario name or YAML path (default: cpfa)")
-    parser.add_argument("--robots", type=int, help="number of robots (robots.count)")
-    parser.add_argument("--duration", type=float, help="sim seconds (sim.duration)")
-    parser.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override any scenario field, e.g. --set resources.respawn=true")
-
-
-def scenario_fields(args: argparse.Namespace) -> dict:
-    return {"robots__count": args.robots, "sim__duration": args.duration}
 
 
 def main(argv: list[str] | None = None) -> int:

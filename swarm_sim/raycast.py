@@ -339,7 +339,8 @@ def cast_scan_pybullet(
     origins = np.asarray(origins, dtype=float)
     n = len(origins)
     angle_min, inc = scan_angles(config.rays, config.fov)
-    angles = np.asarray(headings, dtype=float)[:, None] + (angle_min + inc * np.arange(config.rays))[None, :]
+    offsets = angle_min + inc * np.arange(config.rays)
+    angles = np.asarray(headings, dtype=float)[:, None] + offsets[None, :]
     u = np.stack([np.cos(angles), np.sin(angles)], axis=-1).reshape(-1, 2)
     o = np.repeat(origins, config.rays, axis=0)
     start = robot_radius + PYBULLET_START_OFFSET

@@ -25,9 +25,11 @@ import numpy as np
 
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
 
-MAX_ATTEMPTS = 2000
-"""Random draws per cluster/pile before a placement restarts from scratch."""
-MAX_RESTARTS = 20
+MAX_ATTEMPTS = 4096
+"""Random candidate positions per cluster/pile (drawn in batches) before a layout restarts."""
+BATCH = 256
+"""Candidates drawn and tested at once."""
+MAX_RESTARTS = 10
 """Fresh starts before a placement gives up with a ScenarioError."""
 
 
@@ -48,14 +50,6 @@ def _grid(side: int, spacing: float) -> np.ndarray:
     return np.column_stack([gx.ravel(), gy.ravel()])
 
 
-def _square_clear_of_depot(center: np.ndarray, half_span: float, depot: DepotConfig, keep_out: float) -> bool:
-    """True if every point of the square [center +- half_span] is >= keep_out from the depot."""
-    cx, cy = depot.center
-    nx = min(max(cx, center[0] - half_span), center[0] + half_span)
-    ny = min(max(cy, center[1] - half_span), center[1] + half_span)
-    return math.hypot(nx - cx, ny - cy) >= keep_out
-
-
 def _place_squares(
     half_spans: list[float],
     cfg: ResourceConfig,
@@ -66,33 +60,38 @@ def _place_squares(
 ) -> np.ndarray:
     """Centres (K, 2) for squares of the given half spans: valid and at least one pitch apart.
 
-    Rejection sampling, largest square first; after MAX_ATTEMPTS failed draws for one square the
-    whole layout restarts; after MAX_RESTARTS it raises ScenarioError naming `key`.
+    Rejection sampling, largest square first, BATCH candidates at a time; after MAX_ATTEMPTS
+    candidates for one square the whole layout restarts; after MAX_RESTARTS it raises
+    ScenarioError naming `key`.
     """
     half = _half_extent(cfg, arena)
     keep_out = _keep_out(cfg, depot)
-    order = sorted(range(len(half_spans)), key=lambda i: -half_spans[i])
+    spans = np.asarray(half_spans, dtype=float)
+    order = np.argsort(-spans, kind="stable")
+    dcx, dcy = depot.center
     for _ in range(MAX_RESTARTS):
-        centres = np.zeros((len(half_spans), 2))
+        centres = np.zeros((len(spans), 2))
         placed: list[int] = []
-        for i in order:
-            hs = half_spans[i]
+        for i in order.tolist():
+            hs = spans[i]
             room = half - hs
             if room < 0:
                 raise ScenarioError(
                     f"{key}: a square of side {2 * hs:.2f} m does not fit in the arena "
                     f"(arena.size {arena.size} m, resources.margin {cfg.margin} m)"
                 )
-            for _ in range(MAX_ATTEMPTS):
-                c = rng.uniform(-room, room, size=2)
-                if not _square_clear_of_depot(c, hs, depot, keep_out):
-                    continue
-                if all(
-                    max(abs(c[0] - centres[j, 0]), abs(c[1] - centres[j, 1]))
-                    >= hs + half_spans[j] + cfg.spacing
-                    for j in placed
-                ):
-                    centres[i] = c
+            for _ in range(MAX_ATTEMPTS // BATCH):
+                c = rng.uniform(-room, room, size=(BATCH, 2))
+                # the point of each candidate square nearest to the depot centre
+                nx = np.clip(dcx, c[:, 0] - hs, c[:, 0] + hs)
+                ny = np.clip(dcy, c[:, 1] - hs, c[:, 1] + hs)
+                ok = np.hypot(nx - dcx, ny - dcy) >= keep_out
+                if placed:
+                    gap = np.abs(c[:, None, :] - centres[None, placed, :]).max(axis=2)
+                    ok &= (gap >= hs + spans[placed][None, :] + cfg.spacing).all(axis=1)
+                hits = np.flatnonzero(ok)
+                if len(hits):
+                    centres[i] = c[hits[0]]
                     placed.append(i)
                     break
             else:
@@ -100,7 +99,7 @@ def _place_squares(
         else:
             return centres
     raise ScenarioError(
-        f"{key}: cannot place {len(half_spans)} non-overlapping groups of resources in the "
+        f"{key}: cannot place {len(spans)} non-overlapping groups of resources in the "
         f"{arena.size} m arena (margin {cfg.margin} m, {cfg.min_depot_clearance} m clear of the "
         f"depot) after {MAX_RESTARTS} attempts"
     )
@@ -188,13 +187,11 @@ def place_one(
 
     A single resource drawn "by the distribution" is a 1 x 1 cluster or a pile of one, i.e. a
     uniform valid position for every distribution. It keeps at least one `spacing` from the
-    positions in `avoid` (the resources on the ground) when it can within MAX_ATTEMPTS draws.
+    positions in `avoid` (the resources on the ground) if one of BATCH candidates does.
     """
-    candidate = _uniform(1, cfg, arena, depot, rng)[0]
+    candidates = _uniform(BATCH, cfg, arena, depot, rng)
     if avoid is None or len(avoid) == 0:
-        return candidate
-    for _ in range(MAX_ATTEMPTS):
-        if np.min(np.hypot(avoid[:, 0] - candidate[0], avoid[:, 1] - candidate[1])) >= cfg.spacing:
-            return candidate
-        candidate = _uniform(1, cfg, arena, depot, rng)[0]
-    return candidate
+        return candidates[0]
+    d2 = ((candidates[:, None, :] - np.asarray(avoid)[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+    clear = np.flatnonzero(d2 >= cfg.spacing**2)
+    return candidates[clear[0] if len(clear) else 0]

@@ -21,7 +21,8 @@ FULL = 2 * math.pi
 
 
 def scan(origins, headings, rays=4, fov=FULL, range_max=12.0, range_min=0.0, scene=OPEN):
-    return cast_scan(np.array(origins, float), np.array(headings, float), R, scene, rays, fov, range_max, range_min)
+    origins, headings = np.array(origins, float), np.array(headings, float)
+    return cast_scan(origins, headings, R, scene, rays, fov, range_max, range_min)
 
 
 # --------------------------------------------------------------------------- conventions
@@ -115,7 +116,8 @@ def _segments(scene: StaticScene, inflate: float) -> np.ndarray:
     for x, y, hx, hy, yaw in scene.boxes:
         c, s = math.cos(yaw), math.sin(yaw)
         hx, hy = hx + inflate, hy + inflate
-        corners = [(x + c * a - s * b, y + s * a + c * b) for a, b in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
+        signs = ((-1, -1), (1, -1), (1, 1), (-1, 1))
+        corners = [(x + c * a * hx - s * b * hy, y + s * a * hx + c * b * hy) for a, b in signs]
         segs += [(*corners[k], *corners[(k + 1) % 4]) for k in range(4)]
     return np.array(segs)
 
@@ -190,9 +192,9 @@ def test_batched_scan_equals_brute_force(seed, n, crowd, rays, fov):
 
 
 def _world_with(scene: StaticScene, n: int, rays: int, backend: str = "analytic") -> World:
-    obstacles = tuple(ObstacleConfig("cylinder", (x, y), (2 * r, 2 * r)) for x, y, r in scene.circles) + tuple(
-        ObstacleConfig("box", (x, y), (2 * hx, 2 * hy), yaw) for x, y, hx, hy, yaw in scene.boxes
-    )
+    cylinders = [ObstacleConfig("cylinder", (x, y), (2 * r, 2 * r)) for x, y, r in scene.circles]
+    boxes = [ObstacleConfig("box", (x, y), (2 * hx, 2 * hy), yaw) for x, y, hx, hy, yaw in scene.boxes]
+    obstacles = (*cylinders, *boxes)
     s = load_scenario("cpfa", robots__count=n, sensors__scan__rays=rays, sensors__scan__backend=backend)
     return World(dataclasses.replace(s, obstacles=obstacles))
 
@@ -214,7 +216,8 @@ def test_pybullet_backend_agrees_with_the_analytic_one(seed):
         pos = np.array([[q.x, q.y] for q in world.true_poses().values()])
         yaw = np.array([q.yaw for q in world.true_poses().values()])
         sc = world.scenario.sensors.scan
-        analytic = cast_scan(pos, yaw, R, StaticScene.from_scenario(world.scenario), sc.rays, sc.fov, sc.range_max)
+        static = StaticScene.from_scenario(world.scenario)
+        analytic = cast_scan(pos, yaw, R, static, sc.rays, sc.fov, sc.range_max)
         bullet = cast_scan_pybullet(world.client, pos, yaw, world.scenario.robots.height / 2, R, sc)
     finally:
         world.close()
@@ -246,5 +249,17 @@ def test_world_observations_use_the_configured_backend():
     np.testing.assert_allclose(out["analytic"], want.astype(np.float32), rtol=1e-6, atol=1e-6)
     bullet = out["pybullet"]
     assert not np.array_equal(bullet, out["analytic"])  # really the other backend
-    assert np.all(bullet >= reference_scan(pos, yaw, OPEN, sc.rays, sc.fov, sc.range_max, BULLET_TOLERANCE) - 1e-5)
-    assert np.all(bullet <= reference_scan(pos, yaw, OPEN, sc.rays, sc.fov, sc.range_max, -BULLET_TOLERANCE) + 1e-5)
+    grown = reference_scan(pos, yaw, OPEN, sc.rays, sc.fov, sc.range_max, BULLET_TOLERANCE)
+    shrunk = reference_scan(pos, yaw, OPEN, sc.rays, sc.fov, sc.range_max, -BULLET_TOLERANCE)
+    assert np.all(bullet >= grown - 1e-5) and np.all(bullet <= shrunk + 1e-5)
+
+
+def test_pybullet_threads_do_not_change_the_scan():
+    s = load_scenario("cpfa", robots__count=16, sensors__scan__backend="pybullet")
+    one, two = World(s, scan_threads=1), World(s, scan_threads=2)
+    try:
+        a, b = one.reset(), two.reset()
+        assert all(np.array_equal(a[r].ranges, b[r].ranges) for r in one.robots)
+    finally:
+        one.close()
+        two.close()
