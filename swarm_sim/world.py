@@ -595,6 +595,17 @@ class World:
         xs, ys, yaws = self._pos[:, 0].tolist(), self._pos[:, 1].tolist(), self._yaw.tolist()
         return {r: Pose2D(xs[i], ys[i], wrap_angle(yaws[i])) for i, r in enumerate(self.robots)}
 
+    def odometry_poses(self) -> dict[RobotId, Pose2D]:
+        """The odometry estimates before the wire rounding [m, rad; world frame].
+
+        Observation.pose.yaw is wire_yaw(this yaw). A publisher should encode these: a second
+        quaternion round trip of the already rounded yaw is not the identity (about 3% of yaws
+        move by an ulp), so re-encoding Observation.pose would hand graph controllers a yaw one
+        ulp away from the batch runner's.
+        """
+        xs, ys, yaws = self._odo[:, 0].tolist(), self._odo[:, 1].tolist(), self._odo[:, 2].tolist()
+        return {r: Pose2D(xs[i], ys[i], yaws[i]) for i, r in enumerate(self.robots)}
+
     def carried_resource(self, robot: RobotId) -> int | None:
         """Index of the resource `robot` holds, or None."""
         k = int(self._carrying[self._index[robot]])

@@ -118,8 +118,9 @@ class WorldNode(Node):
         }
         return BagWriter(Path(path), metadata=meta)
 
-    def _publish(self, pub, data: bytes, topic: str) -> None:
-        pub.publish(data)
+    def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
+        if send:
+            pub.publish(data)
         if self.bag is not None:
             self.bag.write(topic, self.world.t_ns, data)
 
@@ -153,20 +154,25 @@ class WorldNode(Node):
 
     # ------------------------------------------------------------------ the loop
 
-    def _publish_tick(self, obs: dict[RobotId, Observation]) -> None:
+    def _publish_tick(self, obs: dict[RobotId, Observation], *, send: bool = True) -> None:
+        """Tick k's clock and observations; `send=False` records them without asking the
+        controllers for another answer (the state at the end of the run)."""
         t_ns = self.world.t_ns
-        self._publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK)
+        self._publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK, send=send)
         sc = self.scenario.sensors.scan
+        # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
+        # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
+        poses = self.world.odometry_poses()
         for r, o in obs.items():
             pubs = self._obs_pubs[r]
             encoded = {
-                topics.ODOM: odometry.encode_odometry(r, t_ns, o.pose, o.linear_velocity, o.angular_velocity),
+                topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
                 topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
                 topics.RESOURCES: resources.encode_resources(t_ns, o.resources),
                 topics.GRIPPER: gripper.encode_gripper(t_ns, o.carrying),
             }
             for name, data in encoded.items():
-                self._publish(pubs[name], data, topics.robot_topic(r, name))
+                self._publish(pubs[name], data, topics.robot_topic(r, name), send=send)
 
     def _publish_world_state(self, final: bool = False) -> None:
         t_ns = self.world.t_ns
@@ -253,7 +259,7 @@ class WorldNode(Node):
             if now - last_progress >= cfg.progress_period:
                 last_progress = now
                 self.print_progress(now - wall0)
-        self._publish_tick(obs)
+        self._publish_tick(obs, send=False)
         self._publish_world_state(final=True)
         # Let the controllers' last status messages reach the recorder.
         end = time.monotonic() + 0.5

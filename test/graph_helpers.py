@@ -19,7 +19,7 @@ SMALL_ARENA = [
 
 def run_graph(bag: Path, *args: str, timeout: float = 300.0) -> dict:
     """Run swarm-run to completion and return its JSON summary."""
-    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json",
+    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json", "--tick-timeout", "20",
            "--domain-id", os.environ["ROS_DOMAIN_ID"], *args]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
                             cwd=Path(__file__).resolve().parents[1])

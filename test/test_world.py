@@ -94,6 +94,21 @@ def test_reset_after_teleport_restores_the_start(make_world):
     assert w.reset() == start
 
 
+def test_odometry_poses_are_the_unrounded_observation_poses(make_world):
+    from swarm_msgs_py.odometry import decode_odometry, encode_odometry
+
+    w = make_world(scenario(8))
+    rng = np.random.default_rng(3)
+    for _ in range(30):
+        obs = w.step(random_commands(w.robots, rng))
+        for r, raw in w.odometry_poses().items():
+            o = obs[r]
+            assert (o.pose.x, o.pose.y, o.pose.yaw) == (raw.x, raw.y, wire_yaw(raw.yaw))
+            # what a graph controller decodes when the publisher encodes the raw pose
+            wire = decode_odometry(encode_odometry(r, o.stamp_ns, raw, o.linear_velocity, o.angular_velocity))
+            assert wire.pose == o.pose
+
+
 def test_robots_start_on_a_grid_around_the_depot(make_world):
     s = load_scenario("cpfa", robots__count=9, robots__start_spacing=0.4, depot__center=[1.0, -2.0])
     w = make_world(s)
@@ -302,7 +317,9 @@ def test_touching_a_wall_is_not_a_robot_collision(make_world):
 def test_nan_and_too_fast_commands_are_clamped_and_counted(make_world):
     w = make_world(scenario(3))
     w.teleport({
-        "robot_0": Pose2D(-3.0, 3.0, 0.0), "robot_1": Pose2D(3.0, 3.0, 0.0), "robot_2": Pose2D(0.0, -3.0, 0.0)
+        "robot_0": Pose2D(-3.0, 3.0, 0.0),
+        "robot_1": Pose2D(3.0, 3.0, 0.0),
+        "robot_2": Pose2D(0.0, -3.0, 0.0),
     })
     before = w.true_poses()
     w.step({
@@ -398,24 +415,26 @@ def test_same_seed_same_commands_identical_observations(make_world):
     assert c[0][0] != a[0][0]
 
 
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=10, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 2**31), robots=st.integers(1, 9))
 def test_robots_stay_in_the_arena_and_apart(seed, robots):
+    """Random driving in a small arena. A body moves up to one substep's travel into another
+    before pybullet sees the contact and pushes it back: 0.16 m/s x 0.05 s = 8 mm into a wall,
+    twice that between two robots closing head-on (or a robot pushed into a wall)."""
     s = load_scenario(
         "cpfa", robots__count=robots, arena__size=2.0, depot__radius=0.3,
         resources__distribution="uniform", resources__count=10, resources__min_depot_clearance=0.1,
     )
+    overlap = 2 * 0.16 * 0.05 + 1e-3
     with World(s, seed) as w:
         rng = np.random.default_rng(seed)
         for _ in range(100):
             w.step(random_commands(w.robots, rng))
             xy = np.array([[q.x, q.y] for q in w.true_poses().values()])
-            assert np.all(np.abs(xy) <= 1.0 - 0.085 + 0.005)
+            assert np.all(np.abs(xy) <= 1.0 - 0.085 + overlap)
             d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
             np.fill_diagonal(d, np.inf)
-            # two robots closing at 2 x 0.16 m/s can overlap by one substep's travel (1.6 cm)
-            # before pybullet sees the contact; then it pushes them apart
-            assert np.all(d >= 0.17 - 2 * 0.16 * 0.05 - 1e-3)
+            assert np.all(d >= 0.17 - overlap)
 
 
 def test_reset_replays_the_run(make_world):
