@@ -33,8 +33,12 @@ Events are stamped with the new tick's time, which is also the stamp of the obse
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import dataclasses
 import math
+import os
+import sys
 from collections.abc import Iterable, Mapping
 
 import numpy as np
@@ -154,6 +158,22 @@ def _observation_factory():
 _new_observation = _observation_factory()
 
 
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """pybullet's C code prints its build time on stdout when it connects; keep stdout for
+    results (``--json`` output must be JSON only)."""
+    sys.stdout.flush()
+    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    try:
+        yield
+    finally:
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
 class World:
     """One object owns the pybullet client (p.DIRECT) and passes its id to every call.
 
@@ -187,7 +207,8 @@ class World:
         self._zone_r2 = np.array([z.radius**2 for z in zones])
         self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
         self._ground_version = 0
-        self._client: int | None = p.connect(p.DIRECT)
+        with _quiet_stdout():
+            self._client: int | None = p.connect(p.DIRECT)
         try:
             self._build()
         except BaseException:
