@@ -5,15 +5,15 @@ creates its first rclpy context, so everything here is plain environment variabl
 this module never imports rclpy.
 
 * Up to ``LOCALHOST_MAX_PROCESSES`` processes: ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
-  rmw_fastrtps then announces only to 127.0.0.1 and only on the ports of the first
-  few participant ids (Fast DDS ``maxInitialPeersRange``), which is enough for a
-  handful of processes.
+  rmw_fastrtps then announces to 127.0.0.1 only, but guesses peers by participant
+  index (32 of 40 peers found in 60 s) and binds its sockets to 0.0.0.0 and the LAN
+  address; set the constant to 0 to use the profile always.
 * More processes (one per robot): the Fast DDS profile ``fastdds_loopback.xml``
-  (UDP bound to 127.0.0.1 plus shared memory, no multicast, SPDP sent to 256
-  participant ids on 127.0.0.1). The range must then be ``SYSTEM_DEFAULT``:
-  with ``LOCALHOST`` rmw_fastrtps overwrites the profile's metatraffic locators and
-  initial peers, with ``SUBNET`` it appends ``ROS_STATIC_PEERS``; only
-  ``SYSTEM_DEFAULT`` leaves the profile alone.
+  (UDP bound to 127.0.0.1 only, no multicast, no shared memory, SPDP sent to 256
+  participant ids on 127.0.0.1). The range must then be ``SYSTEM_DEFAULT``: rmw_fastrtps
+  starts from the XML default profile and, for ``LOCALHOST``, adds a 0.0.0.0 unicast
+  locator and initial peers on top of it, for ``SUBNET`` it adds ``ROS_STATIC_PEERS``;
+  only ``SYSTEM_DEFAULT`` leaves the profile alone.
 """
 
 from __future__ import annotations
@@ -28,8 +28,10 @@ LOCALHOST_MAX_PROCESSES = 24
 PROFILE_MAX_PROCESSES = 256
 """Participants per domain the profile can discover (its maxInitialPeersRange)."""
 DOMAIN_RANGE = (100, 200)
-"""Inclusive range of private ROS_DOMAIN_IDs: clear of the default 0 and, at the
-RTPS port formula 7400 + 250 * domain, of the ports of domains below 100."""
+"""Inclusive range of private ROS_DOMAIN_IDs (the project's convention, clear of 0).
+A domain owns UDP ports 7400 + 250 * domain + 10 + 2 * participant (+1): above 120
+processes they spill into the next domain's range, and for domains above 101 they lie
+in Linux's ephemeral range; Fast DDS then moves on to a free port (mutation_tries)."""
 
 _DROPPED = (
     # Each of these would override or extend the discovery chosen here.
@@ -42,6 +44,7 @@ _DROPPED = (
     "FASTDDS_DEFAULT_PROFILES_FILE",
     "RMW_FASTRTPS_USE_QOS_FROM_XML",
     "FASTDDS_ENVIRONMENT_FILE",
+    "SKIP_DEFAULT_XML_FILE",
 )
 
 
@@ -60,14 +63,14 @@ def loopback_env(
     env = {k: v for k, v in (os.environ if base is None else base).items() if k not in _DROPPED}
     env["RMW_IMPLEMENTATION"] = "rmw_fastrtps_cpp"
     env["ROS_DOMAIN_ID"] = str(domain_id)
+    # No DEFAULT_FASTRTPS_PROFILES.xml from the working directory on top of ours.
+    env["SKIP_DEFAULT_XML_FILE"] = "1"
     if processes <= LOCALHOST_MAX_PROCESSES:
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     else:
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
-        env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # Fast DDS 2.x name
-        env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # Fast DDS 3.x name
-        # No DEFAULT_FASTRTPS_PROFILES.xml from the working directory on top of ours.
-        env["SKIP_DEFAULT_XML_FILE"] = "1"
+        env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 2.x name
+        env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 3.x name
     return env
 
 

@@ -41,7 +41,7 @@ class ControllerNode(Node):
     def __init__(self, robot: str, config: ControllerConfig | None = None, **kwargs) -> None:
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
-            "controller", namespace=robot, start_parameter_services=False,
+            "controller", namespace=robot, start_parameter_services=False, enable_rosout=False,
             parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.robot = robot
