@@ -16,12 +16,13 @@ import sys
 from dataclasses import dataclass
 
 import rclpy
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from swarm_controllers.api import Behaviour, behaviour_rng, make_behaviour
 from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
@@ -51,6 +52,8 @@ class ControllerNode(Node):
         self.mailbox = Mailbox()
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
+        self._answered_stamp = -1
+        self._answer = b""
         decoders = {
             topics.ODOM: odometry.decode_odometry,
             topics.SCAN: scan.decode_scan,
@@ -76,6 +79,9 @@ class ControllerNode(Node):
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         stamp = decoded[0]
+        if stamp == self._answered_stamp:  # the world re-sent a tick: our answer was late or lost
+            self._cmd_pub.publish(self._answer)
+            return
         self._latest[name] = decoded
         if len(self._latest) == 4 and all(v[0] == stamp for v in self._latest.values()):
             self._tick(stamp)
@@ -98,7 +104,9 @@ class ControllerNode(Node):
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
-        self._cmd_pub.publish(twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular))
+        self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
+        self._answered_stamp = stamp_ns
+        self._cmd_pub.publish(self._answer)
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:
@@ -116,11 +124,13 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=["swarm-controllers", *ros_args])
     nodes: list[ControllerNode] = []
     try:
-        executor = SingleThreadedExecutor()
+        executor = make_executor()
         for robot in robots:
             nodes.append(ControllerNode(robot, config))
             executor.add_node(nodes[-1])
-        executor.spin()
+        # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
+        while rclpy.ok():
+            executor.spin_once(timeout_sec=0.5)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

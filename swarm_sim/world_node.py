@@ -22,11 +22,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import rclpy
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
+from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.bag import BagWriter
@@ -46,6 +47,9 @@ class WorldNodeConfig:
     """`lockstep` or `realtime`."""
     tick_timeout: float = 2.0
     """Lockstep: wall seconds to wait for a controller's answer before counting it stale."""
+    resend_period: float = 0.25
+    """Lockstep: wall seconds after which a tick's observations are re-sent to controllers
+    that have not answered (they answer a repeated tick with their cached command)."""
     dead_after: int = 3
     """Lockstep: stale ticks in a row after which a controller is no longer waited for."""
     real_time_factor: float = 1.0
@@ -86,13 +90,16 @@ class WorldNode(Node):
             for r in self.robots
         }
         self._commands: dict[RobotId, Command] = {}
+        self._sent: dict[RobotId, dict[str, bytes]] = {}
+        """This tick's encoded observations per robot, to re-send if an answer is late."""
         self._answered: dict[RobotId, int] = {}
         self._missed: dict[RobotId, int] = dict.fromkeys(self.robots, 0)
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
+        self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
             if self.bag is not None:
                 self.bag.add_topic(topic, topics.type_string(topic), "reliable")
-            self.create_subscription(
+            self._cmd_subs[robot] = self.create_subscription(
                 topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
@@ -173,6 +180,7 @@ class WorldNode(Node):
             }
             for name, data in encoded.items():
                 self._publish(pubs[name], data, topics.robot_topic(r, name), send=send)
+            self._sent[r] = encoded
 
     def _publish_world_state(self, final: bool = False) -> None:
         t_ns = self.world.t_ns
@@ -190,14 +198,14 @@ class WorldNode(Node):
             )
             self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
 
-    def wait_for_controllers(self, executor: SingleThreadedExecutor) -> None:
+    def wait_for_controllers(self, executor: Executor) -> None:
         deadline = time.monotonic() + self.config.startup_timeout
         missing = list(self.robots)
         while missing and time.monotonic() < deadline:
             self._spin(executor, 0.1)
             missing = [
                 r for r in self.robots
-                if self.count_publishers(topics.robot_topic(r, topics.CMD_VEL)) == 0
+                if self._cmd_subs[r].get_publisher_count() == 0
                 or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
             ]
         if missing:
@@ -205,21 +213,39 @@ class WorldNode(Node):
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
 
-    def _spin(self, executor: SingleThreadedExecutor, timeout: float) -> None:
+    def _spin(self, executor: Executor, timeout: float) -> float:
+        """Spin once; returns the wall seconds the bag took (flush/split), which must not
+        count against the controllers' deadline."""
         executor.spin_once(timeout_sec=timeout)
-        if self.bag is not None:
-            self.bag.poll()  # flush/split on time even while the run is stalled
+        if self.bag is None:
+            return 0.0
+        t0 = time.monotonic()
+        self.bag.poll()  # flush/split on time even while the run is stalled
+        return time.monotonic() - t0
 
-    def _await_commands(self, executor: SingleThreadedExecutor) -> None:
+    def _await_commands(self, executor: Executor) -> None:
         """Lockstep barrier: spin until every live controller answered this tick."""
         stamp = self.world.t_ns
         waiting = [r for r in self.robots if self._missed[r] < self.config.dead_after]
-        deadline = time.monotonic() + self.config.tick_timeout
+        now = time.monotonic()
+        deadline, resend = now + self.config.tick_timeout, now + self.config.resend_period
         while True:
             waiting = [r for r in waiting if self._answered.get(r) != stamp]
-            if not waiting or time.monotonic() >= deadline:
+            now = time.monotonic()
+            if not waiting:
                 break
-            self._spin(executor, min(0.05, max(0.0, deadline - time.monotonic())))
+            if now >= deadline:  # take what has already arrived before calling anyone stale
+                for _ in range(4 * len(waiting)):
+                    executor.spin_once(timeout_sec=0.0)
+                break
+            if now >= resend:  # a sample lost (e.g. while discovery settles): ask again
+                resend = now + self.config.resend_period
+                for r in waiting:
+                    for name, data in self._sent[r].items():
+                        self._obs_pubs[r][name].publish(data)
+            bag_time = self._spin(executor, min(0.05, max(0.0, deadline - now)))
+            deadline += bag_time
+            resend += bag_time
         for r in self.robots:
             if self._answered.get(r) == stamp:
                 self._missed[r] = 0
@@ -229,7 +255,7 @@ class WorldNode(Node):
                 if self._missed[r] == self.config.dead_after:
                     self.get_logger().warning(f"{r}: no answer for {self._missed[r]} ticks, not waiting for it")
 
-    def _await_wall(self, executor: SingleThreadedExecutor, until: float) -> None:
+    def _await_wall(self, executor: Executor, until: float) -> None:
         while (remaining := until - time.monotonic()) > 0:
             self._spin(executor, min(0.05, remaining))
         stamp = self.world.t_ns
@@ -237,7 +263,7 @@ class WorldNode(Node):
             if self._answered.get(r) != stamp:
                 self.world.stats[r].stale_ticks += 1
 
-    def run(self, executor: SingleThreadedExecutor) -> None:
+    def run(self, executor: Executor) -> None:
         cfg, sim = self.config, self.scenario.sim
         self._discover()
         self.wait_for_controllers(executor)
@@ -309,7 +335,7 @@ def main(argv: list[str] | None = None) -> int:
     node = None
     try:
         node = WorldNode(config)
-        executor = SingleThreadedExecutor()
+        executor = make_executor()
         executor.add_node(node)
         node.run(executor)
     except (KeyboardInterrupt, ExternalShutdownException):
