@@ -4,6 +4,13 @@ process and once with one process per robot."""
 
 from __future__ import annotations
 
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
 import pytest
 
 from graph_helpers import SMALL_ARENA, overrides, run_graph
@@ -45,3 +52,45 @@ def test_graph_run_records_a_complete_bag(tmp_path, processes):
     assert {d.zone for d in trace.drops} == {"depot"}
     stamps = [m.stamp_ns for m in read_bag(bag) if m.topic == "/robot_0/cmd_vel"]
     assert stamps == sorted(stamps)
+
+
+def test_realtime_mode_runs_near_its_target_factor(tmp_path):
+    summary = run_graph(tmp_path / "rt", "--robots", "4", "--duration", "10", "--mode", "realtime",
+                        "--real-time-factor", "4", *overrides(SMALL_ARENA))
+    assert summary["mode"] == "realtime" and summary["sim_seconds"] == 10.0
+    assert 2.0 <= summary["real_time_factor"] <= 4.4, summary
+
+
+def test_ctrl_c_stops_everything_and_leaves_a_valid_bag(tmp_path):
+    bag = tmp_path / "interrupted"
+    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--robots", "4", "--duration", "600",
+           "--domain-id", os.environ["ROS_DOMAIN_ID"], *overrides(SMALL_ARENA)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            cwd=Path(__file__).resolve().parents[1])
+    try:
+        deadline = time.monotonic() + 120
+        while not (bag / "metadata.yaml").exists() or _recorded_clock(bag) < 2.0:
+            assert proc.poll() is None and time.monotonic() < deadline, "the run did not start"
+            time.sleep(0.5)
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=90)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0, out
+    info = bag_info(bag)
+    assert not info.truncated and info.message_counts["/clock"] > 20
+    trace = load_run(bag)
+    assert 2.0 <= trace.sim_seconds < 600 and trace.wall_seconds > 0
+    assert "interrupted" in out
+    # nothing of the run is left behind
+    leftover = subprocess.run(["pgrep", "-f", str(bag)], capture_output=True, text=True).stdout
+    assert leftover.strip() == ""
+
+
+def _recorded_clock(bag) -> float:
+    try:
+        return bag_info(bag).end_ns / 1e9
+    except Exception:
+        return 0.0

@@ -169,3 +169,19 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
 def test_controller_node_refuses_bad_robot_id(context):
     with pytest.raises(ValueError, match="unknown robot id"):
         ControllerNode("rover-1", ControllerConfig(overrides=SMALL), context=context)
+
+
+def test_world_node_survives_malformed_commands(context, tmp_path):
+    junk = Node("junk", context=context)
+    pub = junk.create_publisher(topics.type_of(topics.CMD_VEL), "/robot_0/cmd_vel", SENSOR_LOCKSTEP)
+
+    def policy(robot, stamp):
+        pub.publish(b"\x00\x01\x00\x00\x01")  # a truncated TwistStamped
+        return (0.05, 0.0)
+
+    try:
+        world, _, bag = run_world(context, tmp_path, policy)
+    finally:
+        junk.destroy_node()
+    assert world.world.tick == 10 and world.world.stats["robot_0"].stale_ticks == 0
+    assert load_run(bag).sim_seconds == pytest.approx(1.0)
