@@ -55,10 +55,12 @@ Rules, in the paper's words, and how they are realised here:
   is blocked within one robot diameter of it (someone stands on the site; CPFA-ROS likewise
   starts searching when its travel is interrupted).
 
-Per-tick probabilities: p_s and p_r are taken as per tick of a controller ticking at
-`CpfaConfig.original_tick_rate` (16 Hz; the early ARGoS controller draws them every control
-step, later versions only every 0.5 s, CPFA-ROS per 0.5 m waypoint). With our tick dt the
-same hazard per second is p' = 1 - (1 - p) ** (original_tick_rate * dt).
+Per-draw probabilities: p_s and p_r are drawn every 1 / `CpfaConfig.draw_rate` seconds in the
+reference implementation. The queue paper's lab's CPFA-ARGoS draws both only when the tick is a
+multiple of 5 s (``SimulationTick() % (5 * SimulationTicksPerSecond()) == 0``), so the default
+is 0.2 Hz (the early iAnt controller drew every 16 Hz step; CPFA-ROS per 0.5 m waypoint). We
+keep the same hazard per second but spread it over every tick of dt seconds:
+p' = 1 - (1 - p) ** (draw_rate * dt), so no 5 s clock is shared by all robots.
 
 Obstacle avoidance has priority over every state's motion; the state machine still runs (and
 draws) on avoidance ticks, as in ARGoS where the CPFA step and the collision-avoiding move are
@@ -129,14 +131,14 @@ def poisson_cdf(k: int, lam: float) -> float:
     return min(total, 1.0)
 
 
-def per_tick_probability(p: float, original_tick_rate: float, dt: float) -> float:
-    """Rescale a per-tick probability evolved at `original_tick_rate` [Hz] to a tick of `dt` [s]:
+def per_tick_probability(p: float, draw_rate: float, dt: float) -> float:
+    """Rescale a probability drawn at `draw_rate` [Hz] to a tick of `dt` [s]:
     the same hazard per second, p' = 1 - (1 - p)^(rate * dt)."""
     if p <= 0.0:
         return 0.0
     if p >= 1.0:
         return 1.0
-    return -math.expm1(original_tick_rate * dt * math.log1p(-p))
+    return -math.expm1(draw_rate * dt * math.log1p(-p))
 
 
 def informed_search_sigma(omega: float, lambda_id: float, t_search: float) -> float:
@@ -158,10 +160,10 @@ class CpfaBehaviour:
             scenario.controller.avoidance, scenario.sensors.scan, scenario.robots.max_angular_speed
         )
         self._p_switch = per_tick_probability(
-            cfg.probability_of_switching_to_searching, cfg.original_tick_rate, dt
+            cfg.probability_of_switching_to_searching, cfg.draw_rate, dt
         )
         self._p_return = per_tick_probability(
-            cfg.probability_of_returning_to_nest, cfg.original_tick_rate, dt
+            cfg.probability_of_returning_to_nest, cfg.draw_rate, dt
         )
         self._omega = cfg.uninformed_search_variation
         self._lambda_id = cfg.rate_of_informed_search_decay

@@ -156,14 +156,14 @@ class CpfaConfig:
     """Central-place foraging algorithm parameters (Hecker & Moses 2015, Table 1/3).
 
     Defaults are the values BCLab's CPFA implementation labels "according to Beyond
-    Pheromones"; probabilities are per control tick of the original 16 Hz controller and are
+    Pheromones"; p_s and p_r are per draw of the reference controller (see `draw_rate`) and are
     rescaled to our tick by the behaviour.
     """
 
     probability_of_switching_to_searching: float = 0.045
-    """p_s: per-tick chance that a departing robot stops travelling and starts searching."""
+    """p_s: chance per draw that a departing robot stops travelling and starts searching."""
     probability_of_returning_to_nest: float = 0.01
-    """p_r: per-tick chance that a searching robot gives up and returns."""
+    """p_r: chance per draw that a searching robot gives up and returns."""
     uninformed_search_variation: float = 0.4
     """omega [rad]: std of the heading change of the correlated random walk."""
     rate_of_informed_search_decay: float = 0.1666
@@ -178,8 +178,10 @@ class CpfaConfig:
     """Waypoints weaker than this are forgotten."""
     search_step: float = 0.08
     """Distance between heading changes of the random walk [m]."""
-    original_tick_rate: float = 16.0
-    """Tick rate [Hz] the per-tick probabilities were evolved for (ARGoS CPFA: 16)."""
+    draw_rate: float = 0.2
+    """How often [Hz] p_s and p_r are drawn in the reference implementation: the CPFA-ARGoS
+    controller of the queue paper's lab draws both once every 5 s of its 16 Hz loop. The
+    behaviour applies the same hazard per second at every tick of ours."""
 
 
 @dataclass(frozen=True)

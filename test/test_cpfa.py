@@ -169,8 +169,8 @@ def test_informed_search_sigma_formula():
 
 def test_behaviour_rescales_probabilities_to_its_tick():
     b = behaviour()
-    assert b.switch_probability == pytest.approx(1 - (1 - 0.045) ** (16 * 0.1))
-    assert b.return_probability == pytest.approx(1 - (1 - 0.01) ** (16 * 0.1))
+    assert b.switch_probability == pytest.approx(1 - (1 - 0.045) ** (0.2 * 0.1))
+    assert b.return_probability == pytest.approx(1 - (1 - 0.01) ** (0.2 * 0.1))
 
 
 # ------------------------------------------------------------------------------ departing
