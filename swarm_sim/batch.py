@@ -24,7 +24,7 @@ from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.messaging import Mailbox
 from swarm_sim.metrics import RunTrace, summarize
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent, RobotId
+from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
 
 
@@ -41,7 +41,7 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     robots = world.robots
     behaviours = {r: make_behaviour(scenario, r, behaviour_rng(scenario.seed, r)) for r in robots}
     mailbox = Mailbox()
-    status: dict[RobotId, BehaviourStatus] = {}
+    last_step_ns = 0
     trace = RunTrace(
         scenario=scenario.name, seed=scenario.seed, robots=robots, sim_seconds=0.0,
         wall_seconds=0.0, total_resources=scenario.resources.count, mode="batch",
@@ -55,15 +55,17 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
             inbox = mailbox.take_before(world.t_ns)
             commands = {}
             for r, b in behaviours.items():
-                command = b.step(dataclasses.replace(obs[r], messages=inbox))
+                o = obs[r] if not inbox else dataclasses.replace(obs[r], messages=inbox)
+                command = b.step(o)
                 commands[r] = command
                 for message in command.messages:
                     mailbox.post(message)
-                status[r] = b.status(world.t_ns)
+            last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
+        status = {r: b.status(last_step_ns) for r, b in behaviours.items()}
         trace.sim_seconds = world.t_ns / NS_PER_S
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
