@@ -16,7 +16,7 @@ import sys
 from dataclasses import dataclass
 
 import rclpy
-from rclpy.executors import Executor, ExternalShutdownException
+from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -27,7 +27,7 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import BehaviourStatus, Observation, PheromoneMessage, robot_index
+from swarm_sim.types import Observation, PheromoneMessage, robot_index
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from swarm_msgs_py import clock as clock_codec
 from swarm_sim.bag import BagError, bag_info, read_bag
 from swarm_sim.metrics import RunTrace, delivered_over_time, summarize
 from swarm_sim.scenario import scenario_from_dict
-from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent, robot_index
+from swarm_sim.types import NS_PER_S, DropEvent, robot_index
 
 
 def load_run(path: Path | str) -> RunTrace:
