@@ -104,7 +104,6 @@ class WorldNode(Node):
                 SENSOR_LOCKSTEP, raw=True,
             )
         self._recorded: set[str] = set(self._own_topics) | set(self._cmd_topic)
-        self._warned_unknown: set[str] = set()
         self._next_discovery = 0.0
 
     # ------------------------------------------------------------------ plumbing
