@@ -42,8 +42,14 @@ def _cpfa(scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> Behav
     return CpfaBehaviour(scenario, robot, rng)
 
 
+def _ddsa(scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> Behaviour:
+    from swarm_controllers.ddsa import DdsaBehaviour
+
+    return DdsaBehaviour(scenario, robot, rng)
+
+
 # Factories import their module lazily, so a behaviour's module loads only when it is used.
-_FACTORIES: dict[str, BehaviourFactory] = {"cpfa": _cpfa}
+_FACTORIES: dict[str, BehaviourFactory] = {"cpfa": _cpfa, "ddsa": _ddsa}
 
 
 def register_behaviour(name: str, factory: BehaviourFactory) -> None:

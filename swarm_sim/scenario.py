@@ -195,12 +195,24 @@ class AvoidanceConfig:
 
 
 @dataclass(frozen=True)
+class SpiralConfig:
+    """Square-spiral search (DDSA / MDBSA, Lu & Luna 2023)."""
+
+    gap: float = 0.18
+    """Distance g between adjacent spiral lines [m] (paper Sec. IV: 0.13 m detection radius
+    plus room for encoder noise)."""
+    arena_margin: float = 0.2
+    """Spirals are clipped to the arena square shrunk by this much on every side [m]."""
+
+
+@dataclass(frozen=True)
 class ControllerConfig:
     behaviour: str = "cpfa"
     cpfa: CpfaConfig = field(default_factory=CpfaConfig)
     avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
     arrival_tolerance: float = 0.1
     """A target counts as reached within this distance [m]."""
+    spiral: SpiralConfig = field(default_factory=SpiralConfig)
 
 
 @dataclass(frozen=True)
@@ -473,3 +485,7 @@ def validate(s: Scenario) -> None:
         _require(min(o.size) > 0, f"obstacles[{i}].size: must be positive")
         _require(_inside(o.center, half, 0.0), f"obstacles[{i}].center: {o.center} is outside the arena")
     _require(s.controller.arrival_tolerance > 0, "controller.arrival_tolerance: must be positive")
+    sp = s.controller.spiral
+    _require(sp.gap > 0, "controller.spiral.gap: must be positive")
+    _require(sp.arena_margin >= 0, "controller.spiral.arena_margin: must not be negative")
+    _require(sp.arena_margin < half, "controller.spiral.arena_margin: leaves no arena to search")
