@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from swarm_sim.geometry import wrap_angle
-from swarm_sim.scenario import AvoidanceConfig, ScanConfig
+from swarm_sim.scenario import AvoidanceConfig, ScanConfig, Scenario
 from swarm_sim.types import Command
 
 _FULL_CIRCLE_TOLERANCE = 1e-9
@@ -131,3 +131,47 @@ class ObstacleAvoidance:
             return total / len(indices)
 
         return mean_free(self._left) - mean_free(self._right)
+
+
+class AvoidThenEscape:
+    """Obstacle avoidance with priority over a behaviour's motion, then a straight escape run.
+
+    When an avoidance episode ends the robot drives straight ahead for `escape_distance`
+    before its behaviour steers again (ARGoS pushes a FORWARD move after its avoidance turn);
+    without it, a goal just beside an obstacle makes the avoidance turn and the goal turn undo
+    each other forever with the robot standing still.
+    """
+
+    def __init__(self, scenario: Scenario, escape_distance: float) -> None:
+        r = scenario.robots
+        self.avoidance = ObstacleAvoidance(
+            scenario.controller.avoidance, scenario.sensors.scan, r.max_angular_speed
+        )
+        self._escape = Command(r.max_linear_speed, 0.0)
+        self._escape_ticks = max(
+            1, math.ceil(escape_distance / (r.max_linear_speed * scenario.sim.dt) - 1e-9)
+        )
+        self._escape_left = 0
+        self._was_avoiding = False
+
+    @property
+    def events(self) -> int:
+        return self.avoidance.events
+
+    @property
+    def active(self) -> bool:
+        return self.avoidance.active
+
+    def update(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
+        """The command that overrides the behaviour this tick (a turn away or the escape run),
+        or None when the behaviour steers."""
+        avoid = self.avoidance.update(ranges)
+        if avoid is None and self._was_avoiding:
+            self._escape_left = self._escape_ticks
+        self._was_avoiding = avoid is not None
+        if avoid is not None:
+            return avoid
+        if self._escape_left:
+            self._escape_left -= 1
+            return self._escape
+        return None

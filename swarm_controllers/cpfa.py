@@ -77,7 +77,7 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import ObstacleAvoidance
+from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import (
@@ -156,9 +156,7 @@ class CpfaBehaviour:
         self.robot = robot
         self._rng = rng
         self._limits = DriveLimits.from_scenario(scenario)
-        self._avoidance = ObstacleAvoidance(
-            scenario.controller.avoidance, scenario.sensors.scan, scenario.robots.max_angular_speed
-        )
+        self._avoidance = AvoidThenEscape(scenario, escape_distance=cfg.search_step)
         self._p_switch = per_tick_probability(
             cfg.probability_of_switching_to_searching, cfg.draw_rate, dt
         )
@@ -182,12 +180,6 @@ class CpfaBehaviour:
         half = scenario.arena.size / 2.0
         self._bound = half - margin if half > margin else half / 2.0
         self._site_clearance2 = (scenario.depot.radius + margin) ** 2
-        self._escape_ticks = max(
-            1, math.ceil(cfg.search_step / (scenario.robots.max_linear_speed * dt) - 1e-9)
-        )
-        self._escape_left = 0
-        """Ticks left of the straight run that follows an avoidance episode."""
-        self._was_avoiding = False
 
         self._state = CpfaState.DEPARTING
         self._mode = SearchMode.UNINFORMED
@@ -285,10 +277,7 @@ class CpfaBehaviour:
             else:
                 self._trips += 1
                 out = self._at_nest(obs, delivered=True)
-        avoid = self._avoidance.update(obs.ranges)
-        if avoid is None and self._was_avoiding:
-            self._escape_left = self._escape_ticks
-        self._was_avoiding = avoid is not None
+        override = self._avoidance.update(obs.ranges)
         state = self._state
         if state is CpfaState.DEPARTING:
             linear, angular = self._departing(obs)
@@ -296,13 +285,8 @@ class CpfaBehaviour:
             linear, angular = self._searching(obs)
         else:
             linear, angular = self._returning(obs)
-        if avoid is not None:
-            if not out:
-                return avoid
-            linear, angular = avoid.linear, avoid.angular
-        elif self._escape_left:
-            self._escape_left -= 1
-            linear, angular = self._limits.max_linear, 0.0
+        if override is not None:
+            linear, angular = override.linear, override.angular
         return Command(linear, angular, out)
 
     # ------------------------------------------------------------------ states

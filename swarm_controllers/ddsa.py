@@ -47,12 +47,11 @@ candidates are a larger gap near the centre or avoidance that ignores robots on 
 
 from __future__ import annotations
 
-import math
 from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import ObstacleAvoidance
+from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
@@ -90,20 +89,12 @@ class DdsaBehaviour:
         self._wp = [(float(x), float(y)) for x, y in self.path.waypoints]
         self._cum = [float(c) for c in self.path.cumulative]
         self._limits = DriveLimits.from_scenario(scenario)
-        self._avoidance = ObstacleAvoidance(
-            scenario.controller.avoidance, scenario.sensors.scan, scenario.robots.max_angular_speed
-        )
+        self._avoidance = AvoidThenEscape(scenario, escape_distance=scenario.robots.diameter)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
         self._arrival2 = scenario.controller.arrival_tolerance**2
         self._center = center
         self._depot_r2 = scenario.depot.radius**2
-        dt = scenario.sim.dt
-        self._escape_ticks = max(
-            1, math.ceil(scenario.robots.diameter / (scenario.robots.max_linear_speed * dt) - 1e-9)
-        )
-        self._escape_left = 0
-        self._was_avoiding = False
 
         self._state = DdsaState.SEARCHING
         self._next = 0
@@ -175,10 +166,7 @@ class DdsaBehaviour:
             self._state = DdsaState.SEARCHING  # picked up on the way out, nothing to resume
         if self._parked:
             return Command(0.0, 0.0)
-        avoid = self._avoidance.update(obs.ranges)
-        if avoid is None and self._was_avoiding:
-            self._escape_left = self._escape_ticks
-        self._was_avoiding = avoid is not None
+        override = self._avoidance.update(obs.ranges)
         state = self._state
         if state is DdsaState.SEARCHING:
             linear, angular = self._searching(obs)
@@ -188,12 +176,7 @@ class DdsaBehaviour:
             linear, angular = self._to_depot(obs)
         if self._parked:
             return Command(0.0, 0.0)
-        if avoid is not None:
-            return avoid
-        if self._escape_left:
-            self._escape_left -= 1
-            return Command(self._limits.max_linear, 0.0)
-        return Command(linear, angular)
+        return override if override is not None else Command(linear, angular)
 
     # ------------------------------------------------------------------ states
 
