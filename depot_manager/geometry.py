@@ -41,7 +41,8 @@ ARC_STEP**2 / (8 r), under 0.5 mm here, which is the tolerance on every lane dis
 class DepotGeometryConfig:
     """Depot and queue dimensions (sec. III and Table I / sec. VII of the paper).
 
-    Standalone for now; a later change moves it into the scenario.
+    A view of the scenario's `depot` and `robots` sections (`from_scenario`), which are the one
+    place these facts live; constructing it directly is for tests and the drawing command.
     """
 
     depot_center: tuple[float, float] = (0.0, 0.0)
@@ -58,6 +59,15 @@ class DepotGeometryConfig:
     """Foot-bot diameter (sec. VII) [m]."""
     slot_pitch: float | None = None
     """Arc-length distance between queue slots along a line [m]; None = lane_spacing."""
+
+    @classmethod
+    def from_scenario(cls, scenario) -> DepotGeometryConfig:
+        d = scenario.depot
+        return cls(
+            depot_center=tuple(d.center), depot_radius=d.radius,
+            perimeter_radius=d.perimeter_radius, docks=d.docks, lane_spacing=d.lane_spacing,
+            robot_diameter=scenario.robots.diameter,
+        )
 
     @property
     def pitch(self) -> float:

@@ -14,6 +14,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from swarm_sim.protocol import CENTER, DEPOT, Server
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId, robot_index
 
@@ -48,8 +49,28 @@ def _ddsa(scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> Behav
     return DdsaBehaviour(scenario, robot, rng)
 
 
+def _mdbsa(distributed: bool) -> BehaviourFactory:
+    def factory(scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> Behaviour:
+        from swarm_controllers.mdbsa import MdbsaBehaviour
+
+        return MdbsaBehaviour(scenario, robot, rng, distributed=distributed)
+
+    return factory
+
+
+def _queue(scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> Behaviour:
+    from swarm_controllers.queueing import QueueBehaviour
+
+    return QueueBehaviour(scenario, robot, rng)
+
+
 # Factories import their module lazily, so a behaviour's module loads only when it is used.
-_FACTORIES: dict[str, BehaviourFactory] = {"cpfa": _cpfa, "ddsa": _ddsa}
+_FACTORIES: dict[str, BehaviourFactory] = {
+    "cpfa": _cpfa, "ddsa": _ddsa, "mdbsa_c": _mdbsa(False), "mdbsa_d": _mdbsa(True),
+    "queue": _queue,
+}
+CENTER_BEHAVIOURS = ("mdbsa_c", "mdbsa_d")
+"""Behaviours that need the center node (region assignment)."""
 
 
 def register_behaviour(name: str, factory: BehaviourFactory) -> None:
@@ -79,3 +100,29 @@ def behaviour_rng(seed: int, robot: RobotId) -> np.random.Generator:
     """The generator a robot's behaviour draws from: seeded by (run seed, robot index), so the
     graph and the batch runner, and every process split of the graph, seed it identically."""
     return np.random.default_rng([seed, robot_index(robot)])
+
+
+def server_channels(scenario: Scenario) -> tuple[str, ...]:
+    """The servers (see `swarm_sim.protocol`) a scenario needs, by channel: the center for
+    MDBSA, the depot manager when the depot has queues. The graph starts one node each."""
+    channels = []
+    if scenario.controller.behaviour in CENTER_BEHAVIOURS:
+        channels.append(CENTER)
+    if scenario.depot.queue != "none":
+        channels.append(DEPOT)
+    return tuple(channels)
+
+
+def make_servers(scenario: Scenario) -> dict[str, Server]:
+    """The server cores `server_channels` names, built from the scenario."""
+    servers: dict[str, Server] = {}
+    for channel in server_channels(scenario):
+        if channel == CENTER:
+            from swarm_controllers.center import CenterServer
+
+            servers[channel] = CenterServer(scenario)
+        else:
+            from depot_manager.server import DepotServer
+
+            servers[channel] = DepotServer(scenario)
+    return servers

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections import defaultdict
 from dataclasses import dataclass
 
 import rclpy
@@ -20,13 +21,14 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_controllers.api import Behaviour, behaviour_rng, make_behaviour
-from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_controllers.api import Behaviour, behaviour_rng, make_behaviour, server_channels
+from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, protocol, resources, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
-from swarm_sim.scenario import load_scenario
+from swarm_sim.protocol import CENTER, DEPOT
+from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import Observation, PheromoneMessage, robot_index
 
 
@@ -66,6 +68,10 @@ class ControllerNode(Node):
             topics.type_of(topics.PHEROMONES), topics.PHEROMONES,
             lambda data: self.mailbox.post(pheromone.decode_pheromone(data)), EVENTS, raw=True,
         )
+        inbound, outbound = protocol_topics(self.scenario)
+        for topic in inbound:
+            self.create_subscription(topics.type_of(topic), topic, self._on_protocol, EVENTS, raw=True)
+        self._protocol_pubs = {t: self.create_publisher(topics.type_of(t), t, EVENTS) for t in outbound}
         for name, decode in decoders.items():
             self.create_subscription(
                 topics.type_of(name), name,
@@ -76,6 +82,15 @@ class ControllerNode(Node):
         self._pheromone_pub = self.create_publisher(
             topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS
         )
+
+    def _on_protocol(self, data: bytes) -> None:
+        try:
+            messages = protocol.decode_messages(data)
+        except ValueError as exc:
+            self.get_logger().warning(f"dropping a malformed protocol message: {exc}")
+            return
+        for m in messages:
+            self.mailbox.post(m)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         stamp = decoded[0]
@@ -94,11 +109,16 @@ class ControllerNode(Node):
             carrying=self._latest[topics.GRIPPER][1], messages=self.mailbox.take_before(stamp_ns),
         )
         command = self.behaviour.step(obs)
+        by_topic: dict[str, list] = defaultdict(list)
         for message in command.messages:
             if isinstance(message, PheromoneMessage):
                 self._pheromone_pub.publish(pheromone.encode_pheromone(message))
             else:
-                raise TypeError(f"{self.robot}: no topic for outgoing {type(message).__name__}")
+                by_topic[protocol.topic_of(message)].append(message)
+        for topic, messages in by_topic.items():
+            if topic not in self._protocol_pubs:
+                raise TypeError(f"{self.robot}: this scenario has no receiver on {topic}")
+            self._protocol_pubs[topic].publish(protocol.encode_messages(stamp_ns, messages))
         status = self.behaviour.status(stamp_ns)
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
         if key != self._last_status:
@@ -107,6 +127,23 @@ class ControllerNode(Node):
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
+
+
+def protocol_topics(scenario: Scenario) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(topics a controller listens to, topics it sends on) besides its own and the
+    pheromones: the servers' topics when the scenario runs them, the radio for tail joining."""
+    inbound, outbound = [], []
+    channels = server_channels(scenario)
+    if CENTER in channels:
+        inbound.append(topics.CENTER_ASSIGNMENTS)
+        outbound.append(topics.CENTER_REPORTS)
+    if DEPOT in channels:
+        inbound.append(topics.DEPOT_GRANTS)
+        outbound.append(topics.DEPOT_REPORTS)
+        if scenario.depot.joining == "tail":
+            inbound.append(topics.RADIO)
+            outbound.append(topics.RADIO)
+    return tuple(inbound), tuple(outbound)
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:

@@ -35,6 +35,23 @@ topic                 type                                 from -> to        cor
                                                                              (`pheromone`)
 /world/markers        visualization_msgs/msg/MarkerArray   world -> RViz     scenario + state
                                                                              (`markers`)
+/center/reports       diagnostic_msgs/msg/DiagnosticArray  robot -> center   ProgressReport
+                                                                             (`protocol`)
+/center/assignments   diagnostic_msgs/msg/DiagnosticArray  center -> robots  RegionAssignment
+                                                                             (`protocol`)
+/center/state         diagnostic_msgs/msg/DiagnosticArray  center -> all     regions' walkers and
+                                                                             progress (`server_state`)
+/center/markers       visualization_msgs/msg/MarkerArray   center -> RViz    regions, paths
+/depot/reports        diagnostic_msgs/msg/DiagnosticArray  robot -> depot    DepotReport
+                                                                             (`protocol`)
+/depot/grants         diagnostic_msgs/msg/DiagnosticArray  depot -> robots   DepotGrant (`protocol`)
+/depot/state          diagnostic_msgs/msg/DiagnosticArray  depot -> all      queues and docks
+                                                                             (`server_state`)
+/depot/markers        visualization_msgs/msg/MarkerArray   depot -> RViz     lines, docks, slots
+/radio                diagnostic_msgs/msg/DiagnosticArray  robot -> robots   RadioQuery/RadioReply,
+                                                                             kept within range
+                                                                             (`protocol`)
+/lockstep/ack         std_msgs/msg/Header                  server -> world   tick done (`ack`)
 ====================  ===================================  ================  ======================
 
 Frames: ``world`` for poses, resources, pheromones and markers; ``<robot>/base_link`` for the

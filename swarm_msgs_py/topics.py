@@ -30,6 +30,18 @@ WORLD_EVENTS = "/world/events"
 WORLD_ROBOT_STATS = "/world/robot_stats"
 WORLD_MARKERS = "/world/markers"
 PHEROMONES = "/nest/pheromones"
+CENTER_REPORTS = "/center/reports"
+CENTER_ASSIGNMENTS = "/center/assignments"
+CENTER_STATE = "/center/state"
+CENTER_MARKERS = "/center/markers"
+DEPOT_REPORTS = "/depot/reports"
+DEPOT_GRANTS = "/depot/grants"
+DEPOT_STATE = "/depot/state"
+DEPOT_MARKERS = "/depot/markers"
+RADIO = "/radio"
+LOCKSTEP_ACK = "/lockstep/ack"
+"""Servers (center, depot manager) answer each lockstep tick here: header.stamp = the tick,
+header.frame_id = the server's channel (`center`, `depot`)."""
 
 ROBOT_TOPIC_TYPES: dict[str, str] = {
     ODOM: "nav_msgs/msg/Odometry",
@@ -47,6 +59,16 @@ GLOBAL_TOPIC_TYPES: dict[str, str] = {
     WORLD_ROBOT_STATS: "diagnostic_msgs/msg/DiagnosticArray",
     WORLD_MARKERS: "visualization_msgs/msg/MarkerArray",
     PHEROMONES: "geometry_msgs/msg/PointStamped",
+    CENTER_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
+    CENTER_ASSIGNMENTS: "diagnostic_msgs/msg/DiagnosticArray",
+    CENTER_STATE: "diagnostic_msgs/msg/DiagnosticArray",
+    CENTER_MARKERS: "visualization_msgs/msg/MarkerArray",
+    DEPOT_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
+    DEPOT_GRANTS: "diagnostic_msgs/msg/DiagnosticArray",
+    DEPOT_STATE: "diagnostic_msgs/msg/DiagnosticArray",
+    DEPOT_MARKERS: "visualization_msgs/msg/MarkerArray",
+    RADIO: "diagnostic_msgs/msg/DiagnosticArray",
+    LOCKSTEP_ACK: "std_msgs/msg/Header",
 }
 """Absolute topic -> ROS type string."""
 

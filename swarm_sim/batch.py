@@ -2,7 +2,7 @@
 
 It plays the roles the graph splits over nodes, in the same order: observations of tick k go
 to every behaviour together with the messages stamped before k, the commands come back, the
-world steps. Same scenario and seed as a lockstep graph run -> same trajectories and metrics
+servers (center, depot manager) handle their messages stamped before k, the world steps. Same scenario and seed as a lockstep graph run -> same trajectories and metrics
 (tested in test/test_determinism.py).
 """
 
@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm_controllers.api import behaviour_rng, make_behaviour
+from swarm_controllers.api import behaviour_rng, make_behaviour, make_servers
 from swarm_sim.cli import add_scenario_arguments, scenario_fields
-from swarm_sim.messaging import Mailbox
-from swarm_sim.metrics import RunTrace, summarize
+from swarm_sim.messaging import Router
+from swarm_sim.protocol import DEPOT, ROBOTS
+from swarm_sim.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
@@ -40,26 +41,33 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     world = World(scenario)
     robots = world.robots
     behaviours = {r: make_behaviour(scenario, r, behaviour_rng(scenario.seed, r)) for r in robots}
-    mailbox = Mailbox()
+    servers = make_servers(scenario)
+    router = Router()
     last_step_ns = 0
     trace = RunTrace(
         scenario=scenario.name, seed=scenario.seed, robots=robots, sim_seconds=0.0,
-        wall_seconds=0.0, total_resources=scenario.resources.count, mode="batch",
+        wall_seconds=0.0, total_resources=scenario.resources.count, mode="batch", config=scenario,
     )
+    perimeter = PerimeterLog(robots, scenario.depot.center, scenario.depot.perimeter_radius)
     poses = np.zeros((scenario.ticks + 1, len(robots), 3)) if record_poses else None
     try:
         obs = world.reset()
         for k in range(scenario.ticks):
+            xy = [(o.pose.x, o.pose.y) for o in obs.values()]
+            perimeter.update(world.t_ns / NS_PER_S, xy)
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
-            inbox = mailbox.take_before(world.t_ns)
+            inbox = router.take_before(ROBOTS, world.t_ns)
             commands = {}
             for r, b in behaviours.items():
                 o = obs[r] if not inbox else dataclasses.replace(obs[r], messages=inbox)
                 command = b.step(o)
                 commands[r] = command
                 for message in command.messages:
-                    mailbox.post(message)
+                    router.post(message)
+            for channel, server in servers.items():
+                for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
+                    router.post(message)
             last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
@@ -69,6 +77,10 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
         trace.sim_seconds = world.t_ns / NS_PER_S
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
+        trace.perimeter_entries = perimeter.entries
+        depot = servers.get(DEPOT)
+        if depot is not None:
+            trace.queue_lengths = list(depot.history)
     finally:
         world.close()
     trace.wall_seconds = time.monotonic() - wall0

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from swarm_sim.protocol import CHANNELS, channel_of
+
 
 def _order(message: Any) -> tuple[int, str, str]:
     return (message.stamp_ns, type(message).__name__, repr(message))
@@ -31,3 +33,17 @@ class Mailbox:
             return ()
         self._pending = [m for m in self._pending if m.stamp_ns >= stamp_ns]
         return tuple(sorted(ready, key=_order))
+
+
+class Router:
+    """One `Mailbox` per channel (`swarm_sim.protocol.CHANNELS`): what the batch runner uses
+    in place of the graph's topics."""
+
+    def __init__(self) -> None:
+        self._boxes = {channel: Mailbox() for channel in CHANNELS}
+
+    def post(self, message: Any) -> None:
+        self._boxes[channel_of(message)].post(message)
+
+    def take_before(self, channel: str, stamp_ns: int) -> tuple[Any, ...]:
+        return self._boxes[channel].take_before(stamp_ns)

@@ -12,7 +12,30 @@ from typing import Any
 
 import numpy as np
 
+from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent, RobotId, RobotStats
+
+
+class PerimeterLog:
+    """When each robot crossed into the depot perimeter (queue paper sec. III: the drop-off
+    time runs from entering the perimeter to the drop). Fed the odometry poses every tick, by
+    the batch runner as they are stepped and by `swarm-analyze` as they were recorded."""
+
+    def __init__(self, robots: tuple[RobotId, ...], center: tuple[float, float], radius: float) -> None:
+        self.robots = robots
+        self._center = np.asarray(center, dtype=float)
+        self._r2 = radius * radius
+        self._inside = np.zeros(len(robots), dtype=bool)
+        self.entries: dict[RobotId, list[float]] = {r: [] for r in robots}
+        """Per robot, the sim times [s] it entered the perimeter disc."""
+
+    def update(self, t: float, xy: np.ndarray) -> None:
+        """`xy`: (robots, 2) positions at time `t` [m, world frame], in `robots` order."""
+        d = np.asarray(xy, dtype=float) - self._center
+        inside = np.einsum("ij,ij->i", d, d) < self._r2
+        for i in np.flatnonzero(inside & ~self._inside):
+            self.entries[self.robots[i]].append(t)
+        self._inside = inside
 
 
 @dataclass
@@ -32,6 +55,12 @@ class RunTrace:
     """World counters at the end of the run."""
     status: dict[RobotId, BehaviourStatus] = field(default_factory=dict)
     """Each behaviour's last published status."""
+    config: Scenario | None = None
+    """The scenario the run used (world facts the metrics need: docks, perimeter, regions)."""
+    perimeter_entries: dict[RobotId, list[float]] = field(default_factory=dict)
+    """`PerimeterLog.entries`."""
+    queue_lengths: list[tuple[float, tuple[int, ...]]] = field(default_factory=list)
+    """(t [s], robots queued on each entry line) whenever it changed (depot manager runs)."""
 
 
 def resources_delivered(trace: RunTrace) -> int:
@@ -65,6 +94,42 @@ def trips_by_robot(trace: RunTrace) -> dict[RobotId, int]:
     return trips
 
 
+def dropoff_times(trace: RunTrace) -> list[float]:
+    """Per delivery, the time from the carrier's last entry into the perimeter to the drop [s]
+    (queue paper sec. VII, metric 3); deliveries without a recorded entry are skipped."""
+    out = []
+    for d in trace.drops:
+        t = d.stamp_ns / NS_PER_S
+        entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
+        if entered:
+            out.append(t - entered[-1])
+    return out
+
+
+def deliveries_outside_docks(trace: RunTrace) -> int | None:
+    """Drops farther than the dock radius from every dock stop (None without a scenario)."""
+    if trace.config is None:
+        return None
+    from depot_manager.geometry import DepotGeometryConfig, make_docks
+
+    stops = np.array([k.stop for k in make_docks(DepotGeometryConfig.from_scenario(trace.config))])
+    radius = trace.config.depot.dock_radius + 1e-6
+    return sum(
+        1 for d in trace.drops if np.min(np.hypot(stops[:, 0] - d.x, stops[:, 1] - d.y)) > radius
+    )
+
+
+def queue_length_stats(trace: RunTrace) -> tuple[float, int]:
+    """Time-weighted mean and the maximum of the total entry-line queue length."""
+    if not trace.queue_lengths:
+        return 0.0, 0
+    times = [t for t, _ in trace.queue_lengths] + [trace.sim_seconds]
+    totals = [sum(q) for _, q in trace.queue_lengths]
+    weights = np.diff(times)
+    mean = float(np.dot(weights, totals) / weights.sum()) if weights.sum() > 0 else float(totals[-1])
+    return mean, max(totals)
+
+
 def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
     return float(np.mean(list(values.values()))) if values else 0.0
 
@@ -92,4 +157,27 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "trips_by_robot": trips,
         "stale_ticks": sum(s.stale_ticks for s in trace.stats.values()),
         "clamped_commands": sum(s.clamped_commands for s in trace.stats.values()),
+        **_paper_metrics(trace),
+    }
+
+
+def _paper_metrics(trace: RunTrace) -> dict[str, Any]:
+    """The queue paper's and the MDBSA paper's per-run metrics."""
+    delivered = resources_delivered(trace)
+    dropoff = dropoff_times(trace)
+    queue_mean, queue_max = queue_length_stats(trace)
+    minutes = trace.sim_seconds / 60.0
+    cfg = trace.config
+    mdbsa = cfg is not None and cfg.controller.behaviour in ("mdbsa_c", "mdbsa_d")
+    return {
+        "resources_collected_pct": round(100.0 * delivered / trace.total_resources, 6)
+        if trace.total_resources else 0.0,
+        "dropoff_time_mean_s": round(float(np.mean(dropoff)), 6) if dropoff else None,
+        "dropoff_times_s": [round(v, 3) for v in dropoff],
+        "deliveries_outside_docks": deliveries_outside_docks(trace),
+        "queue_length_mean": round(queue_mean, 6),
+        "queue_length_max": queue_max,
+        "resources_per_robot": round(delivered / len(trace.robots), 6) if trace.robots else 0.0,
+        "foraging_rate_per_min": round(delivered / minutes, 6) if minutes > 0 else 0.0,
+        "regions": cfg.controller.spiral.regions if mdbsa else None,
     }

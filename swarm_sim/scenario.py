@@ -69,6 +69,9 @@ class RobotConfig:
     """[rad/s]."""
     start_spacing: float = 0.4
     """Robots start on a square grid of this pitch [m] centred on the depot."""
+    radio_range: float = 0.4
+    """gamma: robot-to-robot messages reach only robots within this distance [m] (queue paper
+    sec. III; used by tail joining)."""
     odometry_noise: NoiseConfig = field(default_factory=NoiseConfig)
 
 
@@ -118,10 +121,32 @@ class ResourceConfig:
 
 @dataclass(frozen=True)
 class DepotConfig:
+    """The central depot and, for the queue strategies, its docks and queue area
+    (queue_depot_traffic.md sec. III; geometry built by `depot_manager.geometry`)."""
+
     center: tuple[float, float] = (0.0, 0.0)
     """[m, world frame]"""
     radius: float = 0.5
     """Radius of the central depot disc (the CPFA nest) [m]."""
+    delivery: Literal["depot", "docks", "region_centers"] = "depot"
+    """Where resources are delivered: `depot` anywhere in the depot disc (CPFA, DDSA,
+    MDBSA-C); `docks` only at the docks after `unload_time` (queue strategies);
+    `region_centers` at each MDBSA region's center (MDBSA-D)."""
+    queue: Literal["none", "single", "multi"] = "none"
+    """Queue wrapping strategy inside the perimeter (sec. IV); needs delivery `docks`."""
+    joining: Literal["entry", "tail"] = "entry"
+    """Endpoint finding (sec. V): entry-point joining or tail joining."""
+    perimeter_radius: float = 2.0
+    """Radius of the perimeter (red circle) [m]; only carriers may enter it."""
+    docks: int = 4
+    """Number K of docks on the depot boundary."""
+    lane_spacing: float = 0.20
+    """Distance between adjacent queue lanes [m] (sec. VII)."""
+    unload_time: float = 5.0
+    """T_unload: a robot stays at its dock this long before its resource is dropped [s]. The
+    paper gives no value; 5 s is our choice."""
+    dock_radius: float = 0.06
+    """A robot unloads while its centre is within this distance of the dock stop [m]."""
 
 
 @dataclass(frozen=True)
@@ -203,6 +228,12 @@ class SpiralConfig:
     plus room for encoder noise)."""
     arena_margin: float = 0.2
     """Spirals are clipped to the arena square shrunk by this much on every side [m]."""
+    regions: int = 16
+    """MDBSA: number of square regions N_R = 4^k (paper's experiment 1 default 16)."""
+    center_range: float = 0.75
+    """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
+    region_center_radius: float = 0.25
+    """MDBSA-D: radius of each region's own drop zone around the region center [m]."""
 
 
 @dataclass(frozen=True)
@@ -244,8 +275,29 @@ class Scenario:
         return [f"robot_{i}" for i in range(self.robots.count)]
 
     def all_drop_zones(self) -> tuple[DropZoneConfig, ...]:
-        depot = DropZoneConfig("depot", self.depot.center, self.depot.radius, 0.0, "depot")
-        return (depot, *self.drop_zones)
+        """The zones the world drops resources in: `drop_zones` plus the ones `depot.delivery`
+        implies (the depot disc, the docks, or the MDBSA region centers)."""
+        d = self.depot
+        if d.delivery == "docks":
+            from depot_manager.geometry import DepotGeometryConfig, make_docks
+
+            implied = tuple(
+                DropZoneConfig(f"dock_{k.index}", (float(k.stop[0]), float(k.stop[1])),
+                               d.dock_radius, d.unload_time, "dock")
+                for k in make_docks(DepotGeometryConfig.from_scenario(self))
+            )
+        elif d.delivery == "region_centers":
+            from swarm_controllers.spiral import region_centers
+
+            sp = self.controller.spiral
+            implied = tuple(
+                DropZoneConfig(f"region_{i}", (float(x), float(y)), sp.region_center_radius, 0.0,
+                               "region_center")
+                for i, (x, y) in enumerate(region_centers(sp.regions, self.arena.size))
+            )
+        else:
+            implied = (DropZoneConfig("depot", d.center, d.radius, 0.0, "depot"),)
+        return (*implied, *self.drop_zones)
 
 
 # --------------------------------------------------------------------------- loading
@@ -489,3 +541,29 @@ def validate(s: Scenario) -> None:
     _require(sp.gap > 0, "controller.spiral.gap: must be positive")
     _require(sp.arena_margin >= 0, "controller.spiral.arena_margin: must not be negative")
     _require(sp.arena_margin < half, "controller.spiral.arena_margin: leaves no arena to search")
+    k = round(math.log(sp.regions, 4)) if sp.regions >= 1 else -1
+    _require(k >= 0 and 4**k == sp.regions, f"controller.spiral.regions: {sp.regions} is not a power of 4")
+    _require(sp.center_range > 0, "controller.spiral.center_range: must be positive")
+    _require(sp.region_center_radius > 0, "controller.spiral.region_center_radius: must be positive")
+    _require(r.radio_range > 0, "robots.radio_range: must be positive")
+    d = s.depot
+    _require(d.unload_time >= 0, "depot.unload_time: must not be negative")
+    _require(d.dock_radius > 0, "depot.dock_radius: must be positive")
+    _require(
+        d.queue == "none" or d.delivery == "docks",
+        f"depot.queue: {d.queue!r} queues lead to docks; set depot.delivery: docks",
+    )
+    if d.delivery == "docks":
+        from depot_manager.geometry import DepotGeometryConfig, make_layout
+
+        try:
+            geometry = DepotGeometryConfig.from_scenario(s)
+            geometry.validate()
+            if d.queue != "none":
+                make_layout(d.queue, geometry)
+        except ValueError as exc:
+            raise ScenarioError(f"depot: {exc}") from None
+        _require(
+            _inside(d.center, half, d.perimeter_radius),
+            f"depot.perimeter_radius: a perimeter of {d.perimeter_radius} m does not fit in the arena",
+        )

@@ -1,7 +1,8 @@
 """The world node: puts the `World` core on the ROS graph, owns sim time, records the run.
 
 Lockstep (default): for each tick k it publishes ``/clock`` and every robot's observations
-stamped k, waits until every live controller has answered with a ``cmd_vel`` stamped k (a
+stamped k, waits until every live controller has answered with a ``cmd_vel`` stamped k and
+every server the scenario needs (center, depot manager) with a ``/lockstep/ack`` stamped k (a
 controller silent for `tick_timeout` wall seconds is counted stale and keeps its last command;
 after `dead_after` stale ticks in a row it is no longer waited for until it answers again),
 then steps the core. Free-running (`realtime`): steps every dt / real_time_factor wall
@@ -25,6 +26,8 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 
+from swarm_controllers.api import server_channels
+from swarm_msgs_py import ack as ack_codec
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
@@ -92,8 +95,11 @@ class WorldNode(Node):
         self._commands: dict[RobotId, Command] = {}
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
-        self._answered: dict[RobotId, int] = {}
-        self._missed: dict[RobotId, int] = dict.fromkeys(self.robots, 0)
+        self._answered: dict[str, int] = {}
+        """Robot or server channel -> the last tick it answered."""
+        self.servers: tuple[str, ...] = server_channels(self.scenario)
+        """Server channels (center, depot) the barrier waits for besides the robots."""
+        self._missed: dict[str, int] = dict.fromkeys((*self.robots, *self.servers), 0)
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
@@ -104,6 +110,14 @@ class WorldNode(Node):
                 SENSOR_LOCKSTEP, raw=True,
             )
         self._recorded: set[str] = set(self._own_topics) | set(self._cmd_topic)
+        if self.servers:
+            self._recorded.add(topics.LOCKSTEP_ACK)
+            if self.bag is not None:
+                self.bag.add_topic(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK), "reliable")
+            self._ack_sub = self.create_subscription(
+                topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
+                SENSOR_LOCKSTEP, raw=True,
+            )
         self._next_discovery = 0.0
 
     # ------------------------------------------------------------------ plumbing
@@ -140,6 +154,17 @@ class WorldNode(Node):
             return
         self._commands[robot] = Command(linear, angular)
         self._answered[robot] = stamp_ns
+
+    def _on_ack(self, data: bytes) -> None:
+        if self.bag is not None:
+            self.bag.write(topics.LOCKSTEP_ACK, self.world.t_ns, data)
+        try:
+            channel, stamp_ns = ack_codec.decode_ack(data)
+        except ValueError as exc:
+            self.get_logger().warning(f"dropping malformed lockstep ack: {exc}")
+            return
+        if channel in self._missed:
+            self._answered[channel] = stamp_ns
 
     def _discover(self) -> None:
         """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
@@ -207,6 +232,8 @@ class WorldNode(Node):
                 if self._cmd_subs[r].get_publisher_count() == 0
                 or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
             ]
+            if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
+                missing.append("servers (" + ", ".join(self.servers) + ")")
         if missing:
             self.get_logger().warning(
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
@@ -223,9 +250,9 @@ class WorldNode(Node):
         return time.monotonic() - t0
 
     def _await_commands(self, executor: Executor) -> None:
-        """Lockstep barrier: spin until every live controller answered this tick."""
+        """Lockstep barrier: spin until every live controller and server answered this tick."""
         stamp = self.world.t_ns
-        waiting = [r for r in self.robots if self._missed[r] < self.config.dead_after]
+        waiting = [r for r in self._missed if self._missed[r] < self.config.dead_after]
         now = time.monotonic()
         deadline, resend = now + self.config.tick_timeout, now + self.config.resend_period
         while True:
@@ -240,17 +267,21 @@ class WorldNode(Node):
             if now >= resend:  # a sample lost (e.g. while discovery settles): ask again
                 resend = now + self.config.resend_period
                 for r in waiting:
-                    for name, data in self._sent[r].items():
-                        self._obs_pubs[r][name].publish(data)
+                    if r in self._sent:
+                        for name, data in self._sent[r].items():
+                            self._obs_pubs[r][name].publish(data)
+                    else:  # a server: it answers a repeated /clock with its ack
+                        self._clock_pub.publish(clock_codec.encode_clock(stamp))
             bag_time = self._spin(executor, min(0.05, max(0.0, deadline - now)))
             deadline += bag_time
             resend += bag_time
-        for r in self.robots:
+        for r in self._missed:
             if self._answered.get(r) == stamp:
                 self._missed[r] = 0
             else:
                 self._missed[r] += 1
-                self.world.stats[r].stale_ticks += 1
+                if r in self.world.stats:
+                    self.world.stats[r].stale_ticks += 1
                 if self._missed[r] == self.config.dead_after:
                     self.get_logger().warning(f"{r}: no answer for {self._missed[r]} ticks, not waiting for it")
 
