@@ -29,6 +29,7 @@ setup(
         "mcap-ros2-support",
         "rosbags",
         "matplotlib",
+        "scipy",
     ],
     extras_require={
         "ros": [
@@ -36,7 +37,7 @@ setup(
             "ros-jazzy-common-interfaces",
             "ros-jazzy-rmw-fastrtps-cpp",
         ],
-        "test": ["pytest", "hypothesis", "scipy"],
+        "test": ["pytest", "hypothesis"],
     },
     entry_points={
         "console_scripts": [
@@ -45,6 +46,9 @@ setup(
             "swarm-analyze = swarm_sim.analysis:main",
             "swarm-world = swarm_sim.world_node:main",
             "swarm-controllers = swarm_controllers.controller_node:main",
+            "swarm-center = swarm_controllers.center_node:main",
+            "swarm-depot-manager = depot_manager.node:main",
+            "swarm-compare = swarm_sim.compare:main",
         ],
     },
 )

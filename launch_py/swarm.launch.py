@@ -2,8 +2,9 @@
 
     ros2 launch swarmforage swarm.launch.py robots:=16 scenario:=cpfa seed:=0 bag:=bags/run1
 
-Starts the world node (which records the bag) and one controller process hosting every robot's
-controller node (console scripts on PATH). `swarm-run` does the same without ros2launch; nothing in the tests needs this.
+Starts the world node (which records the bag), one controller process hosting every robot's
+controller node and the servers the scenario needs (center, depot manager; console scripts on
+PATH). `swarm-run` does the same without ros2launch; nothing in the tests needs this.
 """
 
 from launch import LaunchDescription
@@ -17,7 +18,13 @@ def _nodes(context):
     seed = LaunchConfiguration("seed").perform(context)
     bag = LaunchConfiguration("bag").perform(context)
     common = ["--scenario", scenario, "--seed", seed, "--set", f"robots.count={robots}"]
+    from swarm_controllers.api import server_channels
+    from swarm_sim.scenario import load_scenario
+
+    servers = server_channels(load_scenario(scenario, [f"robots.count={robots}"]))
+    scripts = {"center": "swarm-center", "depot": "swarm-depot-manager"}
     return [
+        *[ExecuteProcess(cmd=[scripts[c], *common], output="screen") for c in servers],
         ExecuteProcess(cmd=["swarm-controllers", "--robots",
                             *[f"robot_{i}" for i in range(robots)], *common], output="screen"),
         ExecuteProcess(cmd=["swarm-world", *common, "--bag", bag], output="screen"),

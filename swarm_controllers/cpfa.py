@@ -150,7 +150,13 @@ def informed_search_sigma(omega: float, lambda_id: float, t_search: float) -> fl
 class CpfaBehaviour:
     """One robot running the CPFA. See the module docstring for the rules and their sources."""
 
-    def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
+    def __init__(
+        self, scenario: Scenario, robot: RobotId, rng: np.random.Generator,
+        *, keep_out: float | None = None,
+    ) -> None:
+        """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
+        carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
+        give-up return ends at its edge. None: the depot disc (the plain CPFA)."""
         cfg = scenario.controller.cpfa
         dt = scenario.sim.dt
         self.robot = robot
@@ -175,11 +181,13 @@ class CpfaBehaviour:
         self._arrival2 = arrival**2
         self._blocked2 = (arrival + scenario.robots.diameter) ** 2
         self._nest = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
-        self._nest_r2 = scenario.depot.radius**2
+        nest_radius = scenario.depot.radius if keep_out is None else keep_out
+        self._nest_r2 = nest_radius**2
         margin = max(scenario.resources.margin, scenario.robots.diameter)
         half = scenario.arena.size / 2.0
         self._bound = half - margin if half > margin else half / 2.0
-        self._site_clearance2 = (scenario.depot.radius + margin) ** 2
+        self._site_clearance2 = (nest_radius + margin) ** 2
+        self._keep_out2 = -1.0 if keep_out is None else keep_out**2
 
         self._state = CpfaState.DEPARTING
         self._mode = SearchMode.UNINFORMED
@@ -338,7 +346,9 @@ class CpfaBehaviour:
             heading = yaw + normal(0.0, sigma)
             end_x = x + step * math.cos(heading)
             end_y = y + step * math.sin(heading)
-            if abs(end_x) <= bound and abs(end_y) <= bound:
+            nx, ny = self._nest
+            if (abs(end_x) <= bound and abs(end_y) <= bound
+                    and (end_x - nx) ** 2 + (end_y - ny) ** 2 > self._keep_out2):
                 break
         else:
             heading = math.atan2(-y, -x)  # back toward the arena centre (the world origin)

@@ -153,3 +153,32 @@ def encode_markers(
         + resource_markers(resources, stamp_ns)
         + robot_markers(scenario, robot_poses, carrying, stamp_ns)
     )
+
+
+# --------------------------------------------------------------------------- servers' drawings
+
+
+def line_markers(
+    ns: str, lines: list[np.ndarray], color: tuple[float, float, float, float],
+    width: float = 0.02, stamp_ns: int = 0,
+) -> list[Marker]:
+    """One LINE_STRIP per polyline ((n, 2) [m, world]), id = position in `lines`."""
+    out = []
+    for i, pts in enumerate(lines):
+        m = _marker(stamp_ns, ns, i, Marker.LINE_STRIP, ColorRGBA(r=color[0], g=color[1], b=color[2], a=color[3]))
+        m.scale.x = width
+        m.points = [Point(x=x, y=y, z=0.01) for x, y in np.asarray(pts, float).reshape(-1, 2).tolist()]
+        out.append(m)
+    return out
+
+
+def point_markers(
+    ns: str, id_: int, points: np.ndarray, color: tuple[float, float, float, float],
+    size: float, stamp_ns: int = 0, cubes: bool = False,
+) -> list[Marker]:
+    """One SPHERE_LIST (or CUBE_LIST) of `points` ((n, 2) [m, world])."""
+    kind = Marker.CUBE_LIST if cubes else Marker.SPHERE_LIST
+    m = _marker(stamp_ns, ns, id_, kind, ColorRGBA(r=color[0], g=color[1], b=color[2], a=color[3]))
+    m.scale = Vector3(x=size, y=size, z=size)
+    m.points = [Point(x=x, y=y, z=size / 2) for x, y in np.asarray(points, float).reshape(-1, 2).tolist()]
+    return [m]

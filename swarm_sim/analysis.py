@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_msgs_py import diagnostics, odometry, server_state, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_sim.bag import BagError, bag_info, read_bag
-from swarm_sim.metrics import RunTrace, delivered_over_time, summarize
+from swarm_sim.metrics import PerimeterLog, RunTrace, delivered_over_time, summarize
 from swarm_sim.scenario import scenario_from_dict
 from swarm_sim.types import NS_PER_S, DropEvent, robot_index
 
@@ -33,11 +33,23 @@ def load_run(path: Path | str) -> RunTrace:
     trace = RunTrace(
         scenario=scenario.name, seed=scenario.seed, robots=tuple(scenario.robot_names),
         sim_seconds=float(meta.get("sim_seconds", 0.0)), wall_seconds=float(meta.get("wall_seconds", 0.0)),
-        total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"),
+        total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
     )
+    index = {r: i for i, r in enumerate(trace.robots)}
+    positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
     last_clock = 0
     for m in read_bag(path):
-        if m.topic == topics.CLOCK:
+        if m.topic.endswith("/" + topics.ODOM):
+            robot = m.topic[1:].partition("/")[0]
+            if robot in index:
+                stamp, pose, _, _ = odometry.decode_odometry(m.data)
+                if stamp not in positions:
+                    positions[stamp] = np.full((len(index), 2), np.nan)
+                positions[stamp][index[robot]] = (pose.x, pose.y)
+        elif m.topic == topics.DEPOT_STATE:
+            stamp, state = server_state.decode_state(m.data)
+            trace.queue_lengths.append((stamp / NS_PER_S, server_state.queue_lengths(state)))
+        elif m.topic == topics.CLOCK:
             last_clock = max(last_clock, clock_codec.decode_clock(m.data))
         elif m.topic == topics.WORLD_EVENTS:
             for event in diagnostics.decode_events(m.data)[1]:
@@ -49,7 +61,23 @@ def load_run(path: Path | str) -> RunTrace:
             trace.status[status.robot] = status
     if not trace.sim_seconds:  # the run was cut off before it could write its totals
         trace.sim_seconds = last_clock / NS_PER_S
+    trace.perimeter_entries = _perimeter_entries(trace, positions)
     return trace
+
+
+def _perimeter_entries(trace: RunTrace, positions: dict[int, np.ndarray]) -> dict[str, list[float]]:
+    """Replay the recorded odometry through the `PerimeterLog` the batch runner feeds live (a
+    robot missing from a tick keeps its previous position)."""
+    depot = trace.config.depot
+    log = PerimeterLog(trace.robots, depot.center, depot.perimeter_radius)
+    previous = np.full((len(trace.robots), 2), np.inf)
+    for stamp in sorted(positions):
+        xy = positions[stamp]
+        missing = np.isnan(xy[:, 0])
+        xy[missing] = previous[missing]
+        log.update(stamp / NS_PER_S, xy)
+        previous = xy
+    return log.entries
 
 
 def load_odometry(path: Path | str) -> dict[str, np.ndarray]:

@@ -71,6 +71,7 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
             last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
+        perimeter.update(world.t_ns / NS_PER_S, [(o.pose.x, o.pose.y) for o in obs.values()])
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
         status = {r: b.status(last_step_ns) for r, b in behaviours.items()}

@@ -1,0 +1,744 @@
+"""Depot admission: the depot manager's single authority over queue slots
+(queue_depot_traffic.md secs. III, IV-A/B/D, V).
+
+ROS-free and deterministic; `t` is sim time [s] and only orders requests (FCFS).
+
+Cell model
+----------
+Every line of the layout (entry lines, inner queues, exit lines) is cut into *cells*: robot-sized
+slots `Polyline.slots(pitch)` from the line's start (index 0), then made to end exactly at the
+line's end: trailing slots closer than one robot diameter to the end are dropped and the end
+itself is appended, so neighbouring cells are between one robot diameter and pitch + diameter
+apart. Consequences:
+
+- multi: the last cell of ``entry_line_k`` is dock k's stop; ``exit_line_k`` cell 0 is the
+  same physical cell (an alias).
+- single: the last cell of ``entry_line`` is the inner entry point, which is also cell 0 of every
+  inner queue; the last cell of every inner queue is the inner exit point, which is also
+  ``exit_line`` cell 0.
+- single inner queues overlap on the ring lane. Their ring cells are taken from one common
+  *ring grid* (the cells of inner entry point -> ring -> inner exit point, without any V), so an
+  overlap is the *same* cell on several inner queues, not a conflict, and robots of different
+  inner queues follow each other along the ring. Around its own dock an inner queue leaves the
+  grid: the slots of its V from the last grid cell before the V down to the dock stop, the dock
+  stop, and the slots of its V from the dock up to the first grid cell after it (each part made
+  to end exactly as above). The skipped grid cells above the V conflict with the V's cells.
+
+Physical cells are identified only through these aliases and the ring grid, never by accident of
+position: two cells of different lines that happen to lie on each other *conflict*.
+
+Conflicts: two distinct cells conflict if their centres are closer than (robot_diameter +
+lane_spacing)/2, or, for cells adjacent on a line, closer than robot_diameter (adjacent slots
+are nose to tail by design). Adjacent lanes, exactly lane_spacing apart, do not conflict;
+overlapping or crossing lines do. An *intersection cell* is a cell with any conflict.
+
+A robot *owns* the cells from the one it last reported (`arrived`/`join`) up to its grant.
+A cell is *free* for robot r if no other robot owns it or a cell conflicting with it.
+
+Routes: multi: entry_line_k (its last cell is dock k) -> exit_line_k. single: entry_line ->
+inner_queue_k (chosen at dispatch) -> exit_line. A robot leaves the perimeter on reaching the
+last cell of its exit line.
+
+Rules (the paper's) and the choices it leaves open
+---------------------------------------------------
+- **join** (sec. V): accepted iff the line is an entry line, the robot is not inside, the cell
+  and its conflicts are free, the cell is behind the tail (its index is below every owned cell
+  of that line: robots queue towards higher indices), and it is not an intersection cell.
+  Refusals, checked in this order: ``"unknown line"``, ``"already inside"``, ``"unknown cell"``
+  (index out of range; our addition), ``"occupied"``, ``"not behind the tail"``, ``"keep clear"``
+  (an intersection cell: a robot waiting there could close a gridlock; our addition).
+- **arrived**: the robot reached a cell of its route (either name of an alias); it releases
+  every cell before it. A cell behind its current one, beyond its grant or not on its route, or
+  an unknown robot, is a ValueError. Reporting its current cell again is a no-op (it keeps its
+  waiting time). Reaching the last cell of the exit line: it has left; everything is released.
+- **unloaded**: only while the robot is at its dock cell (else ValueError); repeats are no-ops.
+  It does not restart the robot's waiting time, so a robot that waited at its dock keeps its
+  place in the FCFS order.
+- **step** (grants): robots are served in FCFS order of the time they started waiting for their
+  next cell, i.e. the time of their last `arrived`/`join`; ties go counter-clockwise: ascending
+  bearing of the robot's current cell about the depot centre, atan2 mapped to [0, 2 pi); then
+  robot id. A robot is topped up whenever its grant ends fewer than `lookahead` cells ahead of
+  its current cell (a rolling horizon, so robots need not stop at every grant); it is extended
+  greedily through free cells along its route to at most `lookahead` cells ahead of its current
+  cell, with:
+  * **keep clear** (sec. IV-D): a grant never ends on an intersection cell (except the route's
+    last cell, where the robot leaves). It extends through a run of intersection cells only if
+    the whole run and the non-intersection cell after it are free; such a run is granted at once
+    even beyond `lookahead` (stopping inside it is not allowed, so the run is indivisible).
+    Otherwise the grant stops before the run.
+  * **dock**: a grant never passes a dock cell before `unloaded`.
+  * **dispatch** (single, sec. IV-A): a robot whose grant reaches the end of the entry line (the
+    inner entry point) is dispatched into inner queue k only if no other robot owns the dock
+    cell or a cell conflicting with it, and no other robot owns a cell of inner queue k between
+    the entry point (exclusive) and the dock. Among the eligible docks the first one
+    counter-clockwise from the inner entry point is chosen; if no cell can be granted along it
+    this step, the robot is not dispatched yet (and may get another dock later).
+  * **leaving the dock** (single, sec. IV-A): after `unloaded` the robot gets cells past its dock
+    only if the inner exit point is free and no other robot owns a cell of inner queue k
+    between the dock (exclusive) and the inner exit point. Hence at most two robots per inner
+    queue: one between the entry point and the dock (inclusive), one after the dock.
+  * **FCFS claims**: a robot standing at its grant end whose next cells cannot be granted claims
+    them (the run it needs, or for a robot held at its dock the cells of the leave-the-dock
+    rule) against robots served after it *that are upstream of it* (an earlier cell in the
+    topological order of the route graph). Claims are never made against downstream robots:
+    a downstream robot may be the one the claimer waits for, and such a claim would close a
+    wait cycle. Claims last one step.
+- **No gridlock.** Cells along every route strictly increase in a topological order of the
+  route graph (checked at construction). A robot that has stopped does so on a non-intersection
+  cell, so it only blocks robots that want that very cell, which are upstream of it; claims,
+  the dispatch and the leave-the-dock rules also only make robots wait for downstream ones. So
+  the most downstream stopped robot is either unloading or gets a grant, every step: some robot
+  can always move, and since routes are finite every robot leaves once arrivals stop.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from depot_manager.geometry import ARC_STEP, Polyline, QueueLayout
+
+SAME_POINT = 1e-6
+"""Two cells closer than this [m] are the same point (aliases at line junctions)."""
+TOL = 1e-6
+"""Distance comparisons [m] are strict by this margin (slots are exactly one pitch apart)."""
+LINE_TOL = 1e-3
+"""Cells lie on their line to within the arc discretisation (geometry.ARC_STEP) [m]."""
+SWEEP_STEP = 0.01
+"""Sampling step along a line between two cells when looking for swept conflicts [m]."""
+
+
+@dataclass(frozen=True)
+class DepotState:
+    """What the depot manager knows at one instant (for `/depot/state` and metrics)."""
+
+    t: float
+    """Sim time of the last `step` [s]."""
+    entry_lines: tuple[str, ...]
+    entry_queue_lengths: tuple[int, ...]
+    """Per entry line, robots whose current cell is on it (its last cell included)."""
+    dock_occupants: tuple[str, ...]
+    """Per dock, the robot owning its cell, '' if none."""
+    inner_queue_counts: tuple[int, ...]
+    """Per inner queue (single only), robots dispatched into it and not yet past its exit
+    point."""
+    occupied: tuple[tuple[str, int, str], ...]
+    """Every owned cell as (line, cell, robot), named along the owner's route, sorted."""
+    inside: tuple[str, ...]
+    """Robots inside the perimeter (joined, not left), sorted."""
+    left: int
+    """Robots that have left the perimeter so far."""
+
+
+def line_cells(points: np.ndarray | Polyline, pitch: float, min_gap: float) -> np.ndarray:
+    """Slots of a line every `pitch` [m] from its start, ending exactly at its end: trailing
+    slots closer than `min_gap` to the end are dropped and the end appended, (n, 2) [m]."""
+    line = points if isinstance(points, Polyline) else Polyline("_", np.asarray(points, float))
+    s = line.slots(pitch)
+    end = line.end
+    keep = len(s)
+    while keep > 1 and np.linalg.norm(s[keep - 1] - end) < min_gap:
+        keep -= 1
+    return np.concatenate([s[:keep], end[None, :]])
+
+
+def _project(line: Polyline, pts: np.ndarray) -> np.ndarray:
+    """Arc length [m] of the point of `line` nearest to each of `pts`, searched forwards from
+    the previous one (cells lie on their line, in order)."""
+    a, b = line.points[:-1], line.points[1:]
+    v = b - a
+    vv = np.maximum((v * v).sum(axis=1), 1e-18)
+    cum = line.cumulative
+    out = []
+    lo = 0
+    for p in pts:
+        t = np.clip(((p - a) * v).sum(axis=1) / vv, 0.0, 1.0)
+        d = np.linalg.norm(a + t[:, None] * v - p, axis=1)
+        d[:lo] = np.inf
+        j = int(np.argmin(d))
+        lo = j
+        out.append(cum[j] + t[j] * math.sqrt(vv[j]))
+    return np.array(out)
+
+
+def _bearing(p: np.ndarray, c: np.ndarray) -> float:
+    return math.atan2(p[1] - c[1], p[0] - c[0]) % (2 * math.pi)
+
+
+class _Model:
+    """The immutable cell model of one layout (built once per layout object)."""
+
+    def __init__(self, layout: QueueLayout) -> None:
+        cfg = layout.config
+        self.layout = layout
+        self.kind = layout.kind
+        self.center = cfg.center
+        pitch, diam = cfg.pitch, cfg.robot_diameter
+        self._xy: list[np.ndarray] = []
+        self.line_ids: dict[str, np.ndarray] = {}
+
+        def add(p: np.ndarray) -> int:
+            self._xy.append(np.asarray(p, float))
+            return len(self._xy) - 1
+
+        def new_ids(pts: np.ndarray) -> list[int]:
+            return [add(p) for p in pts]
+
+        def same(a: np.ndarray, b: np.ndarray, what: str) -> None:
+            if np.linalg.norm(np.asarray(a) - np.asarray(b)) > SAME_POINT:
+                raise ValueError(f"layout {layout.kind}: {what} do not meet ({a} vs {b})")
+
+        self.entry_names = tuple(ln.name for ln in layout.entry_lines)
+        self.exit_names = tuple(ln.name for ln in layout.exit_lines)
+        self.inner_names = tuple(ln.name for ln in layout.inner_queues)
+        self.dock_ids: list[int] = []
+        # route templates: list of (line name, first index used) segments
+        self.routes: list[tuple[tuple[str, int], ...]] = []
+
+        if layout.kind == "multi":
+            if len(layout.entry_lines) != len(layout.exit_lines) or len(layout.docks) != len(
+                layout.entry_lines
+            ):
+                raise ValueError("multi layout: need one entry line, exit line and dock each")
+            for k, (en, ex) in enumerate(zip(layout.entry_lines, layout.exit_lines)):
+                e = line_cells(en, pitch, diam)
+                same(e[-1], layout.docks[k].stop, f"{en.name} and dock {k}")
+                e[-1] = layout.docks[k].stop
+                ids_e = new_ids(e)
+                x = line_cells(ex, pitch, diam)
+                same(x[0], e[-1], f"{en.name} and {ex.name}")
+                self.line_ids[en.name] = np.array(ids_e)
+                self.line_ids[ex.name] = np.array([ids_e[-1]] + new_ids(x[1:]))
+                self.dock_ids.append(ids_e[-1])
+                self.routes.append(((en.name, 0), (ex.name, 1)))
+        elif layout.kind == "single":
+            self._build_single(layout, pitch, diam, add, new_ids, same)
+        else:
+            raise ValueError(f"unknown layout kind {layout.kind!r}")
+
+        self.xy = np.array(self._xy)
+        del self._xy
+        n = len(self.xy)
+        self.lines = self.entry_names + self.inner_names + self.exit_names
+        self.line_xy = {ln: self.xy[ids] for ln, ids in self.line_ids.items()}
+        self.bearing = np.array([_bearing(p, self.center) for p in self.xy])
+
+        # conflicts
+        adjacent = set()
+        for ids in self.line_ids.values():
+            for a, b in zip(ids[:-1], ids[1:]):
+                adjacent.add((int(a), int(b)))
+                adjacent.add((int(b), int(a)))
+        thr = (cfg.robot_diameter + cfg.lane_spacing) / 2.0
+        d = np.linalg.norm(self.xy[:, None, :] - self.xy[None, :, :], axis=2)
+        conflicts: list[list[int]] = [[] for _ in range(n)]
+        for i, j in zip(*np.nonzero(d < thr - TOL)):
+            i, j = int(i), int(j)
+            if i == j:
+                continue
+            limit = diam if (i, j) in adjacent else thr
+            if d[i, j] < limit - TOL:
+                conflicts[i].append(j)
+        docks = set(self.dock_ids)
+        for c, a, b in sorted(self._sweep_hits(layout, diam)):
+            if a in conflicts[c] or b in conflicts[c]:
+                continue
+            x = a if b in docks else b  # the mover owns both ends; docks must stay clear
+            conflicts[c].append(x)
+            conflicts[x].append(c)
+        self.conflicts = tuple(tuple(sorted(c)) for c in conflicts)
+        self.intersection = np.array([len(c) > 0 for c in self.conflicts])
+
+        # route graph: topological order (strictly increasing along every route)
+        succ: list[set[int]] = [set() for _ in range(n)]
+        for k in range(len(self.routes)):
+            r = self.route_ids(k)
+            for a, b in zip(r[:-1], r[1:]):
+                succ[a].add(b)
+        indeg = [0] * n
+        for s in succ:
+            for b in s:
+                indeg[b] += 1
+        heap = [i for i in range(n) if indeg[i] == 0]
+        heapq.heapify(heap)
+        order = []
+        while heap:
+            i = heapq.heappop(heap)
+            order.append(i)
+            for b in sorted(succ[i]):
+                indeg[b] -= 1
+                if indeg[b] == 0:
+                    heapq.heappush(heap, b)
+        if len(order) != n:
+            raise ValueError(f"layout {layout.kind}: the route graph has a cycle")
+        self.rank = np.empty(n, dtype=int)
+        self.rank[order] = np.arange(n)
+
+        # places where robots must be able to stop
+        for k, dock in enumerate(self.dock_ids):
+            if self.intersection[dock]:
+                raise ValueError(f"dock {k} conflicts with another line's cells")
+        if self.kind == "single" and self.intersection[self.line_ids[self.entry_names[0]][-1]]:
+            raise ValueError("the inner entry point conflicts with another line's cells")
+
+    def _build_single(self, layout, pitch, diam, add, new_ids, same) -> None:
+        (en,), (ex,) = layout.entry_lines, layout.exit_lines
+        inner = layout.inner_queues
+        if len(inner) != len(layout.docks) or not inner:
+            raise ValueError("single layout: need one inner queue per dock")
+        c = layout.config.center
+        e = line_cells(en, pitch, diam)
+        e_in, x_in = inner[0].start, inner[0].end
+        same(e[-1], e_in, f"{en.name} and the inner entry point")
+        ids_e = new_ids(e)
+        self.line_ids[en.name] = np.array(ids_e)
+
+        # ring grid: inner entry point -> ring (CCW) -> inner exit point, with no V
+        q0 = inner[0].points
+        r_ring = float(np.linalg.norm(q0[1] - c))
+        phi0 = math.atan2(q0[1][1] - c[1], q0[1][0] - c[0])
+        phi1 = phi0 + (_bearing(q0[-2], c) - phi0) % (2 * math.pi)
+        m = max(1, math.ceil((phi1 - phi0) * r_ring / ARC_STEP))
+        phi = np.linspace(phi0, phi1, m + 1)
+        arc = c + r_ring * np.stack([np.cos(phi), np.sin(phi)], axis=1)
+        grid = line_cells(np.vstack([e_in, arc, x_in]), pitch, diam)
+        ids_g = [ids_e[-1]] + new_ids(grid[1:])
+        g_ang = np.unwrap([phi0] + [math.atan2(*(p - c)[::-1]) for p in grid[1:]])
+        ids_x_in = ids_g[-1]
+
+        for k, (q, dock) in enumerate(zip(inner, layout.docks)):
+            pts = q.points
+            v = int(np.argmin(np.linalg.norm(pts - dock.stop, axis=1)))
+            same(pts[v], dock.stop, f"{q.name} and dock {k}")
+            if not 0 < v < len(pts) - 1:
+                raise ValueError(f"{q.name}: dock {k} is not inside the inner queue")
+            ang = lambda p: phi0 + (_bearing(p, c) - phi0) % (2 * math.pi)  # noqa: E731
+            a_out, a_back = ang(pts[v - 1]), ang(pts[v + 1])
+            ia = int(np.nonzero(g_ang <= a_out + 1e-9)[0][-1])
+            ib = int(np.nonzero(g_ang >= a_back - 1e-9)[0][0])
+            vert_ang = np.array([ang(p) for p in pts])
+            down = [grid[ia]] + [
+                p for p, a in zip(pts[1:v], vert_ang[1:v]) if a > g_ang[ia] + 1e-12
+            ] + [dock.stop]
+            up = [dock.stop] + [
+                p for p, a in zip(pts[v + 1 : -1], vert_ang[v + 1 : -1]) if a < g_ang[ib] - 1e-12
+            ] + [grid[ib]]
+            down_c = line_cells(np.array(down), pitch, diam)
+            up_c = line_cells(np.array(up), pitch, diam)
+            down_c[-1] = dock.stop
+            dock_id = add(dock.stop)
+            ids = (
+                ids_g[: ia + 1] + new_ids(down_c[1:-1]) + [dock_id]
+                + new_ids(up_c[1:-1]) + ids_g[ib:]
+            )
+            self.line_ids[q.name] = np.array(ids)
+            self.dock_ids.append(dock_id)
+            self.routes.append(((en.name, 0), (q.name, 1), (ex.name, 1)))
+
+        x = line_cells(ex, pitch, diam)
+        same(x[0], x_in, f"{ex.name} and the inner exit point")
+        self.line_ids[ex.name] = np.array([ids_x_in] + new_ids(x[1:]))
+
+    def _sweep_hits(self, layout: QueueLayout, diam: float) -> set[tuple[int, int, int]]:
+        """(c, a, b): a robot driving along a line from cell a to the next cell b passes within a
+        robot diameter of cell c (e.g. leaving a dock up its V, next to a ring cell)."""
+        polys = {ln.name: ln for ln in layout.lines()}
+        hits: set[tuple[int, int, int]] = set()
+        for name, ids in self.line_ids.items():
+            poly = polys[name]
+            s = _project(poly, self.xy[ids])
+            n = np.maximum(2, np.ceil(np.diff(s) / SWEEP_STEP).astype(int) + 1)
+            seg = np.repeat(np.arange(len(n)), n)
+            frac = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n - 1, n)
+            pts = poly.point_at(s[seg] + frac * np.diff(s)[seg])
+            # a, b and their neighbours on this line are not swept past
+            near = ids[np.clip(seg[:, None] + np.arange(-1, 3), 0, len(ids) - 1)]
+            for lo in range(0, len(pts), 1024):
+                blk = slice(lo, lo + 1024)
+                diff = pts[blk, None, :] - self.xy[None, :, :]
+                d2 = (diff * diff).sum(axis=2)
+                d2[np.arange(len(d2))[:, None], near[blk]] = np.inf
+                for k, c in zip(*np.nonzero(d2 < (diam - LINE_TOL) ** 2)):
+                    j = seg[lo + k]
+                    hits.add((int(c), int(ids[j]), int(ids[j + 1])))
+        return hits
+
+    def route_ids(self, k: int) -> list[int]:
+        out: list[int] = []
+        for line, first in self.routes[k]:
+            out.extend(int(i) for i in self.line_ids[line][first:])
+        return out
+
+
+_MODELS: weakref.WeakKeyDictionary[QueueLayout, _Model] = weakref.WeakKeyDictionary()
+
+
+def _model(layout: QueueLayout) -> _Model:
+    m = _MODELS.get(layout)
+    if m is None:
+        m = _MODELS[layout] = _Model(layout)
+    return m
+
+
+class _Robot:
+    """A robot inside the perimeter (mutable bookkeeping of `DepotAdmission`)."""
+
+    __slots__ = (
+        "name", "entry", "route", "labels", "lookup", "pos", "end", "key", "unloaded",
+        "complete", "inner", "dock_pos", "entry_len", "inner_end",
+    )
+
+    def __init__(self, name: str, entry: int, t: float) -> None:
+        self.name = name
+        self.entry = entry
+        self.route: list[int] = []
+        self.labels: list[tuple[str, int]] = []
+        self.lookup: dict[tuple[str, int], int] = {}
+        self.pos = self.end = 0
+        self.key = t
+        self.unloaded = False
+        self.complete = False
+        self.inner = -1
+        self.dock_pos = -1
+        self.entry_len = 0
+        self.inner_end = -1  # route index of the inner exit point (single)
+
+
+class DepotAdmission:
+    """Grants queue cells to robots: FCFS, keep-clear, one robot per dock, two per inner
+    queue (see the module docstring for every rule)."""
+
+    def __init__(self, layout: QueueLayout, *, lookahead: int = 8) -> None:
+        if lookahead < 1:
+            raise ValueError(f"lookahead must be >= 1, got {lookahead}")
+        self.layout = layout
+        self.lookahead = lookahead
+        self._m = _model(layout)
+        self._owner: list[str | None] = [None] * len(self._m.xy)
+        self._robots: dict[str, _Robot] = {}
+        self._reported: dict[str, tuple[str, int]] = {}
+        self._left = 0
+        self._t = 0.0
+        m = self._m
+        if m.kind == "single":
+            e_in = m.xy[m.line_ids[m.entry_names[0]][-1]]
+            a0 = _bearing(e_in, m.center)
+            self._dock_order = sorted(
+                range(len(layout.docks)),
+                key=lambda k: ((layout.docks[k].angle - a0) % (2 * math.pi), k),
+            )
+            self._dock_index = [
+                int(np.flatnonzero(m.line_ids[q] == m.dock_ids[k])[0])
+                for k, q in enumerate(m.inner_names)
+            ]
+
+    # ------------------------------------------------------------------ geometry queries
+
+    def cells(self, line: str) -> np.ndarray:
+        """Cell centres of `line`, (n, 2) [m, world frame], index 0 at the line's start."""
+        if line not in self._m.line_xy:
+            raise ValueError(f"unknown line {line!r} (lines: {', '.join(self._m.lines)})")
+        return self._m.line_xy[line].copy()
+
+    def lines(self) -> tuple[str, ...]:
+        """Entry lines, inner queues, exit lines."""
+        return self._m.lines
+
+    def keep_clear(self, line: str, cell: int) -> bool:
+        """The cell is an intersection cell: no grant ends there (sec. IV-D)."""
+        return bool(self._m.intersection[self._id(line, cell)])
+
+    def conflict(self, a: tuple[str, int], b: tuple[str, int]) -> bool:
+        """Cells a and b, each (line, cell), are the same cell or conflict: two robots may not
+        own them at once."""
+        i, j = self._id(*a), self._id(*b)
+        return i == j or j in self._m.conflicts[i]
+
+    def route(self, robot: str) -> tuple[tuple[str, int], ...]:
+        """The robot's route as (line, cell) from its join cell's line start; for a single-queue
+        robot not yet dispatched, only the entry line. Empty if the robot is not inside."""
+        r = self._robots.get(robot)
+        return tuple(r.labels) if r else ()
+
+    def position(self, robot: str) -> tuple[str, int] | None:
+        """The cell the robot last reported (or joined at)."""
+        r = self._robots.get(robot)
+        return r.labels[r.pos] if r else None
+
+    # ------------------------------------------------------------------ reports
+
+    def join(self, robot: str, line: str, cell: int, t: float) -> str:
+        """Ask to join entry line `line` at `cell`; "" if accepted, else the refusal reason."""
+        m = self._m
+        if line not in m.entry_names:
+            return "unknown line"
+        if robot in self._robots:
+            return "already inside"
+        ids = m.line_ids[line]
+        if not 0 <= cell < len(ids):
+            return "unknown cell"
+        c = int(ids[cell])
+        if not self._free(c, robot):
+            return "occupied"
+        owned = [i for i, cid in enumerate(ids) if self._owner[cid] is not None]
+        if owned and cell >= min(owned):
+            return "not behind the tail"
+        if m.intersection[c]:
+            return "keep clear"
+        r = _Robot(robot, m.entry_names.index(line), t)
+        if m.kind == "multi":
+            self._set_route(r, r.entry)
+        else:
+            self._set_route(r, None)
+        r.pos = r.end = cell
+        self._owner[c] = robot
+        self._robots[robot] = r
+        return ""
+
+    def arrived(self, robot: str, line: str, cell: int, t: float) -> None:
+        """The robot reached (line, cell) of its route: release the cells behind it."""
+        r = self._robots.get(robot)
+        if r is None:
+            raise ValueError(f"unknown robot {robot!r}: not inside the depot perimeter")
+        p = r.lookup.get((line, cell))
+        if p is None:
+            raise ValueError(
+                f"{robot}: ({line}, {cell}) is not on its route "
+                f"(now at {r.labels[r.pos]}, granted up to {r.labels[r.end]})"
+            )
+        if p < r.pos:
+            raise ValueError(f"{robot}: ({line}, {cell}) is behind its current cell {r.labels[r.pos]}")
+        if p > r.end:
+            raise ValueError(f"{robot}: ({line}, {cell}) is beyond its grant {r.labels[r.end]}")
+        if p == r.pos:
+            return
+        for c in r.route[r.pos : p]:
+            self._owner[c] = None
+        r.pos, r.key = p, t
+        if r.complete and p == len(r.route) - 1:
+            for c in r.route[p : r.end + 1]:
+                self._owner[c] = None
+            del self._robots[robot]
+            self._reported.pop(robot, None)
+            self._left += 1
+
+    def unloaded(self, robot: str, t: float) -> None:
+        """The robot's resource was dropped: it may leave its dock (when the rules allow)."""
+        r = self._robots.get(robot)
+        if r is None:
+            raise ValueError(f"unknown robot {robot!r}: not inside the depot perimeter")
+        if r.dock_pos < 0 or r.pos != r.dock_pos:
+            raise ValueError(f"{robot}: unloaded while not at its dock (at {r.labels[r.pos]})")
+        r.unloaded = True
+
+    # ------------------------------------------------------------------ grants
+
+    def step(self, t: float) -> dict[str, tuple[str, int]]:
+        """Extend grants (FCFS, ties counter-clockwise); -> robots whose grant changed since the
+        last step -> (line, furthest granted cell)."""
+        self._t = t
+        m = self._m
+        order = sorted(
+            self._robots.values(), key=lambda r: (-r.key, m.bearing[r.route[r.pos]], r.name)
+        )
+        claims = np.full(len(m.xy), -1, dtype=int)
+        for r in order:
+            self._advance(r, claims)
+        changed = {}
+        for name, r in self._robots.items():
+            g = r.labels[r.end]
+            if self._reported.get(name) != g:
+                self._reported[name] = g
+                changed[name] = g
+        return changed
+
+    def grant(self, robot: str) -> tuple[str, int] | None:
+        """(line, furthest granted cell) of the robot; None if it is not inside."""
+        r = self._robots.get(robot)
+        return r.labels[r.end] if r else None
+
+    def is_last(self, robot: str) -> bool:
+        """The robot is on an entry line and no robot on that line is at a lower cell."""
+        r = self._robots.get(robot)
+        if r is None or r.pos >= r.entry_len:
+            return False
+        return not any(
+            o.entry == r.entry and o.pos < r.pos and o.pos < o.entry_len
+            for o in self._robots.values()
+        )
+
+    @property
+    def robots_inside(self) -> tuple[str, ...]:
+        return tuple(sorted(self._robots))
+
+    def entry_queue_lengths(self) -> tuple[int, ...]:
+        n = [0] * len(self._m.entry_names)
+        for r in self._robots.values():
+            if r.pos < r.entry_len:
+                n[r.entry] += 1
+        return tuple(n)
+
+    def snapshot(self) -> DepotState:
+        m = self._m
+        inner = [0] * len(m.inner_names)
+        occupied = []
+        for r in self._robots.values():
+            if r.inner >= 0 and r.pos <= r.inner_end:
+                inner[r.inner] += 1
+            occupied.extend((*r.labels[p], r.name) for p in range(r.pos, r.end + 1))
+        return DepotState(
+            t=self._t,
+            entry_lines=m.entry_names,
+            entry_queue_lengths=self.entry_queue_lengths(),
+            dock_occupants=tuple(self._owner[d] or "" for d in m.dock_ids),
+            inner_queue_counts=tuple(inner),
+            occupied=tuple(sorted(occupied)),
+            inside=self.robots_inside,
+            left=self._left,
+        )
+
+    # ------------------------------------------------------------------ internals
+
+    def _id(self, line: str, cell: int) -> int:
+        ids = self._m.line_ids.get(line)
+        if ids is None:
+            raise ValueError(f"unknown line {line!r} (lines: {', '.join(self._m.lines)})")
+        if not 0 <= cell < len(ids):
+            raise ValueError(f"{line} has cells 0..{len(ids) - 1}, not {cell}")
+        return int(ids[cell])
+
+    def _set_route(self, r: _Robot, k: int | None) -> None:
+        """Route of template k (None: single-queue entry line only, before dispatch)."""
+        m = self._m
+        segments = m.routes[k] if k is not None else ((m.entry_names[0], 0),)
+        r.route, r.labels, r.lookup = [], [], {}
+        prev_last = None
+        for line, first in segments:
+            ids = m.line_ids[line]
+            if first == 1 and prev_last is not None:
+                r.lookup[(line, 0)] = prev_last  # alias of the previous line's last cell
+            for i in range(first, len(ids)):
+                r.lookup[(line, i)] = len(r.route)
+                r.route.append(int(ids[i]))
+                r.labels.append((line, i))
+            prev_last = len(r.route) - 1
+        r.entry_len = len(m.line_ids[segments[0][0]])
+        r.complete = k is not None
+        r.inner = r.dock_pos = r.inner_end = -1
+        if k is not None:
+            r.dock_pos = r.route.index(m.dock_ids[k])
+            if m.kind == "single":
+                r.inner = k
+                r.inner_end = r.entry_len - 1 + len(m.line_ids[m.inner_names[k]]) - 1
+
+    def _free(self, c: int, robot: str) -> bool:
+        own = self._owner
+        o = own[c]
+        if o is not None and o != robot:
+            return False
+        for x in self._m.conflicts[c]:
+            o = own[x]
+            if o is not None and o != robot:
+                return False
+        return True
+
+    def _stoppable(self, r: _Robot, i: int) -> bool:
+        return not self._m.intersection[r.route[i]] or (r.complete and i == len(r.route) - 1)
+
+    def _extension(self, r: _Robot, claims: np.ndarray) -> int:
+        """Furthest route index the robot can be granted now (r.end if none)."""
+        rank = self._m.rank[r.route[r.pos]]
+        limit = r.pos + self.lookahead
+        i = best = r.end
+        n = len(r.route)
+        while i + 1 < n:
+            if i >= limit and i == best:
+                break
+            if i == r.dock_pos and not r.unloaded:
+                break
+            c = r.route[i + 1]
+            if claims[c] > rank or not self._free(c, r.name):
+                break
+            i += 1
+            if self._stoppable(r, i):
+                best = i
+        return best
+
+    def _needed_run(self, r: _Robot) -> list[int]:
+        """The cells the robot needs for its next stop: the next cell, through any run of
+        intersection cells to the next stoppable one."""
+        out = []
+        i = r.end
+        while i + 1 < len(r.route):
+            i += 1
+            out.append(r.route[i])
+            if self._stoppable(r, i):
+                break
+        return out
+
+    def _claim(self, cells, rank: int, claims: np.ndarray) -> None:
+        for c in cells:
+            claims[c] = max(claims[c], rank)
+            for x in self._m.conflicts[c]:
+                claims[x] = max(claims[x], rank)
+
+    def _grant_to(self, r: _Robot, end: int) -> None:
+        for c in r.route[r.end + 1 : end + 1]:
+            self._owner[c] = r.name
+        r.end = end
+
+    def _advance(self, r: _Robot, claims: np.ndarray) -> None:
+        m = self._m
+        if r.end - r.pos >= self.lookahead:
+            return
+        stopped = r.end == r.pos
+        rank = int(m.rank[r.route[r.pos]])
+        if r.end == r.dock_pos:
+            if not r.unloaded:
+                return
+            if m.kind == "single" and not self._may_leave_dock(r):
+                if stopped:
+                    ids = m.line_ids[m.inner_names[r.inner]]
+                    self._claim(ids[self._dock_index[r.inner] + 1 :], rank, claims)
+                return
+        end = self._extension(r, claims)
+        if end > r.end:
+            self._grant_to(r, end)
+        elif stopped and r.end < len(r.route) - 1:
+            self._claim(self._needed_run(r), rank, claims)
+        if not r.complete and r.end == len(r.route) - 1:
+            self._dispatch(r, claims)
+
+    def _may_leave_dock(self, r: _Robot) -> bool:
+        m = self._m
+        ids = m.line_ids[m.inner_names[r.inner]]
+        for c in ids[self._dock_index[r.inner] + 1 :]:
+            o = self._owner[c]
+            if o is not None and o != r.name:
+                return False
+        return self._free(int(ids[-1]), r.name)
+
+    def _dispatch(self, r: _Robot, claims: np.ndarray) -> None:
+        """Single queue: send a robot granted up to the inner entry point into an inner queue."""
+        m = self._m
+        for k in self._dock_order:
+            ids = m.line_ids[m.inner_names[k]]
+            d = self._dock_index[k]
+            if any(self._owner[c] not in (None, r.name) for c in ids[1 : d + 1]):
+                continue
+            if not self._free(int(ids[d]), r.name):
+                continue
+            pos, end = r.pos, r.end
+            self._set_route(r, k)
+            r.pos, r.end = pos, end
+            new_end = self._extension(r, claims)
+            if new_end > end:
+                self._grant_to(r, new_end)
+            else:
+                self._set_route(r, None)
+                r.pos, r.end = pos, end
+            return

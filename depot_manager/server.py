@@ -1,0 +1,68 @@
+"""The depot manager's core: `DepotReport`s in, `DepotGrant`s out (queue_depot_traffic.md
+secs. IV-V; implements `swarm_sim.protocol.Server`).
+
+ROS-free. Each tick the server applies the reports in the order given, then lets
+`DepotAdmission` extend grants, and answers with one `DepotGrant` per robot whose grant or
+``last`` flag changed (sorted by robot id), plus one refusal (cell -1, with the reason) per
+refused join. Reports that cannot be applied (unknown robot, a cell not on the robot's route,
+an unknown kind, ...) are ignored and recorded in `errors`: one robot's bad report must not stop
+the depot.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from depot_manager.admission import DepotAdmission
+from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
+from swarm_sim.protocol import DepotGrant, DepotReport
+from swarm_sim.types import NS_PER_S
+
+
+class DepotServer:
+    """Depot manager core, stepped once per tick (see `swarm_sim.protocol`)."""
+
+    def __init__(self, scenario, *, lookahead: int = 8) -> None:
+        self.layout: QueueLayout = make_layout(
+            scenario.depot.queue, DepotGeometryConfig.from_scenario(scenario)
+        )
+        self.admission = DepotAdmission(self.layout, lookahead=lookahead)
+        self.errors: list[str] = []
+        """One line per report that could not be applied."""
+        self.history: list[tuple[float, tuple[int, ...]]] = []
+        """(t [s], robots per entry line), appended whenever the queue lengths change."""
+        self._last: dict[str, bool] = {}
+
+    def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[DepotGrant, ...]:
+        t = stamp_ns / NS_PER_S
+        adm = self.admission
+        out: list[DepotGrant] = []
+        for m in messages:
+            if not isinstance(m, DepotReport):
+                continue
+            try:
+                if m.kind == "join":
+                    reason = adm.join(m.robot, m.line, m.cell, t)
+                    if reason:
+                        out.append(DepotGrant(stamp_ns, m.robot, m.line, -1, False, reason))
+                elif m.kind == "at":
+                    adm.arrived(m.robot, m.line, m.cell, t)
+                elif m.kind == "unloaded":
+                    adm.unloaded(m.robot, t)
+                else:
+                    raise ValueError(f"unknown report kind {m.kind!r}")
+            except (ValueError, TypeError) as e:
+                self.errors.append(f"t={t:.3f} {m.robot} {m.kind} {m.line}/{m.cell}: {e}")
+        changed = adm.step(t)
+        inside = adm.robots_inside
+        last = {r: adm.is_last(r) for r in inside}
+        for r in inside:
+            if r in changed or last[r] != self._last.get(r):
+                line, cell = changed.get(r) or adm.grant(r)
+                out.append(DepotGrant(stamp_ns, r, line, cell, last[r]))
+        self._last = last
+        lengths = adm.entry_queue_lengths()
+        if not self.history or self.history[-1][1] != lengths:
+            self.history.append((t, lengths))
+        out.sort(key=lambda g: g.robot)  # stable: a refusal stays before its robot's grant
+        return tuple(out)

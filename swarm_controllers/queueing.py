@@ -1,0 +1,427 @@
+"""Delivery queue strategies Q_SE, Q_ST, Q_ME, Q_MT (queue_depot_traffic.md, secs. III-VI).
+
+A robot forages with the CPFA (`swarm_controllers.cpfa`) and, once it carries a resource to the
+depot's perimeter, queues under the depot manager's grants (`depot_manager.server`): the
+manager owns every queue slot, the robot only drives to the slots it was granted and reports
+each one it reaches. The scenario chooses the wrapping (``depot.queue``: single or multi) and
+the endpoint finding (``depot.joining``: entry or tail), so Q_SE = single + entry, Q_ST =
+single + tail, Q_ME = multi + entry, Q_MT = multi + tail.
+
+Phases of a delivery, and the choices the paper leaves open:
+
+* **Foraging** (CPFA). Only carriers may enter the perimeter (sec. III): the CPFA keeps its
+  sites and walk legs out of the perimeter disc (plus `KEEP_OUT_BAND`), a give-up return ends
+  at its edge, and a non-carrier inside the band is steered out radially, or round the disc
+  along its tangent when its travel would cut through it. The CPFA is not stepped while the
+  robot queues; when the robot has left the perimeter it is stepped again, sees the drop and
+  lays pheromone / chooses its next site then (its view of the delivery time is the exit).
+* **Entry-point joining** (sec. V-A). The perimeter is cut into arcs whose preferred tangent
+  direction leads to the nearest entry point along the circle (the arcs meet halfway between
+  neighbouring entry points). The robot drives along a circle one lane outside the perimeter
+  (so it does not collide with the outermost queue lane), asks to join slot 0 of that entry
+  line when it is at the entry point, waits there while the manager refuses (line full), and
+  then follows the entry line slot by slot to the endpoint and on.
+* **Tail joining** (sec. V-B). The robot heads straight for the depot centre. Whenever its
+  scan sees something within the radio range gamma it broadcasts a `RadioQuery` (at most every
+  `QUERY_PERIOD`); queued robots within gamma answer where they are queued and whether they
+  are last (the manager tells each queued robot whether it is last), and other searchers answer
+  that they are searching. Hearing a searcher, it yields with probability 1/2 for
+  `YIELD_TIME` (the paper's "randomly yielding"). Hearing the last robot of an entry line, it
+  asks to join the slot behind it. Hearing only robots that are not last, it goes backwards
+  along their line (opposite to the queue's direction) to about gamma behind the lowest slot it
+  heard of, and asks again. Reaching the inner region's boundary without hearing anyone, it
+  takes the nearest slot of the nearest entry line (the fallback) and asks to join there; a
+  refusal sends it backwards along that line. After `SEEK_TIMEOUT` without joining it falls
+  back to entry-point joining.
+* **Queued**. The robot drives slot to slot along its route (entry line, then for the single
+  queue the inner queue the manager dispatched it to, then the exit line), reporting every slot
+  it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
+  take it into a neighbouring lane); it only brakes when something is right in front. At the
+  dock it waits for the world to drop its resource (T_unload), reports ``unloaded``, and goes
+  on as granted. At the last exit slot (on the perimeter) it reports that slot and drives out
+  radially, then forages again.
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+from functools import lru_cache
+
+import numpy as np
+
+from depot_manager.admission import DepotAdmission
+from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
+from swarm_controllers.avoidance import AvoidThenEscape
+from swarm_controllers.cpfa import CpfaBehaviour
+from swarm_controllers.motion import DriveLimits, go_to_point_twist
+from swarm_sim.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, within_range
+from swarm_sim.scenario import Scenario
+from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
+
+KEEP_OUT_BAND = 0.25
+"""Non-carriers keep this far outside the perimeter [m]."""
+QUERY_PERIOD = 0.5
+"""Tail joining: at most one radio query per this many seconds [s]."""
+YIELD_TIME = 1.0
+"""Tail joining: how long a yielding searcher stands still [s]."""
+SEEK_TIMEOUT = 120.0
+"""Tail joining: give up and use entry-point joining after this long [s]."""
+RETRY_PERIOD = 1.0
+"""How often a refused join is asked again [s]."""
+SLOT_TOLERANCE = 0.05
+"""A slot counts as reached within this distance [m]."""
+BRAKE_RANGE = 0.1
+"""Queued robots stop when the scan sees something this close in front [m from the centre]."""
+
+
+class Phase(Enum):
+    FORAGING = "foraging"
+    TO_ENTRY = "to_entry"
+    SEEKING = "seeking"
+    JOINING = "joining"
+    QUEUED = "queued"
+    LEAVING = "leaving"
+
+
+@lru_cache(maxsize=8)
+def _queues(geometry: DepotGeometryConfig, kind: str) -> tuple[QueueLayout, dict[str, np.ndarray]]:
+    """The layout and every line's slots, computed once per process (the manager's cells)."""
+    layout = make_layout(kind, geometry)
+    admission = DepotAdmission(layout)
+    return layout, {line: admission.cells(line) for line in admission.lines()}
+
+
+class QueueBehaviour:
+    """One robot foraging with the CPFA and delivering through the depot's queues."""
+
+    def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
+        depot = scenario.depot
+        if depot.queue == "none":
+            raise ValueError("behaviour 'queue' needs depot.queue: single or multi")
+        self.robot = robot
+        self._rng = rng
+        self._limits = DriveLimits.from_scenario(scenario)
+        self._center = (float(depot.center[0]), float(depot.center[1]))
+        self._R = depot.perimeter_radius
+        self._lane = depot.lane_spacing
+        self._gamma = scenario.robots.radio_range
+        self._tail = depot.joining == "tail"
+        self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._R + KEEP_OUT_BAND)
+        self._avoid = AvoidThenEscape(scenario, escape_distance=0.1)
+        self._layout, self._cells = _queues(DepotGeometryConfig.from_scenario(scenario), depot.queue)
+        self._entry_lines = tuple(line.name for line in self._layout.entry_lines)
+        self._entry_angles = np.array(
+            [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
+        )
+        self._dock_cells = {
+            (name, i)
+            for name, cells in self._cells.items()
+            for dock in self._layout.docks
+            for i in np.flatnonzero(np.hypot(*(cells - dock.stop).T) < 1e-6)
+        }
+        self._exit_lines = {line.name for line in self._layout.exit_lines}
+        self._front = _front_rays(scenario)
+        self._phase = Phase.FORAGING
+        self._carrying = False
+        self._line = ""  # the line the robot is on (or joining)
+        self._cell = -1  # the last slot of `_line` it reached
+        self._grant: tuple[str, int] | None = None
+        self._last = False
+        self._entry = 0  # entry-joining: which entry line
+        self._retry_at = 0.0
+        self._query_at = 0.0
+        self._seek_until = 0.0
+        self._yield_until = 0.0
+        self._goal: tuple[float, float] | None = None  # tail joining: where to look next
+        self._join: tuple[str, int] | None = None  # the join asked for, awaiting an answer
+        self._leave_to = (0.0, 0.0)
+        self._stamp_ns = 0
+
+    # ------------------------------------------------------------------ views
+
+    @property
+    def phase(self) -> Phase:
+        return self._phase
+
+    @property
+    def cpfa(self) -> CpfaBehaviour:
+        return self._cpfa
+
+    def status(self, stamp_ns: int | None = None) -> BehaviourStatus:
+        base = self._cpfa.status(stamp_ns if stamp_ns is not None else self._stamp_ns)
+        state = base.state if self._phase is Phase.FORAGING else self._phase.name
+        return BehaviourStatus(
+            self.robot, base.stamp_ns, state, base.obstacle_avoidance_events + self._avoid.events,
+            base.trips, base.extra + (("line", self._line), ("cell", str(self._cell))),
+        )
+
+    # ------------------------------------------------------------------ the tick
+
+    def step(self, obs: Observation) -> Command:
+        self._stamp_ns = obs.stamp_ns
+        out: list[object] = []
+        carrying = bool(obs.carrying)
+        dropped = self._carrying and not carrying
+        self._carrying = carrying
+        self._handle(obs, out)
+        x, y = obs.pose.x, obs.pose.y
+        r = math.hypot(x - self._center[0], y - self._center[1])
+        phase = self._phase
+        if phase is Phase.FORAGING:
+            if carrying and r <= self._R + KEEP_OUT_BAND:
+                self._begin_delivery(obs, r, out)
+            else:
+                return self._forage(obs, r, out)
+        if dropped and self._phase is Phase.QUEUED:
+            out.append(DepotReport(obs.stamp_ns, self.robot, "unloaded", self._line, self._cell))
+        phase = self._phase
+        if phase is Phase.TO_ENTRY:
+            linear, angular = self._to_entry(obs, r, out)
+        elif phase is Phase.SEEKING:
+            linear, angular = self._seek(obs, r, out)
+        elif phase is Phase.JOINING:
+            linear, angular = self._joining(obs, out)
+        elif phase is Phase.QUEUED:
+            linear, angular = self._queued(obs, out)
+        else:
+            linear, angular = self._leaving(obs, r)
+            if self._phase is Phase.FORAGING:
+                return self._forage(obs, r, out)
+        if phase in (Phase.TO_ENTRY, Phase.SEEKING):
+            override = self._avoid.update(obs.ranges)
+            if override is not None:
+                linear, angular = override.linear, override.angular
+        elif linear > 0.0 and min(obs.ranges[i] for i in self._front) < BRAKE_RANGE:
+            linear = 0.0
+        return Command(linear, angular, tuple(out))
+
+    # ------------------------------------------------------------------ messages
+
+    def _handle(self, obs: Observation, out: list[object]) -> None:
+        x, y = obs.pose.x, obs.pose.y
+        for m in obs.messages:
+            if isinstance(m, DepotGrant):
+                if m.robot == self.robot:
+                    self._on_grant(m, obs)
+            elif isinstance(m, RadioQuery):
+                if m.sender != self.robot and within_range(m, x, y, self._gamma):
+                    reply = self._reply(m, obs)
+                    if reply is not None:
+                        out.append(reply)
+            elif isinstance(m, RadioReply):
+                if m.to == self.robot and self._phase is Phase.SEEKING and within_range(m, x, y, self._gamma):
+                    self._on_reply(m, obs, out)
+
+    def _on_grant(self, grant: DepotGrant, obs: Observation) -> None:
+        if grant.cell < 0:  # a refused join
+            if self._phase is Phase.JOINING and self._join is not None and grant.line == self._join[0]:
+                line, cell = self._join
+                self._join = None
+                self._retry_at = obs.t + RETRY_PERIOD
+                if not self._tail:
+                    self._phase = Phase.TO_ENTRY  # wait at the entry point, ask again
+                    return
+                self._phase = Phase.SEEKING
+                if grant.reason == "not behind the tail":
+                    self._back_along(line, cell)
+            return
+        if self._phase is Phase.JOINING and self._join is not None:
+            self._line, self._cell = self._join[0], self._join[1] - 1
+            self._join = None
+            self._phase = Phase.QUEUED
+        self._grant = (grant.line, grant.cell)
+        self._last = grant.last
+
+    def _reply(self, query: RadioQuery, obs: Observation) -> RadioReply | None:
+        x, y = obs.pose.x, obs.pose.y
+        if self._phase is Phase.QUEUED and self._line in self._entry_lines:
+            return RadioReply(obs.stamp_ns, self.robot, query.sender, x, y, self._line,
+                              max(self._cell, 0), self._last)
+        if self._phase is Phase.SEEKING:
+            return RadioReply(obs.stamp_ns, self.robot, query.sender, x, y, "", -1, False)
+        return None
+
+    def _on_reply(self, reply: RadioReply, obs: Observation, out: list[object]) -> None:
+        if not reply.line:  # another searcher: yield at random
+            if self._rng.random() < 0.5:
+                self._yield_until = obs.t + YIELD_TIME
+            return
+        if reply.line not in self._entry_lines:
+            return
+        if self._join is not None:
+            return
+        if reply.last and reply.cell > 0:
+            self._request_join(reply.line, reply.cell - 1, obs, out)
+        elif not reply.last:
+            self._back_along(reply.line, reply.cell)
+
+    # ------------------------------------------------------------------ phases
+
+    def _forage(self, obs: Observation, r: float, out: list[object]) -> Command:
+        command = self._cpfa.step(obs)
+        out.extend(command.messages)
+        messages = tuple(out)
+        if self._carrying or r > self._R + KEEP_OUT_BAND:
+            return Command(command.linear, command.angular, messages)
+        cx, cy = self._center
+        x, y = obs.pose.x, obs.pose.y
+        ux, uy = ((x - cx) / r, (y - cy) / r) if r > 1e-9 else (1.0, 0.0)
+        if r < self._R + 0.5 * KEEP_OUT_BAND:  # inside: straight out
+            goal = (cx + ux * (self._R + 2 * KEEP_OUT_BAND), cy + uy * (self._R + 2 * KEEP_OUT_BAND))
+            return Command(*go_to_point_twist(x, y, obs.pose.yaw, *goal, self._limits), messages)
+        tx, ty = self._cpfa.target
+        if _segment_hits_disc((x, y), (tx, ty), self._center, self._R + 0.5 * KEEP_OUT_BAND):
+            # Round the disc along its tangent, on the side of the target.
+            side = 1.0 if (tx - x) * -uy + (ty - y) * ux >= 0 else -1.0
+            goal = (x - side * uy * 0.3 + ux * 0.05, y + side * ux * 0.3 + uy * 0.05)
+            return Command(*go_to_point_twist(x, y, obs.pose.yaw, *goal, self._limits), messages)
+        return Command(command.linear, command.angular, messages)
+
+    def _begin_delivery(self, obs: Observation, r: float, out: list[object]) -> None:
+        self._grant = None
+        self._line, self._cell = "", -1
+        if self._tail:
+            self._phase = Phase.SEEKING
+            self._seek_until = obs.t + SEEK_TIMEOUT
+            self._goal = None
+        else:
+            self._start_entry_joining(obs)
+
+    def _start_entry_joining(self, obs: Observation) -> None:
+        bearing = math.atan2(obs.pose.y - self._center[1], obs.pose.x - self._center[0])
+        gaps = np.abs(np.remainder(self._entry_angles - bearing + math.pi, 2 * math.pi) - math.pi)
+        self._entry = int(np.argmin(gaps))
+        self._phase = Phase.TO_ENTRY
+
+    def _to_entry(self, obs: Observation, r: float, out: list[object]) -> tuple[float, float]:
+        """Along the circle one lane outside the perimeter, in the arc's preferred direction."""
+        x, y = obs.pose.x, obs.pose.y
+        cx, cy = self._center
+        line = self._entry_lines[self._entry]
+        entry = self._cells[line][0]
+        target_bearing = self._entry_angles[self._entry]
+        bearing = math.atan2(y - cy, x - cx)
+        delta = math.remainder(target_bearing - bearing, 2 * math.pi)
+        ring = self._R + self._lane
+        if abs(delta) * ring < 0.15:
+            d = math.hypot(entry[0] - x, entry[1] - y)
+            if d <= 2 * SLOT_TOLERANCE and self._join is None and obs.t >= self._retry_at:
+                self._request_join(line, 0, obs, out)
+            if d <= SLOT_TOLERANCE:
+                return 0.0, 0.0
+            return go_to_point_twist(x, y, obs.pose.yaw, float(entry[0]), float(entry[1]), self._limits)
+        step = math.copysign(min(abs(delta), 0.3 / ring), delta)
+        goal = (cx + ring * math.cos(bearing + step), cy + ring * math.sin(bearing + step))
+        return go_to_point_twist(x, y, obs.pose.yaw, *goal, self._limits)
+
+    def _seek(self, obs: Observation, r: float, out: list[object]) -> tuple[float, float]:
+        x, y = obs.pose.x, obs.pose.y
+        if obs.t >= self._seek_until:
+            self._start_entry_joining(obs)
+            return self._to_entry(obs, r, out)
+        if obs.t < self._yield_until:
+            return 0.0, 0.0
+        near = bool(np.min(obs.ranges) < self._gamma)
+        if near and obs.t >= self._query_at:
+            self._query_at = obs.t + QUERY_PERIOD
+            out.append(RadioQuery(obs.stamp_ns, self.robot, float(x), float(y)))
+        if self._join is not None:  # a reply this tick made it ask to join
+            return self._joining(obs, out)
+        if self._goal is None and r <= self._layout.inner_radius and obs.t >= self._retry_at:
+            line, cell = self._nearest_slot(x, y)  # fallback: the nearest line
+            self._request_join(line, cell, obs, out)
+            return self._joining(obs, out)
+        gx, gy = self._goal if self._goal is not None else self._center
+        if self._goal is not None and math.hypot(gx - x, gy - y) < 0.1:
+            self._goal = None  # looked there: keep heading in, asking as we go
+        return go_to_point_twist(x, y, obs.pose.yaw, gx, gy, self._limits)
+
+    def _joining(self, obs: Observation, out: list[object]) -> tuple[float, float]:
+        """Asked to join (line, cell); drive there while the manager answers."""
+        if self._join is None:
+            return 0.0, 0.0
+        line, cell = self._join
+        tx, ty = self._cells[line][cell]
+        if math.hypot(tx - obs.pose.x, ty - obs.pose.y) <= SLOT_TOLERANCE:
+            return 0.0, 0.0
+        return go_to_point_twist(obs.pose.x, obs.pose.y, obs.pose.yaw, float(tx), float(ty), self._limits)
+
+    def _queued(self, obs: Observation, out: list[object]) -> tuple[float, float]:
+        x, y = obs.pose.x, obs.pose.y
+        nxt = self._next_slot()
+        if nxt is None:
+            return 0.0, 0.0
+        line, cell = nxt
+        tx, ty = self._cells[line][cell]
+        if math.hypot(tx - x, ty - y) <= SLOT_TOLERANCE:
+            self._line, self._cell = line, cell
+            out.append(DepotReport(obs.stamp_ns, self.robot, "at", line, cell))
+            if line in self._exit_lines and cell == len(self._cells[line]) - 1:
+                cx, cy = self._center
+                r = math.hypot(x - cx, y - cy)
+                reach = self._R + 2 * KEEP_OUT_BAND
+                self._leave_to = (cx + (x - cx) / r * reach, cy + (y - cy) / r * reach)
+                self._phase = Phase.LEAVING
+                return 0.0, 0.0
+            nxt = self._next_slot()
+            if nxt is None:
+                return 0.0, 0.0
+            tx, ty = self._cells[nxt[0]][nxt[1]]
+        return go_to_point_twist(x, y, obs.pose.yaw, float(tx), float(ty), self._limits)
+
+    def _leaving(self, obs: Observation, r: float) -> tuple[float, float]:
+        if r >= self._R + KEEP_OUT_BAND + 0.05:
+            self._phase = Phase.FORAGING
+            self._line, self._cell, self._grant = "", -1, None
+            return 0.0, 0.0
+        return go_to_point_twist(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._leave_to, self._limits)
+
+    # ------------------------------------------------------------------ helpers
+
+    def _next_slot(self) -> tuple[str, int] | None:
+        """The next slot along the route within the grant, None if the robot must wait."""
+        if self._grant is None:
+            return None
+        g_line, g_cell = self._grant
+        if g_line == self._line:
+            return (g_line, self._cell + 1) if self._cell < g_cell else None
+        if self._cell < len(self._cells[self._line]) - 1:  # finish the current line first
+            return self._line, self._cell + 1
+        return (g_line, 0) if g_cell >= 0 else None
+
+    def _request_join(self, line: str, cell: int, obs: Observation, out: list[object]) -> None:
+        self._join = (line, cell)
+        self._phase = Phase.JOINING
+        out.append(DepotReport(obs.stamp_ns, self.robot, "join", line, cell))
+
+    def _back_along(self, line: str, cell: int) -> None:
+        """Look for the tail about gamma behind `cell` of `line` (against the queue's flow)."""
+        back = max(0, cell - max(1, round(self._gamma / self._lane)))
+        self._line, self._cell = line, -1
+        self._goal = tuple(float(v) for v in self._cells[line][back])
+
+    def _nearest_slot(self, x: float, y: float) -> tuple[str, int]:
+        best = None
+        for line in self._entry_lines:
+            d = np.hypot(*(self._cells[line] - (x, y)).T)
+            i = int(np.argmin(d))
+            if best is None or d[i] < best[0]:
+                best = (float(d[i]), line, i)
+        return best[1], best[2]
+
+
+def _front_rays(scenario: Scenario) -> tuple[int, ...]:
+    scan = scenario.sensors.scan
+    n = scan.rays
+    step = scan.fov / n if scan.fov >= 2 * math.pi - 1e-9 else scan.fov / max(1, n - 1)
+    angles = [-scan.fov / 2 + i * step for i in range(n)]
+    return tuple(i for i, a in enumerate(angles) if abs(math.remainder(a, 2 * math.pi)) <= math.pi / 4)
+
+
+def _segment_hits_disc(p, q, c, radius: float) -> bool:
+    px, py = p[0] - c[0], p[1] - c[1]
+    dx, dy = q[0] - p[0], q[1] - p[1]
+    L2 = dx * dx + dy * dy
+    t = 0.0 if L2 < 1e-12 else max(0.0, min(1.0, -(px * dx + py * dy) / L2))
+    return (px + t * dx) ** 2 + (py + t * dy) ** 2 < radius * radius

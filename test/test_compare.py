@@ -1,0 +1,338 @@
+"""swarm-compare: run plans, the resumable results file, the tests and reports on synthetic rows,
+and one tiny real run through the CLI."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from swarm_sim import compare
+from swarm_sim.compare import (
+    PAPER_TABLE_II, QUEUE_STRATEGIES, RunPlan, main, pairwise_tests, queue_plans, queue_ttests_md,
+    read_results, resource_layout, run_sweep, slim, spiral_mannwhitney_md, spiral_plans, stars,
+    write_queue_report, write_spiral_report,
+)
+from swarm_sim.resources import place_resources
+from swarm_sim.scenario import load_scenario
+
+QUEUE_KEYS = ("resources_collected_pct", "collision_time_per_robot_s", "dropoff_time_mean_s")
+SPIRAL_KEYS = ("resources_per_robot", "collision_time_per_robot_s", "foraging_rate_per_min",
+               "resources_collected_pct")
+
+
+def rows_for(strategy, cell, values, keys=QUEUE_KEYS, **extra):
+    """One synthetic result row per value, every metric in `keys` set to it."""
+    return [{"strategy": strategy, "cell": cell, "seed": i, **{k: float(v) for k in keys}, **extra}
+            for i, v in enumerate(values)]
+
+
+def fake_summary(name, overrides, fields, seed):
+    return {
+        "scenario": name, "seed": seed, "robots": fields.get("robots__count", 8),
+        "resources_delivered": seed, "total_resources": 100, "resources_collected_pct": float(seed),
+        "collision_time_per_robot_s": 1.0 + seed, "dropoff_time_mean_s": 2.0,
+        "dropoff_times_s": [1.5, 2.5], "collision_time_s_by_robot": {"robot_0": 1.0},
+        "oae_by_robot": {"robot_0": 3}, "trips_by_robot": {"robot_0": 1},
+        "resources_per_robot": 1.0, "foraging_rate_per_min": 0.5,
+    }
+
+
+class FakeRunner:
+    """Records every call; raises KeyboardInterrupt after `stop_after` results if set."""
+
+    def __init__(self, stop_after=None):
+        self.calls, self.done, self.stop_after = [], 0, stop_after
+
+    def __call__(self, name, overrides, fields, seeds, jobs):
+        self.calls.append((name, tuple(overrides), dict(fields), tuple(seeds), jobs))
+        for seed in seeds:
+            if self.stop_after is not None and self.done >= self.stop_after:
+                raise KeyboardInterrupt
+            self.done += 1
+            yield fake_summary(name, overrides, fields, seed)
+
+
+# --------------------------------------------------------------------------- stars and tests
+
+
+@pytest.mark.parametrize("p, mark", [(0.0, "***"), (0.0009, "***"), (0.001, "**"), (0.0099, "**"),
+                                     (0.01, "*"), (0.049, "*"), (0.05, "ns"), (0.9, "ns"),
+                                     (math.nan, "n/a")])
+def test_stars_thresholds(p, mark):
+    assert stars(p) == mark
+
+
+@given(st.floats(0, 1), st.floats(0, 1))
+def test_stars_are_monotone_in_p(p, q):
+    rank = {"***": 3, "**": 2, "*": 1, "ns": 0}
+    if p <= q:
+        assert rank[stars(p)] >= rank[stars(q)]
+
+
+def test_clearly_different_groups_are_highly_significant_and_identical_ones_are_not():
+    rng = np.random.default_rng(1)
+    low, high = rng.normal(10, 1, 10), rng.normal(30, 1, 10)
+    rows = rows_for("a", 48, low) + rows_for("b", 48, high) + rows_for("c", 48, low)
+    for test in ("t", "u"):
+        ab, ac = pairwise_tests(rows, "resources_collected_pct", [48], [("a", "b"), ("a", "c")], test)
+        assert ab.p < 0.001 and stars(ab.p) == "***"
+        assert ac.p > 0.5 and stars(ac.p) == "ns"
+        assert ab.stats_a.n == ab.stats_b.n == 10
+
+
+def test_t_test_needs_two_runs_per_group():
+    rows = rows_for("a", 48, [1.0]) + rows_for("b", 48, [2.0, 3.0])
+    (t,) = pairwise_tests(rows, "resources_collected_pct", [48], [("a", "b")], "t")
+    assert math.isnan(t.p) and stars(t.p) == "n/a"
+
+
+def test_runs_without_a_dropoff_time_are_left_out():
+    rows = rows_for("a", 48, [1.0, 2.0]) + [{"strategy": "a", "cell": 48, "dropoff_time_mean_s": None}]
+    assert compare.values_of(rows, "a", 48, "dropoff_time_mean_s") == [1.0, 2.0]
+
+
+def test_ttests_md_marks_pairs_and_orders_against_the_paper():
+    # Synthetic means in the paper's order at 48 robots, CPFA and Q_MT swapped at 64.
+    rng = np.random.default_rng(2)
+    rows = []
+    for i, s in enumerate(QUEUE_STRATEGIES):
+        rows += rows_for(s, 48, 10 + 15 * i + rng.normal(0, 1, 8))
+        j = {0: 4, 4: 0}.get(i, i)
+        rows += rows_for(s, 64, 10 + 15 * j + rng.normal(0, 1, 8))
+    text = queue_ttests_md(rows, [48, 64], QUEUE_STRATEGIES)
+    assert "| CPFA | Q_MT |" in text and "| *** |" in text and "| ns |" not in text
+    order = text.split("## ordering")[1]
+    assert "| 48 | CPFA < Q_SE < Q_ST < Q_ME < Q_MT | CPFA < Q_SE < Q_ST < Q_ME < Q_MT | yes | 1.00 |" in order
+    assert "| 64 | Q_MT < Q_SE < Q_ST < Q_ME < CPFA |" in order and "| no |" in order
+
+
+def test_identical_strategies_give_ns_in_the_report():
+    rng = np.random.default_rng(3)
+    same = rng.normal(40, 3, 10)
+    rows = rows_for("queue_qme", 80, same) + rows_for("queue_qmt", 80, same)
+    text = queue_ttests_md(rows, [80], ["queue_qme", "queue_qmt"])
+    assert text.count("| ns |") == 3 and "| *** |" not in text  # three metrics, one pair
+
+
+# --------------------------------------------------------------------------- reports
+
+
+def test_queue_report_writes_tables_plots_and_the_papers_numbers(tmp_path):
+    rows = []
+    for i, s in enumerate(QUEUE_STRATEGIES):
+        rows += rows_for(s, 48, [10.0 * i + 1, 10.0 * i + 3])  # mean 10i+2, std sqrt(2)
+    written = write_queue_report(rows, tmp_path, [48, 112], QUEUE_STRATEGIES)
+    assert {p.name for p in written} == {"table.md", "ttests.md", "collected.png", "collision_time.png",
+                                         "dropoff_time.png"}
+    assert all(p.stat().st_size > 0 for p in written)
+    table = (tmp_path / "table.md").read_text()
+    assert "| Q_MT | 42.00 ± 1.41 (n=2) | 62.94 | — | 82.39 |" in table
+    for s in QUEUE_STRATEGIES:
+        assert all(f"{v:.2f}" in table for v in PAPER_TABLE_II[s].values())
+
+
+def test_spiral_report_shows_region_free_ddsa_in_every_cell_and_the_papers_claims(tmp_path):
+    rows = rows_for("ddsa", None, [2.0, 2.2, 1.8, 2.1], SPIRAL_KEYS, layout="powerlaw")
+    for cell in (4, 16, 64):
+        rows += rows_for("mdbsa_c", cell, [2.0, 2.1, 1.9, 2.2], SPIRAL_KEYS, layout="powerlaw")
+        rows += rows_for("mdbsa_d", cell, [4.0, 4.4, 3.6, 4.2], SPIRAL_KEYS, layout="powerlaw")
+    written = write_spiral_report(rows, tmp_path, 1, [4, 16, 64])
+    assert {p.name for p in written} == {"tables.md", "mannwhitney.md", "resources_collision.png",
+                                         "foraging_rate.png"}
+    tables = (tmp_path / "tables.md").read_text()
+    assert tables.count("2.02 ± 0.17 (median 2.05, n=4)") == 3 * 4  # DDSA, 3 cells, 4 metrics
+    mw = (tmp_path / "mannwhitney.md").read_text()
+    assert "≈ +101 % (average)" in mw and "On average, MDBSA_{Distributed} collected around 101%" in mw
+    # MDBSA-D has twice DDSA's mean: +100 % in every cell; U = 16 (all of B above A) for n=4+4.
+    assert "| 16 | DDSA | MDBSA-D | 2.05 | 4.10 | +100.0 % | 0.0 |" in mw
+    assert "16: +100.0 %" in mw
+
+
+def test_mann_whitney_marks_separated_groups_and_uses_dash_for_negligible():
+    rows = (rows_for("ddsa", 8, np.arange(10.0), SPIRAL_KEYS)
+            + rows_for("mdbsa_c", 8, np.arange(10.0), SPIRAL_KEYS)
+            + rows_for("mdbsa_d", 8, 100 + np.arange(10.0), SPIRAL_KEYS))
+    text = spiral_mannwhitney_md(rows, 2, [8], compare.SPIRAL_STRATEGIES)
+    section = text.split("## resources collected per robot")[1].split("##")[0]
+    lines = [ln for ln in section.splitlines() if ln.startswith("| 8 |")]
+    assert len(lines) == 3
+    ddsa_c, ddsa_d, c_d = lines
+    assert "| - |" in ddsa_c and "| *** |" in ddsa_d and "| *** |" in c_d
+
+
+def test_claims_cover_the_cells_they_name():
+    by = {(c.experiment, c.metric, c.a, c.b, c.paper): c for c in compare.PAPER_SPIRAL_CLAIMS}
+    c64 = by[(1, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −25 %")]
+    assert c64.covers(64) and not c64.covers(16)
+    c44 = by[(2, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −44 %")]
+    assert not c44.covers(8) and c44.covers(14) and c44.covers(32)
+
+
+# --------------------------------------------------------------------------- plans
+
+
+def test_queue_plans_pass_the_swarm_size_as_robots_count_field():
+    plans = queue_plans([48, 112], ["queue_cpfa", "queue_qmt"], duration=60.0, overrides=["a.b=1"])
+    assert [(p.strategy, p.cell) for p in plans] == [
+        ("queue_cpfa", 48), ("queue_qmt", 48), ("queue_cpfa", 112), ("queue_qmt", 112)]
+    assert dict(plans[2].fields) == {"robots__count": 112, "sim__duration": 60.0}
+    assert plans[0].overrides == ("a.b=1",)
+    assert plans[0].settings != plans[2].settings
+
+
+@pytest.mark.parametrize("experiment", [1, 2, 3])
+@pytest.mark.parametrize("layout", ["powerlaw", "clustered"])
+def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
+    exp = compare.SPIRAL_EXPERIMENTS[experiment]
+    plans = spiral_plans(experiment, layout=layout)
+    for plan in plans:
+        # the mdbsa scenarios are written elsewhere; the overrides must hold on the ddsa file
+        s = load_scenario("ddsa", plan.overrides, **dict(plan.fields))
+        assert s.arena.size == 8.0 and s.resources.distribution == layout
+        setting = {"regions": s.controller.spiral.regions, "robots": s.robots.count,
+                   "resources": s.resources.count}
+        if plan.cell is None:
+            assert plan.strategy == "ddsa" and experiment == 1
+        else:
+            assert setting[exp.vary] == plan.cell
+        assert (s.robots.count, s.sim.duration) == (
+            plan.cell if exp.vary == "robots" else exp.robots, exp.duration_s)
+        if exp.vary != "resources":
+            assert s.resources.count == exp.resources
+        xy = place_resources(s.resources, s.arena, s.depot, np.random.default_rng(0))
+        assert xy.shape == (s.resources.count, 2)
+    strategies = {(p.strategy, p.cell) for p in plans}
+    assert len(strategies) == len(plans)
+    if experiment == 1:
+        assert ("ddsa", None) in strategies and ("ddsa", 16) not in strategies
+        assert {c for s, c in strategies if s == "mdbsa_d"} == {4, 16, 64}
+
+
+def test_experiment_settings_match_the_papers_tables():
+    e = compare.SPIRAL_EXPERIMENTS
+    assert (e[1].robots, e[1].resources, e[1].values, e[1].duration_s) == (8, 160, (4, 16, 64), 720.0)
+    assert (e[2].values, e[2].resources, e[2].regions, e[2].duration_s) == ((8, 14, 20, 26, 32), 200, 16, 960.0)
+    assert (e[3].robots, e[3].values, e[3].regions, e[3].duration_s) == (16, (100, 150, 200, 250, 300), 16, 720.0)
+
+
+def test_user_set_overrides_win_over_the_experiment():
+    (plan, *_) = spiral_plans(2, ["mdbsa_d"], values=[8], overrides=["sim.duration=5"])
+    assert load_scenario("ddsa", plan.overrides).sim.duration == 5.0
+
+
+@given(st.integers(1, 400))
+def test_clustered_layout_satisfies_the_cluster_count_rule(count):
+    opts = dict(o.split("=") for o in resource_layout(count, "clustered"))
+    assert int(opts["resources.clusters"]) * int(opts["resources.cluster_side"]) ** 2 == count
+    assert int(opts["resources.count"]) == count
+
+
+def test_unknown_layout_is_refused():
+    with pytest.raises(ValueError, match="layout"):
+        resource_layout(100, "spiral")
+
+
+# --------------------------------------------------------------------------- results file and resume
+
+
+@given(st.dictionaries(st.sampled_from(["a_by_robot", "collision_time_s_by_robot", "seed", "robots",
+                                        "dropoff_times_s", "collision_time_per_robot_s"]),
+                       st.integers(0, 5)))
+def test_slim_drops_per_robot_and_per_delivery_data_only(summary):
+    summary = {k: ([1.0] * v if k == "dropoff_times_s" else v) for k, v in summary.items()}
+    row = slim(summary)
+    assert not any(k.endswith("_by_robot") for k in row) and "dropoff_times_s" not in row
+    for k in ("seed", "robots", "collision_time_per_robot_s"):
+        assert row.get(k) == summary.get(k)
+    if "dropoff_times_s" in summary:
+        assert row["dropoff_count"] == len(summary["dropoff_times_s"])
+
+
+def test_sweep_appends_each_run_and_resume_skips_finished_runs(tmp_path):
+    path = tmp_path / "results.jsonl"
+    plans = [RunPlan("queue_cpfa", 48, (), (("robots__count", 48),)),
+             RunPlan("queue_qmt", 48, (), (("robots__count", 48),))]
+    cut = FakeRunner(stop_after=5)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(plans, range(4), path, jobs=3, runner=cut, log=lambda _: None)
+    kept = read_results(path)
+    assert [(r["strategy"], r["seed"]) for r in kept] == [("queue_cpfa", s) for s in range(4)] + [("queue_qmt", 0)]
+    assert all("oae_by_robot" not in r and r["settings"] == plans[0].settings for r in kept)
+    with pytest.raises(FileExistsError):
+        run_sweep(plans, range(4), path, runner=FakeRunner(), log=lambda _: None)
+    again = FakeRunner()
+    rows = run_sweep(plans, range(4), path, jobs=3, runner=again, resume=True, log=lambda _: None)
+    assert again.calls == [("queue_qmt", (), {"robots__count": 48}, (1, 2, 3), 3)]
+    assert len(rows) == len(read_results(path)) == 8
+    # other settings are other runs: nothing skipped, and the old rows are not reported
+    other = [RunPlan("queue_cpfa", 48, ("sim.duration=5",), (("robots__count", 48),))]
+    rows = run_sweep(other, range(2), path, runner=(r := FakeRunner()), resume=True, log=lambda _: None)
+    assert len(r.calls) == 1 and len(rows) == 2
+
+
+def test_a_line_cut_short_is_skipped_and_not_glued_to_the_next(tmp_path):
+    path = tmp_path / "results.jsonl"
+    plan = RunPlan("ddsa", 8)
+    good = {"strategy": "ddsa", "settings": plan.settings, "seed": 0, "cell": 8}
+    path.write_text(json.dumps(good) + "\n" + '{"strategy": "dd')
+    assert read_results(path) == [good]
+    run_sweep([plan], range(2), path, runner=(r := FakeRunner()), resume=True, log=lambda _: None)
+    assert r.calls[0][3] == (1,)
+    assert [x["seed"] for x in read_results(path)] == [0, 1]
+
+
+def test_cli_interrupt_then_resume_then_report(tmp_path, capsys):
+    argv = ["queue", "--robots", "48", "64", "--seeds", "3", "--strategies", "queue_cpfa", "queue_qmt",
+            "--out", str(tmp_path), "--jobs", "2"]
+    assert main(argv, runner=FakeRunner(stop_after=4)) == 130
+    assert len(read_results(tmp_path / "results.jsonl")) == 4
+    assert main(argv, runner=FakeRunner()) == 2  # refuses to mix into an existing file
+    runner = FakeRunner()
+    assert main([*argv, "--resume"], runner=runner) == 0
+    assert [(c[0], c[2]["robots__count"], c[3]) for c in runner.calls] == [
+        ("queue_qmt", 48, (1, 2)), ("queue_cpfa", 64, (0, 1, 2)), ("queue_qmt", 64, (0, 1, 2))]
+    assert len(read_results(tmp_path / "results.jsonl")) == 12
+    assert (tmp_path / "ttests.md").exists() and (tmp_path / "collision_time.png").exists()
+    assert main([*argv, "--overwrite"], runner=(r := FakeRunner())) == 0 and len(r.calls) == 4
+    assert len(read_results(tmp_path / "results.jsonl")) == 12
+
+
+def test_cli_refuses_an_unknown_strategy(tmp_path):
+    with pytest.raises(SystemExit):
+        main(["queue", "--strategies", "queue_xyz", "--out", str(tmp_path)], runner=FakeRunner())
+
+
+def test_one_tiny_real_run_through_the_cli(tmp_path):
+    """The real runner end to end: ddsa, 2 robots, 5 s, one seed (about a second)."""
+    code = main(["spiral", "--experiment", "2", "--values", "2", "--strategies", "ddsa", "--seeds", "1",
+                 "--set", "sim.duration=5", "--out", str(tmp_path)])
+    assert code == 0
+    (row,) = read_results(tmp_path / "exp2" / "results.jsonl")
+    assert (row["strategy"], row["cell"], row["robots"], row["seed"]) == ("ddsa", 2, 2, 0)
+    assert row["sim_seconds"] == 5.0 and row["total_resources"] == 200 and row["experiment"] == 2
+    assert "collision_time_s_by_robot" not in row and "resources_per_robot" in row
+    assert (tmp_path / "exp2" / "mannwhitney.md").exists()
+
+
+def test_a_failing_strategy_is_reported_and_the_sweep_goes_on(tmp_path, capsys):
+    def runner(name, overrides, fields, seeds, jobs):
+        if name == "queue_qse":
+            yield fake_summary(name, overrides, fields, seeds[0])
+            raise ModuleNotFoundError("no queue behaviour yet")
+        yield from FakeRunner()(name, overrides, fields, seeds, jobs)
+
+    argv = ["queue", "--robots", "48", "--seeds", "2", "--strategies", "queue_cpfa", "queue_qse",
+            "queue_qmt", "--out", str(tmp_path)]
+    assert main(argv, runner=runner) == 1
+    assert "queue_qse (cell 48)" in capsys.readouterr().err
+    kept = [(r["strategy"], r["seed"]) for r in read_results(tmp_path / "results.jsonl")]
+    assert kept == [("queue_cpfa", 0), ("queue_cpfa", 1), ("queue_qse", 0), ("queue_qmt", 0), ("queue_qmt", 1)]
+    assert (tmp_path / "table.md").exists()
+    with pytest.raises(ModuleNotFoundError):  # the library call without a handler is strict
+        run_sweep(queue_plans([48], ["queue_qse"]), range(2), tmp_path / "strict.jsonl", runner=runner,
+                  log=lambda _: None)
