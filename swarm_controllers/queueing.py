@@ -21,7 +21,8 @@ Phases of a delivery, and the choices the paper leaves open:
   (so it does not collide with the outermost queue lane), asks to join slot 0 of that entry
   line when it is at the entry point, waits there while the manager refuses (line full), and
   then follows the entry line slot by slot to the endpoint and on.
-* **Tail joining** (sec. V-B). The robot heads straight for the depot centre. Whenever its
+* **Tail joining** (sec. V-B). The robot heads straight in, toward the inner region (it stops
+  one lane outside the inner region's boundary: the inner queues must stay clear). Whenever its
   scan sees something within the radio range gamma it broadcasts a `RadioQuery` (at most every
   `QUERY_PERIOD`); queued robots within gamma answer where they are queued and whether they
   are last (the manager tells each queued robot whether it is last), and other searchers answer
@@ -36,7 +37,8 @@ Phases of a delivery, and the choices the paper leaves open:
 * **Queued**. The robot drives slot to slot along its route (entry line, then for the single
   queue the inner queue the manager dispatched it to, then the exit line), reporting every slot
   it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
-  take it into a neighbouring lane); it only brakes when something is right in front. At the
+  take it into a neighbouring lane); it only brakes when something is right in front, and
+  swerves round it only after `BRAKE_PATIENCE` (a deadlock breaker). At the
   dock it waits for the world to drop its resource (T_unload), reports ``unloaded``, and goes
   on as granted. At the last exit slot (on the perimeter) it reports that slot and drives out
   radially, then forages again.
@@ -71,8 +73,15 @@ RETRY_PERIOD = 1.0
 """How often a refused join is asked again [s]."""
 SLOT_TOLERANCE = 0.05
 """A slot counts as reached within this distance [m]."""
-BRAKE_RANGE = 0.1
-"""Queued robots stop when the scan sees something this close in front [m from the centre]."""
+BRAKE_RANGE = 0.08
+"""Queued robots stop when the scan sees something this close right in front (within
+`BRAKE_CONE`) [m from the centre]; robots in the neighbouring lane, a lane spacing away, must
+not trigger it."""
+BRAKE_CONE = math.radians(25.0)
+"""Half-angle of the braking cone about the heading [rad]."""
+BRAKE_PATIENCE = 3.0
+"""A robot braked this long [s] swerves round what blocks it (two robots braking face to face,
+e.g. one pushed off its line, would otherwise wait for each other forever)."""
 
 
 class Phase(Enum):
@@ -136,6 +145,7 @@ class QueueBehaviour:
         self._goal: tuple[float, float] | None = None  # tail joining: where to look next
         self._join: tuple[str, int] | None = None  # the join asked for, awaiting an answer
         self._leave_to = (0.0, 0.0)
+        self._braked_since = math.inf
         self._stamp_ns = 0
 
     # ------------------------------------------------------------------ views
@@ -188,12 +198,17 @@ class QueueBehaviour:
             linear, angular = self._leaving(obs, r)
             if self._phase is Phase.FORAGING:
                 return self._forage(obs, r, out)
-        if phase in (Phase.TO_ENTRY, Phase.SEEKING):
+        if phase in (Phase.TO_ENTRY, Phase.SEEKING) or obs.t - self._braked_since >= BRAKE_PATIENCE:
             override = self._avoid.update(obs.ranges)
             if override is not None:
                 linear, angular = override.linear, override.angular
+            if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
+                self._braked_since = math.inf  # swerved for a second: try the line again
         elif linear > 0.0 and min(obs.ranges[i] for i in self._front) < BRAKE_RANGE:
             linear = 0.0
+            self._braked_since = min(self._braked_since, obs.t)
+        else:
+            self._braked_since = math.inf
         return Command(linear, angular, tuple(out))
 
     # ------------------------------------------------------------------ messages
@@ -328,13 +343,20 @@ class QueueBehaviour:
             out.append(RadioQuery(obs.stamp_ns, self.robot, float(x), float(y)))
         if self._join is not None:  # a reply this tick made it ask to join
             return self._joining(obs, out)
-        if self._goal is None and r <= self._layout.inner_radius and obs.t >= self._retry_at:
+        cx, cy = self._center
+        boundary = self._layout.inner_radius + self._lane
+        if self._goal is None and r <= boundary + SLOT_TOLERANCE:
+            if obs.t < self._retry_at:
+                return 0.0, 0.0  # at the inner region's boundary: never into it
             line, cell = self._nearest_slot(x, y)  # fallback: the nearest line
             self._request_join(line, cell, obs, out)
             return self._joining(obs, out)
-        gx, gy = self._goal if self._goal is not None else self._center
-        if self._goal is not None and math.hypot(gx - x, gy - y) < 0.1:
-            self._goal = None  # looked there: keep heading in, asking as we go
+        if self._goal is None:  # straight in, up to the inner region's boundary
+            gx, gy = cx + (x - cx) / r * boundary, cy + (y - cy) / r * boundary
+        else:
+            gx, gy = self._goal
+            if math.hypot(gx - x, gy - y) < self._gamma / 2:
+                self._goal = None  # looked there: head in again, asking as we go
         return go_to_point_twist(x, y, obs.pose.yaw, gx, gy, self._limits)
 
     def _joining(self, obs: Observation, out: list[object]) -> tuple[float, float]:
@@ -416,7 +438,7 @@ def _front_rays(scenario: Scenario) -> tuple[int, ...]:
     n = scan.rays
     step = scan.fov / n if scan.fov >= 2 * math.pi - 1e-9 else scan.fov / max(1, n - 1)
     angles = [-scan.fov / 2 + i * step for i in range(n)]
-    return tuple(i for i, a in enumerate(angles) if abs(math.remainder(a, 2 * math.pi)) <= math.pi / 4)
+    return tuple(i for i, a in enumerate(angles) if abs(math.remainder(a, 2 * math.pi)) <= BRAKE_CONE)
 
 
 def _segment_hits_disc(p, q, c, radius: float) -> bool:
