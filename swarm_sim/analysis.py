@@ -98,7 +98,9 @@ def plot_run(trace: RunTrace, out: Path) -> Path:
     import matplotlib.pyplot as plt
 
     summary = summarize(trace)
-    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(15, 4))
+    queues = bool(trace.queue_lengths)
+    fig, axes = plt.subplots(1, 4 if queues else 3, figsize=(20 if queues else 15, 4))
+    ax1, ax2, ax3 = axes[:3]
     times, counts = delivered_over_time(trace)
     ax1.step(times, counts, where="post")
     ax1.set(xlabel="sim time [s]", ylabel="resources delivered",
@@ -110,8 +112,62 @@ def plot_run(trace: RunTrace, out: Path) -> Path:
     ax3.bar(idx, [summary["oae_by_robot"][r] for r in names], color="tab:orange")
     ax3.bar(idx, [summary["trips_by_robot"][r] for r in names], color="tab:green", alpha=0.7)
     ax3.set(xlabel="robot", ylabel="count", title="obstacle-avoidance events (orange), trips (green)")
+    if queues:
+        times = [t for t, _ in trace.queue_lengths] + [trace.sim_seconds]
+        lengths = np.array([q for _, q in trace.queue_lengths] + [trace.queue_lengths[-1][1]])
+        for j in range(lengths.shape[1]):
+            axes[3].step(times, lengths[:, j], where="post", label=f"entry line {j}")
+        axes[3].set(xlabel="sim time [s]", ylabel="robots queued", title="queue lengths")
+        axes[3].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+def planned_paths(scenario) -> list[np.ndarray]:
+    """The spirals the search behaviours plan: one per robot (DDSA) or per region (MDBSA);
+    empty for the other behaviours. Built by the behaviours' own code, not re-derived."""
+    behaviour = scenario.controller.behaviour
+    if behaviour == "ddsa":
+        from swarm_controllers.ddsa import DdsaBehaviour
+
+        rng = np.random.default_rng(0)
+        return [DdsaBehaviour(scenario, r, rng).path.waypoints for r in scenario.robot_names]
+    if behaviour in ("mdbsa_c", "mdbsa_d"):
+        from swarm_controllers.center import region_paths
+
+        return [p.waypoints for p in region_paths(scenario)]
+    return []
+
+
+def plot_trajectories(path: Path | str, out: Path, *, start: float = 0.0, end: float | None = None) -> Path:
+    """The robots' recorded trajectories over the planned spirals (as the MDBSA paper's Figs. 1,
+    4 and 5): grey = planned, colour = each robot's odometry between `start` and `end` [s]."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scenario = scenario_from_dict(json.loads(bag_info(Path(path)).metadata["scenario"]))
+    odometry_rows = load_odometry(path)
+    fig, ax = plt.subplots(figsize=(8, 8))
+    half = scenario.arena.size / 2
+    ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="black", lw=1)
+    for waypoints in planned_paths(scenario):
+        ax.plot(waypoints[:, 0], waypoints[:, 1], color="0.75", lw=0.6)
+    for zone in scenario.all_drop_zones():
+        ax.add_patch(plt.Circle(zone.center, zone.radius, color="tab:green", alpha=0.3))
+    cmap = plt.get_cmap("tab10")
+    for i, (robot, rows) in enumerate(odometry_rows.items()):
+        keep = (rows[:, 0] >= start) & (rows[:, 0] <= (end if end is not None else np.inf))
+        ax.plot(rows[keep, 1], rows[keep, 2], lw=0.8, color=cmap(i % 10), label=robot)
+    ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]",
+           title=f"{scenario.name}: trajectories over the planned paths")
+    if len(odometry_rows) <= 16:
+        ax.legend(fontsize=6, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
     plt.close(fig)
     return out
 
@@ -122,6 +178,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="print one JSON object per run")
     parser.add_argument("--plot", type=Path, help="PNG path (default: <bag>/summary.png)")
     parser.add_argument("--no-plot", action="store_true")
+    parser.add_argument("--trajectories", action="store_true",
+                        help="also draw <bag>/trajectories.png: odometry over the planned spirals")
     args = parser.parse_args(argv)
     status = 0
     for bag in args.bags:
@@ -134,13 +192,18 @@ def main(argv: list[str] | None = None) -> int:
         summary = summarize(trace)
         if not args.no_plot:
             summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
+        if args.trajectories:
+            summary["trajectories"] = str(plot_trajectories(bag, bag / "trajectories.png"))
         if args.json:
             print(json.dumps(summary))
         else:
             print(f"{bag}:")
             for key in ("scenario", "seed", "robots", "mode", "sim_seconds", "wall_seconds",
                         "resources_delivered", "total_resources", "collision_time_per_robot_s",
-                        "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands", "plot"):
+                        "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
+                        "resources_collected_pct", "dropoff_time_mean_s", "deliveries_outside_docks",
+                        "queue_length_mean", "queue_length_max", "resources_per_robot",
+                        "foraging_rate_per_min", "regions", "plot", "trajectories"):
                 if key in summary:
                     print(f"  {key:28s} {summary[key]}")
     return status
