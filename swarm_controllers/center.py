@@ -1,8 +1,10 @@
 """Region assignment of the MDBSA center (Lu & Luna, CRV 2023, Sec. IV; ../shared/papers/mdbsa_spiral_search.md).
 
-ROS-free core of the future center node. The center is a hub robots talk to only while they are
-at it: there a robot reports how far it walked (`report_progress`) and, when its walk is over (or
-at the start), asks for a new one (`request`). Deterministic: no rng, every tie goes to the lowest
+ROS-free core of the center node (`center_node.py`): `RegionAssigner` (the book-keeping below),
+`CenterServer` (the assigner behind the `swarm_sim.protocol` messages, end of file) and
+`region_paths` (the regions' spirals, shared with the MDBSA behaviours). The center is a hub
+robots talk to only while they are at it: there a robot reports how far it walked
+(`report_progress`) and, when its walk is over (or at the start), asks for a new one (`request`). Deterministic: no rng, every tie goes to the lowest
 region id; `t` [s, sim time] is only recorded, never used to decide.
 
 Arc length s is always measured from the spiral's start (its region center, `SpiralPath.start`)
@@ -48,11 +50,22 @@ Rules (the paper's, Sec. IV) and the choices the paper leaves open:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from swarm_controllers.spiral import SpiralPath
-from swarm_sim.types import RobotId
+import numpy as np
+
+from swarm_controllers.spiral import (
+    SpiralPath,
+    mdbsa_leg_steps,
+    region_centers,
+    region_side,
+    segments_overlap_collinear,
+)
+from swarm_sim.protocol import ProgressReport, RegionAssignment
+from swarm_sim.scenario import Scenario
+from swarm_sim.types import NS_PER_S, RobotId, robot_index
 
 FORWARD = 1
 """Walk from the spiral's start (region center), outward, clockwise."""
@@ -274,3 +287,177 @@ class RegionAssigner:
         self._last_walk[(robot, region)] = direction
         reg.last_update = float(t)
         return a
+
+
+# --------------------------------------------------------------------------- region spirals
+
+_HEADINGS = ((0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0))  # N, E, S, W: clockwise
+_EPS = 1e-9
+
+
+def region_bounds(scenario: Scenario) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(lo, hi) corners [m, world frame] of the box each region's spiral is clipped to.
+
+    The box is the region square shrunk by g/2 on every side, intersected with the arena
+    shrunk by ``controller.spiral.arena_margin``: the outermost lines of two neighbouring
+    regions are then one gap apart, like the lines within a spiral (no stripe left between
+    regions, none walked twice), and a wall keeps the same margin as in DDSA.
+    """
+    sp = scenario.controller.spiral
+    size = scenario.arena.size
+    half_side = region_side(sp.regions, size) / 2.0 - sp.gap / 2.0
+    wall = size / 2.0 - sp.arena_margin
+    return [(np.maximum(c - half_side, -wall), np.minimum(c + half_side, wall))
+            for c in region_centers(sp.regions, size)]
+
+
+def region_spiral(center: np.ndarray, lo: np.ndarray, hi: np.ndarray, gap: float,
+                  redundant: float = 0.0) -> np.ndarray:
+    """(K, 2) waypoints of a region's spiral, eqs. (4)-(5) with r = 1, clipped to [lo, hi].
+
+    `spiral.mdbsa_path` generalised to a box not centred on the region center (a region by a
+    wall keeps the wall margin there, g/2 elsewhere): circuits inside the box are kept as they
+    are and later waypoints are clamped onto the box. A clamped leg is *useless* when it
+    re-walks a line already walked or (``redundant`` > 0 [m]) runs parallel to a walked one
+    nearer than ``redundant``, which adds almost no new ground. With an off-centre box one side
+    is clamped circuits before the opposite one, so useless legs are walked through (they lead
+    to the sides still open) and the path ends after the last useful leg, once a whole circuit
+    adds nothing. For a centred box this is ``mdbsa_path`` (tested).
+    """
+    c0 = np.asarray(center, dtype=float)
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    if not (np.all(lo <= c0) and np.all(c0 <= hi)):
+        raise ValueError(f"region center {c0} is outside its box {lo}..{hi}")
+    circuits = int(np.ceil(float(np.max(hi - lo)) / gap)) + 3
+    pts = [c0.copy()]
+    p_raw = c0.copy()
+    last_useful = 0
+    for c in range(1, circuits + 1):
+        useful_circuit = False
+        for k, steps in enumerate(mdbsa_leg_steps(c, 1)):
+            p_raw = p_raw + np.array(_HEADINGS[k]) * steps * gap
+            q = np.clip(p_raw, lo, hi)
+            a = pts[-1]
+            if np.linalg.norm(q - a) < _EPS:
+                continue
+            clamped = not np.array_equal(q, p_raw)
+            useless = len(pts) > 1 and _rewalks(a, q, pts, redundant if clamped else 0.0)
+            pts.append(q)
+            if not useless:
+                last_useful = len(pts) - 1
+                useful_circuit = True
+        if not useful_circuit:
+            break
+    return np.array(pts[: last_useful + 1])
+
+
+def _rewalks(a: np.ndarray, q: np.ndarray, pts: list[np.ndarray], within: float) -> bool:
+    """Whether the axis-parallel leg a-q runs along a walked leg of `pts` (sharing a piece of
+    positive length) on the same line or, when within > 0, on a parallel line nearer than that."""
+    if within <= 0.0:
+        return segments_overlap_collinear(np.array([a, q]), np.array(pts))
+    ax = 0 if abs(a[1] - q[1]) < _EPS else 1  # the axis the leg runs along
+    other = 1 - ax
+    lo, hi = min(a[ax], q[ax]), max(a[ax], q[ax])
+    for b0, b1 in zip(pts[:-1], pts[1:]):
+        if abs(b0[other] - b1[other]) >= _EPS or abs(b0[other] - a[other]) >= within:
+            continue
+        if min(hi, max(b0[ax], b1[ax])) - max(lo, min(b0[ax], b1[ax])) > 1e-7:
+            return True
+    return False
+
+
+def region_paths(scenario: Scenario) -> list[SpiralPath]:
+    """The spiral of every region, indexed by region id (row-major as `spiral.region_centers`).
+
+    The one definition the center server and the MDBSA behaviours share, so both measure the
+    same arc lengths. Region centers from eq. (3), boxes from `region_bounds`. A clamped line
+    nearer than (detection radius - g/2) to a parallel line already walked is left out: that
+    line's detection already reaches the region's edge (g/2 beyond the box), so it would add
+    nothing. With the experiment 1 scenarios every point where a resource may lie
+    (``resources.margin`` = 0.3 m from the walls) is then within detection range of some
+    spiral (tested for 4, 16 and 64 regions).
+    """
+    sp = scenario.controller.spiral
+    centers = region_centers(sp.regions, scenario.arena.size)
+    redundant = scenario.sensors.resource_detection_radius - sp.gap / 2.0
+    return [SpiralPath(region_spiral(c, lo, hi, sp.gap, redundant))
+            for c, (lo, hi) in zip(centers, region_bounds(scenario))]
+
+
+# --------------------------------------------------------------------------- the center server
+
+
+class CenterServer:
+    """The MDBSA center's core (`swarm_sim.protocol.Server`): region assignment over messages.
+
+    The center is a hub robots talk to only near it (paper Sec. IV): a `ProgressReport` counts
+    only if its sender was within ``controller.spiral.center_range`` of the depot centre when
+    sending; others (and reports from unknown robots or about unknown regions) are dropped and
+    counted in `ignored`. For each report that counts, in the order received:
+
+    * the progress of its region is recorded (region >= 0) with `RegionAssigner.report_progress`;
+    * if ``done`` or the robot holds no walk, it gets a new one (`RegionAssigner.request`) in a
+      `RegionAssignment` (region -1: idle, ask again later);
+    * otherwise (an MDBSA-C robot passing the center on a delivery) and if the stop of its walk
+      moved since it was last told (its partner reported meanwhile), it is told again: same
+      region and direction, ``s0`` = the reported s, the new ``stop_s``. This is how the center
+      "shares the search progress of other robots" (Sec. IV) with a walker it sees again.
+
+    At most one answer per robot per tick (the last one), sorted by robot index.
+    Deterministic; time is the tick stamp.
+    """
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.paths: list[SpiralPath] = region_paths(scenario)
+        """One spiral per region [m, world frame]."""
+        self.assigner = RegionAssigner(self.paths, scenario.robot_names)
+        cx, cy = scenario.depot.center
+        self._center = (float(cx), float(cy))
+        self._range = float(scenario.controller.spiral.center_range)
+        self._told_stop: dict[RobotId, float] = {}
+        self.ignored = 0
+        """Reports dropped: sent out of range, from an unknown robot or about an unknown region."""
+
+    def snapshot(self) -> list[RegionState]:
+        """Per-region state (walkers, covered arc lengths, remaining) for publishing."""
+        return self.assigner.snapshot()
+
+    def in_range(self, x: float, y: float) -> bool:
+        """Whether a robot at (x, y) [m, world frame] can talk to the center."""
+        return math.hypot(x - self._center[0], y - self._center[1]) <= self._range
+
+    def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[RegionAssignment, ...]:
+        t = stamp_ns / NS_PER_S
+        out: dict[RobotId, RegionAssignment] = {}
+        for m in messages:
+            if not isinstance(m, ProgressReport):
+                continue
+            if (m.robot not in self.assigner.robots or m.region >= self.assigner.n_regions
+                    or not self.in_range(m.x, m.y)):
+                self.ignored += 1
+                continue
+            stop = None
+            if m.region >= 0:
+                stop = self.assigner.report_progress(m.robot, m.region, m.s, t, done=m.done)
+            if m.done or self.assigner.current(m.robot) is None:
+                out[m.robot] = self._tell(stamp_ns, m.robot, self.assigner.request(m.robot, t))
+            elif stop is not None and abs(stop - self._told_stop.get(m.robot, stop)) > _EPS:
+                a = self.assigner.current(m.robot)
+                assert a is not None
+                self._told_stop[m.robot] = stop
+                out[m.robot] = RegionAssignment(
+                    stamp_ns=stamp_ns, robot=m.robot, region=a.region, direction=a.direction,
+                    s0=float(m.s), stop_s=float(stop),
+                    shared=len(self.assigner.snapshot()[a.region].walkers) > 1)
+        return tuple(out[r] for r in sorted(out, key=robot_index))
+
+    def _tell(self, stamp_ns: int, robot: RobotId, a: Assignment | None) -> RegionAssignment:
+        if a is None:
+            self._told_stop.pop(robot, None)
+            return RegionAssignment(stamp_ns=stamp_ns, robot=robot, region=-1, direction=0,
+                                    s0=0.0, stop_s=0.0, shared=False)
+        self._told_stop[robot] = a.stop_s
+        return RegionAssignment(stamp_ns=stamp_ns, robot=robot, region=a.region,
+                                direction=a.direction, s0=float(a.s0), stop_s=float(a.stop_s),
+                                shared=a.shared)

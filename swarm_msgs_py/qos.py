@@ -34,3 +34,12 @@ EVENTS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=1000,
 )
+
+RECORD_LATCHED = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1000,
+)
+"""The recorder's subscription to a latched topic: gets the last message published before it
+subscribed, then every later one."""

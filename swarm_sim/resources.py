@@ -3,7 +3,9 @@
 Every placement draws only from the `numpy.random.Generator` it is given, so the same seed gives
 the same layout. All positions are [m, world frame]. A position is *valid* when it keeps
 ``resources.margin`` from the walls (``|x|, |y| <= L/2 - margin``) and lies at least
-``resources.min_depot_clearance`` outside the depot disc.
+``resources.min_depot_clearance`` outside the depot disc, and at least one ``spacing`` outside
+every other drop zone (docks, MDBSA region centres): a resource inside a zone would count as
+delivered the moment it is picked up.
 
 Distributions:
 
@@ -23,7 +25,9 @@ import math
 
 import numpy as np
 
-from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
+from collections.abc import Sequence
+
+from swarm_sim.scenario import ArenaConfig, DepotConfig, DropZoneConfig, ResourceConfig, ScenarioError
 
 MAX_ATTEMPTS = 4096
 """Random candidate positions per cluster/pile (drawn in batches) before a layout restarts."""
@@ -38,9 +42,23 @@ def _half_extent(cfg: ResourceConfig, arena: ArenaConfig) -> float:
     return arena.size / 2 - cfg.margin
 
 
-def _keep_out(cfg: ResourceConfig, depot: DepotConfig) -> float:
-    """Resources stay at least this far from the depot centre [m]."""
-    return depot.radius + cfg.min_depot_clearance
+Disc = tuple[float, float, float]
+"""(x, y, radius) [m, world frame]: an area resources keep out of."""
+
+
+def _keep_out(cfg: ResourceConfig, depot: DepotConfig, zones: Sequence[DropZoneConfig]) -> list[Disc]:
+    """The depot disc widened by min_depot_clearance, and every drop zone widened by spacing."""
+    discs = [(float(depot.center[0]), float(depot.center[1]), depot.radius + cfg.min_depot_clearance)]
+    discs += [(float(z.center[0]), float(z.center[1]), z.radius + cfg.spacing) for z in zones]
+    return discs
+
+
+def _clear(x: np.ndarray, y: np.ndarray, discs: list[Disc]) -> np.ndarray:
+    """Which points (x, y) lie outside every disc."""
+    ok = np.ones(np.shape(x), dtype=bool)
+    for cx, cy, r in discs:
+        ok &= np.hypot(x - cx, y - cy) >= r
+    return ok
 
 
 def _grid(side: int, spacing: float) -> np.ndarray:
@@ -57,6 +75,7 @@ def _place_squares(
     depot: DepotConfig,
     rng: np.random.Generator,
     key: str,
+    zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
     """Centres (K, 2) for squares of the given half spans: valid and at least one pitch apart.
 
@@ -65,10 +84,9 @@ def _place_squares(
     ScenarioError naming `key`.
     """
     half = _half_extent(cfg, arena)
-    keep_out = _keep_out(cfg, depot)
+    discs = _keep_out(cfg, depot, zones)
     spans = np.asarray(half_spans, dtype=float)
     order = np.argsort(-spans, kind="stable")
-    dcx, dcy = depot.center
     for _ in range(MAX_RESTARTS):
         centres = np.zeros((len(spans), 2))
         placed: list[int] = []
@@ -82,10 +100,12 @@ def _place_squares(
                 )
             for _ in range(MAX_ATTEMPTS // BATCH):
                 c = rng.uniform(-room, room, size=(BATCH, 2))
-                # the point of each candidate square nearest to the depot centre
-                nx = np.clip(dcx, c[:, 0] - hs, c[:, 0] + hs)
-                ny = np.clip(dcy, c[:, 1] - hs, c[:, 1] + hs)
-                ok = np.hypot(nx - dcx, ny - dcy) >= keep_out
+                # the point of each candidate square nearest to each keep-out centre
+                ok = np.ones(len(c), dtype=bool)
+                for cx, cy, r in discs:
+                    nx = np.clip(cx, c[:, 0] - hs, c[:, 0] + hs)
+                    ny = np.clip(cy, c[:, 1] - hs, c[:, 1] + hs)
+                    ok &= np.hypot(nx - cx, ny - cy) >= r
                 if placed:
                     gap = np.abs(c[:, None, :] - centres[None, placed, :]).max(axis=2)
                     ok &= (gap >= hs + spans[placed][None, :] + cfg.spacing).all(axis=1)
@@ -106,11 +126,12 @@ def _place_squares(
 
 
 def _uniform(
-    n: int, cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator
+    n: int, cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator,
+    zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
     """(n, 2) independent uniform valid positions (vectorised rejection sampling)."""
     half = _half_extent(cfg, arena)
-    keep_out = _keep_out(cfg, depot)
+    discs = _keep_out(cfg, depot, zones)
     if half < 0:
         raise ScenarioError(f"resources.margin: {cfg.margin} m leaves no room in the {arena.size} m arena")
     out = np.empty((n, 2))
@@ -119,7 +140,7 @@ def _uniform(
         if filled == n:
             return out
         batch = rng.uniform(-half, half, size=(max(2 * (n - filled), 16), 2))
-        ok = np.hypot(batch[:, 0] - depot.center[0], batch[:, 1] - depot.center[1]) >= keep_out
+        ok = _clear(batch[:, 0], batch[:, 1], discs)
         take = batch[ok][: n - filled]
         out[filled : filled + len(take)] = take
         filled += len(take)
@@ -137,16 +158,18 @@ def powerlaw_pile_sizes(levels: int) -> list[int]:
 
 
 def place_resources(
-    cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator
+    cfg: ResourceConfig, arena: ArenaConfig, depot: DepotConfig, rng: np.random.Generator,
+    zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
-    """Initial resource positions, (cfg.count, 2) [m, world frame], deterministic per `rng`.
+    """Initial resource positions, (cfg.count, 2) [m, world frame], deterministic per `rng`;
+    `zones`: the drop zones to keep clear (`Scenario.all_drop_zones`).
 
     Raises ScenarioError naming the key when the layout cannot be placed.
     """
     if cfg.count == 0:
         return np.zeros((0, 2))
     if cfg.distribution == "uniform":
-        return _uniform(cfg.count, cfg, arena, depot, rng)
+        return _uniform(cfg.count, cfg, arena, depot, rng, zones)
     if cfg.distribution == "clustered":
         if cfg.count != cfg.clusters * cfg.cluster_side**2:
             raise ScenarioError(
@@ -154,7 +177,7 @@ def place_resources(
                 f"{cfg.clusters * cfg.cluster_side ** 2}"
             )
         half_span = (cfg.cluster_side - 1) * cfg.spacing / 2
-        centres = _place_squares([half_span] * cfg.clusters, cfg, arena, depot, rng, "resources.clusters")
+        centres = _place_squares([half_span] * cfg.clusters, cfg, arena, depot, rng, "resources.clusters", zones)
         grid = _grid(cfg.cluster_side, cfg.spacing)
         return (centres[:, None, :] + grid[None, :, :]).reshape(-1, 2)
     if cfg.distribution == "powerlaw":
@@ -168,10 +191,10 @@ def place_resources(
         sides = [math.isqrt(s) for s in piles]
         centres = _place_squares(
             [(side - 1) * cfg.spacing / 2 for side in sides], cfg, arena, depot, rng,
-            "resources.powerlaw_levels",
+            "resources.powerlaw_levels", zones,
         )
         parts = [c[None, :] + _grid(side, cfg.spacing) for c, side in zip(centres, sides)]
-        parts.append(_uniform(cfg.count - sum(piles), cfg, arena, depot, rng))
+        parts.append(_uniform(cfg.count - sum(piles), cfg, arena, depot, rng, zones))
         return np.concatenate(parts, axis=0)
     raise ScenarioError(f"resources.distribution: unknown distribution {cfg.distribution!r}")
 
@@ -182,6 +205,7 @@ def place_one(
     depot: DepotConfig,
     rng: np.random.Generator,
     avoid: np.ndarray | None = None,
+    zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
     """One replacement resource (2,) [m, world frame] for respawn.
 
@@ -189,7 +213,7 @@ def place_one(
     uniform valid position for every distribution. It keeps at least one `spacing` from the
     positions in `avoid` (the resources on the ground) if one of BATCH candidates does.
     """
-    candidates = _uniform(BATCH, cfg, arena, depot, rng)
+    candidates = _uniform(BATCH, cfg, arena, depot, rng, zones)
     if avoid is None or len(avoid) == 0:
         return candidates[0]
     d2 = ((candidates[:, None, :] - np.asarray(avoid)[None, :, :]) ** 2).sum(axis=2).min(axis=1)

@@ -281,7 +281,7 @@ class World:
                 p.createMultiBody(0.0, col, -1, [o.center[0], o.center[1], self._z0], physicsClientId=cid)
 
         # Resources: every resource ever placed keeps its index; `_on_ground` says where it is.
-        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources)
+        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, s.all_drop_zones())
         self._on_ground = np.ones(len(self._res_xy), dtype=bool)
         self._ground_changed()
 
@@ -536,7 +536,7 @@ class World:
                 self.stats[name].deliveries += 1
                 if self.scenario.resources.respawn:
                     s = self.scenario
-                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy)
+                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy, s.all_drop_zones())
                     self._res_xy = np.vstack([self._res_xy, new[None, :]])
                     self._on_ground = np.append(self._on_ground, True)
                     changed = True

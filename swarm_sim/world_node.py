@@ -25,6 +25,7 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
 
 from swarm_controllers.api import server_channels
 from swarm_msgs_py import ack as ack_codec
@@ -32,7 +33,7 @@ from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.bag import BagWriter
 from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
@@ -177,10 +178,16 @@ class WorldNode(Node):
             msg_type = topics.import_type(types[0])
             if msg_type is None or self.bag is None:
                 continue
-            self.bag.add_topic(topic, types[0], "reliable")
+            # Latched topics (servers' state and markers) are recorded from their last message
+            # on, even one published before we subscribed.
+            latched = any(
+                info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                for info in self.get_publishers_info_by_topic(topic)
+            )
+            self.bag.add_topic(topic, types[0], "latched" if latched else "reliable")
             self.create_subscription(
                 msg_type, topic, lambda data, t=topic: self.bag.write(t, self.world.t_ns, data),
-                EVENTS, raw=True,
+                RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
     # ------------------------------------------------------------------ the loop

@@ -8,9 +8,12 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from swarm_controllers.api import behaviour_rng, known_behaviours, make_behaviour
-from swarm_controllers.ddsa import DdsaBehaviour, DdsaState
+from swarm_controllers.avoidance import ray_angles
+from swarm_controllers.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral import ddsa_path
 from swarm_sim.metrics import resources_delivered
 from swarm_sim.scenario import ScenarioError, SpiralConfig, load_scenario
@@ -137,24 +140,87 @@ def test_done_at_the_end_returns_to_the_depot_and_parks():
     assert b.step(obs(u.k, u.x, u.y, u.yaw, ranges=blocked, robot="robot_0")) == Command(0.0, 0.0)
 
 
-def test_obstacle_avoidance_has_priority_and_counts():
+def circle_ranges(cx: float, cy: float, radius: float = BASE.robots.diameter / 2) -> np.ndarray:
+    """The scan of a robot seeing one disc (another robot) centred at body-frame (cx, cy)."""
+    out = []
+    for a in ray_angles(BASE.sensors.scan):
+        ux, uy = math.cos(a), math.sin(a)
+        along = cx * ux + cy * uy
+        disc = along**2 - (cx * cx + cy * cy) + radius**2
+        t = along - math.sqrt(disc) if disc >= 0 else math.inf
+        out.append(t if t > 0 else math.inf)
+    return np.asarray(out, dtype=np.float32)
+
+
+def test_searcher_yields_to_what_is_in_its_lane_then_swerves_right_after_the_timeout():
     b = behaviour()
-    blocked = np.full_like(CLEAR, 0.1)
-    c = b.step(obs(0, 0.0, 0.0, 0.0, ranges=blocked))
-    assert c.linear == 0.0 and c.angular != 0.0
+    u = Unicycle(*b.path.start, math.pi / 2)
+    while b.next_waypoint < 3:
+        u.step(b)
+    assert b.state is DdsaState.SEARCHING
+    ahead = circle_ranges(0.2, 0.0)  # a robot in the lane, 0.115 m ahead of our front
+    c = b.step(obs(u.k, u.x, u.y, u.yaw, ranges=ahead))
+    assert c == Command(0.0, 0.0)  # yields: stops, does not leave its lane
+    assert b.status().obstacle_avoidance_events == 1
+    n = round(LANE_YIELD_TIMEOUT / DT)
+    for j in range(1, n):
+        assert b.step(obs(u.k + j, u.x, u.y, u.yaw, ranges=ahead)) == Command(0.0, 0.0)
+    assert b.status().obstacle_avoidance_events == 1  # one episode, not one per tick
+    c = b.step(obs(u.k + n, u.x, u.y, u.yaw, ranges=ahead))
+    assert c.linear == 0.0 and c.angular < 0.0  # still blocked: the general avoidance, to the right
+    assert b.status().obstacle_avoidance_events == 2
+
+
+def test_off_the_lane_the_general_avoidance_turns_right_at_once():
+    b = behaviour()
+    u = Unicycle(*b.path.start, math.pi / 2)
+    while b.next_waypoint < 3:
+        u.step(b)
+    u.step(b, carrying=True)
+    assert b.state is DdsaState.RETURNING
+    # More room on the left (the obstacle is front-left): still a right turn.
+    c = b.step(obs(u.k, u.x, u.y, u.yaw, carrying=True, ranges=circle_ranges(0.2, 0.1)))
+    assert c.linear == 0.0 and c.angular < 0.0
     assert b.status().obstacle_avoidance_events == 1
 
 
-def test_batch_run_delivers_and_searchers_follow_their_own_spirals(monkeypatch):
-    """Deliveries happen and searchers stay in the neighbourhood of their own spiral.
+def lane(**kw) -> LaneAvoidance:
+    return LaneAvoidance(BASE, **kw)
 
-    Known open point (issue 4): near the centre, adjacent rings are 0.18 m apart for 0.17 m
-    robots, so avoidance (0.3 m) keeps pushing searchers 0.1-0.17 m off their line (robot_0's
-    median is nearer other robots' lines than its own); a tighter bound does not hold yet.
-    """
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.floats(-0.6, 0.6), y=st.floats(BASE.controller.spiral.gap, 0.6), side=st.sampled_from([-1, 1]))
+def test_robots_on_the_next_lanes_never_block_the_lane(x, y, side):
+    """Any robot whose centre is a gap or more to the side (on an adjacent lane or beyond)."""
+    assert not lane().lane_blocked(circle_ranges(x, side * y))
+
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.floats(0.09, BASE.robots.diameter + 0.08), y=st.floats(-0.03, 0.03))
+def test_a_robot_in_the_lane_ahead_blocks_it(x, y):
+    """Centre within 3 cm of our line, its near side at most `lookahead` ahead."""
+    assert lane().lane_blocked(circle_ranges(x, y))
+
+
+def test_lane_avoidance_ignores_what_is_behind_or_far_and_lets_the_behaviour_steer():
+    la = lane()
+    assert not la.lane_blocked(circle_ranges(-0.2, 0.0))  # behind
+    assert not la.lane_blocked(circle_ranges(0.5, 0.0))  # ahead but beyond the lookahead
+    assert la.update(circle_ranges(0.18 + 0.05, 0.18), 0.0, on_lane=True) is None
+    assert la.events == 0 and not la.yielding
+    # Off the lane the same neighbour is an obstacle for the general avoidance.
+    assert la.update(circle_ranges(0.12, 0.12), 0.1, on_lane=False) is not None
+
+
+def test_batch_run_delivers_and_searchers_keep_to_their_own_lanes(monkeypatch):
+    """The experiment 1 swarm (8 robots) for the first 200 s, seed 0: deliveries happen and a
+    searcher stays on its own line. Before `LaneAvoidance` and the lane target (issue 4) the
+    same run had mean 0.021 m, 95th percentile 0.074 m and max 0.35 m off the path; now about
+    0.0015, 0.011 and 0.07 m."""
     import swarm_sim.batch as batch
 
-    s = dataclasses.replace(BASE, sim=dataclasses.replace(BASE.sim, duration=120.0))  # first find at ~80 s with seed 0
+    full = load_scenario("ddsa")
+    s = dataclasses.replace(full, sim=dataclasses.replace(full.sim, duration=200.0))
     built: list[DdsaBehaviour] = []
     log: dict[str, list[tuple[str, int, float, float]]] = {}
 
@@ -178,13 +244,13 @@ def test_batch_run_delivers_and_searchers_follow_their_own_spirals(monkeypatch):
     assert sum(st.trips for st in run.trace.status.values()) > 0
     assert resources_delivered(run.trace) > 0
     paths = {b.robot: b.path.waypoints for b in built}
+    off = []
     for robot, rows in log.items():
-        own = []
-        for state, nxt, x, y in rows:
-            if state != "SEARCHING" or nxt < 2:  # not yet on the path proper
-                continue
-            p = np.array([x, y])
-            own.append(dist_to_polyline(p, paths[robot]))
+        own = [dist_to_polyline(np.array([x, y]), paths[robot])
+               for state, nxt, x, y in rows if state == "SEARCHING" and nxt >= 2]
         assert len(own) > 100, robot
-        own_a = np.array(own)
-        assert np.median(own_a) < 0.25, robot  # within ~1.5 ring spacings of its own line
+        off.extend(own)
+    off_a = np.array(off)
+    assert off_a.mean() < 0.008
+    assert np.percentile(off_a, 95) < 0.03
+    assert off_a.max() < 0.25

@@ -140,3 +140,17 @@ def test_every_layout_is_valid(seed, distribution, clusters, side, depot_x, clea
         d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
         np.fill_diagonal(d, math.inf)
         np.testing.assert_allclose(d.min(axis=1), cfg.spacing, atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_resources_keep_out_of_every_drop_zone(seed):
+    """A resource inside a drop zone would be delivered the moment it is picked up (MDBSA-D's
+    region centres lie in the search area)."""
+    from swarm_sim.scenario import load_scenario
+
+    s = load_scenario("mdbsa_d", seed=seed)
+    zones = s.all_drop_zones()
+    xy = place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), zones)
+    for z in zones:
+        d = np.hypot(xy[:, 0] - z.center[0], xy[:, 1] - z.center[1])
+        assert d.min() >= z.radius + s.resources.spacing - 1e-9, z.name
