@@ -45,8 +45,15 @@ class ObstacleAvoidance:
     """Turns away from whatever the front sector of the scan sees too close; counts episodes."""
 
     def __init__(
-        self, config: AvoidanceConfig, scan: ScanConfig, max_angular: float | None = None
+        self, config: AvoidanceConfig, scan: ScanConfig, max_angular: float | None = None,
+        *, keep_right: bool = False,
     ) -> None:
+        """keep_right: every episode turns right (clockwise) instead of toward the freer side.
+        Turning to the freer side makes two robots meeting head on on one straight line mirror
+        each other (both turn to the same world side, meet again, push each other along for
+        metres); with a fixed turn sense both swerve to their own right and pass, as on a road.
+        DDSA/MDBSA searchers use it (carriers and resuming robots share their lanes)."""
+        self._keep_right = keep_right
         self.config = config
         self.scan = scan
         self._rays = scan.rays
@@ -114,7 +121,8 @@ class ObstacleAvoidance:
         if not self._active:
             self._active = True
             self._events += 1
-            self._command = self._turn_left if self._free_side(values) >= 0.0 else self._turn_right
+            left = not self._keep_right and self._free_side(values) >= 0.0
+            self._command = self._turn_left if left else self._turn_right
         return self._command
 
     def _free_side(self, values: list[float]) -> float:
@@ -142,10 +150,11 @@ class AvoidThenEscape:
     each other forever with the robot standing still.
     """
 
-    def __init__(self, scenario: Scenario, escape_distance: float) -> None:
+    def __init__(self, scenario: Scenario, escape_distance: float, *, keep_right: bool = False) -> None:
         r = scenario.robots
         self.avoidance = ObstacleAvoidance(
-            scenario.controller.avoidance, scenario.sensors.scan, r.max_angular_speed
+            scenario.controller.avoidance, scenario.sensors.scan, r.max_angular_speed,
+            keep_right=keep_right,
         )
         self._escape = Command(r.max_linear_speed, 0.0)
         self._escape_ticks = max(

@@ -38,7 +38,7 @@ Choices where the paper leaves a detail open:
 * **Obstacle avoidance**: `LaneAvoidance` while SEARCHING and on the last
   ``approach_radius`` of RESUMING (the find position may lie on an outer lane, 0.2 m from a
   wall, closer than the general avoidance lets a robot drive), the general scan avoidance with
-  a fixed right turn (`KeepRightAvoidance`) and a straight escape run of one robot diameter
+  a fixed right turn (`ObstacleAvoidance(keep_right=True)`) and a straight escape run of one robot diameter
   (`AvoidThenEscape`) in every other moving state. Either has priority over the state machine
   and counts events. (CPFA keeps the free-side turn.)
 
@@ -66,7 +66,7 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance, ray_angles
+from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
@@ -79,22 +79,6 @@ from swarm_sim.types import (
     RobotId,
     robot_index,
 )
-
-
-class KeepRightAvoidance(ObstacleAvoidance):
-    """The general scan avoidance, but every episode turns right (clockwise).
-
-    Turning toward the freer side makes two robots meeting head on (a carrier and a robot
-    resuming at the same cluster, on the same straight line) mirror each other: both turn to
-    the same world side, meet again, and can push each other along for metres. With a fixed
-    turn sense both swerve to their own right and pass, as on a road. Measured (DDSA with
-    `LaneAvoidance`, 8 robots, 12 min, seeds 0-7): robot-robot contact 31 -> 0.4 s per robot,
-    deliveries 96 -> 108 (a free-side turn accounted for 99 % of the contact time, all of it
-    between carriers and robots resuming).
-    """
-
-    def _free_side(self, values: list[float]) -> float:
-        return -1.0  # "more room on the right": ObstacleAvoidance then turns right
 
 
 LANE_YIELD_TIMEOUT = 3.0
@@ -111,7 +95,7 @@ class LaneAvoidance:
     beyond g / 2 whenever the robots are narrower than the gap, and is ignored. A blocked lane
     makes the robot stop (one avoidance event per yield episode); if it is still blocked after
     `yield_timeout` the general avoidance (`AvoidThenEscape` turning right,
-    `KeepRightAvoidance`) takes over until its turn and escape run are done. Off the lane (``on_lane=False``) the general avoidance applies as is.
+    `ObstacleAvoidance(keep_right=True)`) takes over until its turn and escape run are done. Off the lane (``on_lane=False``) the general avoidance applies as is.
     Once the general avoidance has started an episode it keeps priority until the episode
     ends, so its state never goes stale between calls.
     """
@@ -122,9 +106,7 @@ class LaneAvoidance:
         below ``controller.spiral.arena_margin`` so the wall beyond a lane's end does not
         block the lane). yield_timeout [s, sim time]."""
         r = scenario.robots
-        self.general = AvoidThenEscape(scenario, escape_distance=r.diameter)
-        self.general.avoidance = KeepRightAvoidance(
-            scenario.controller.avoidance, scenario.sensors.scan, r.max_angular_speed)
+        self.general = AvoidThenEscape(scenario, escape_distance=r.diameter, keep_right=True)
         self.lookahead = r.diameter if lookahead is None else float(lookahead)
         self.approach_radius = scenario.controller.avoidance.distance + r.diameter / 2.0
         """A robot this close to a point of its lane [m] drives onto it in lane mode: the general
