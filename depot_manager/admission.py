@@ -30,7 +30,11 @@ position: two cells of different lines that happen to lie on each other *conflic
 Conflicts: two distinct cells conflict if their centres are closer than (robot_diameter +
 lane_spacing)/2, or, for cells adjacent on a line, closer than robot_diameter (adjacent slots
 are nose to tail by design). Adjacent lanes, exactly lane_spacing apart, do not conflict;
-overlapping or crossing lines do. An *intersection cell* is a cell with any conflict.
+overlapping or crossing lines do. Our addition, *swept* conflicts: if a robot driving along a
+line from a cell to the next passes within a robot diameter of a third cell that conflicts with
+neither, that cell conflicts with the destination (with the origin if the destination is a dock,
+which must stay clear). Example: leaving a dock up its V passes 0.15 m from the ring cell above
+the dock. An *intersection cell* is a cell with any conflict.
 
 A robot *owns* the cells from the one it last reported (`arrived`/`join`) up to its grant.
 A cell is *free* for robot r if no other robot owns it or a cell conflicting with it.
@@ -68,7 +72,8 @@ Rules (the paper's) and the choices it leaves open
     Otherwise the grant stops before the run.
   * **dock**: a grant never passes a dock cell before `unloaded`.
   * **dispatch** (single, sec. IV-A): a robot whose grant reaches the end of the entry line (the
-    inner entry point) is dispatched into inner queue k only if no other robot owns the dock
+    inner entry point; it need not have stopped there) is dispatched into inner queue k, which
+    fixes the rest of its route, only if no other robot owns the dock
     cell or a cell conflicting with it, and no other robot owns a cell of inner queue k between
     the entry point (exclusive) and the dock. Among the eligible docks the first one
     counter-clockwise from the inner entry point is chosen; if no cell can be granted along it
@@ -77,6 +82,11 @@ Rules (the paper's) and the choices it leaves open
     only if the inner exit point is free and no other robot owns a cell of inner queue k
     between the dock (exclusive) and the inner exit point. Hence at most two robots per inner
     queue: one between the entry point and the dock (inclusive), one after the dock.
+    Our inner queues share the ring, so read literally ("other robot" = any robot,
+    ``inner_rule="any"``, the default) both rules also wait for robots of other inner queues
+    and the ring nearly serialises; ``inner_rule="own"`` counts only robots dispatched into the
+    same inner queue (cell ownership and keep-clear keep the others apart), which about doubles
+    the inner region's throughput in our tests and keeps the two-robot bound.
   * **FCFS claims**: a robot standing at its grant end whose next cells cannot be granted claims
     them (the run it needs, or for a robot held at its dock the cells of the leave-the-dock
     rule) against robots served after it *that are upstream of it* (an earlier cell in the
@@ -85,10 +95,15 @@ Rules (the paper's) and the choices it leaves open
     wait cycle. Claims last one step.
 - **No gridlock.** Cells along every route strictly increase in a topological order of the
   route graph (checked at construction). A robot that has stopped does so on a non-intersection
-  cell, so it only blocks robots that want that very cell, which are upstream of it; claims,
-  the dispatch and the leave-the-dock rules also only make robots wait for downstream ones. So
-  the most downstream stopped robot is either unloading or gets a grant, every step: some robot
-  can always move, and since routes are finite every robot leaves once arrivals stop.
+  cell (docks and the inner entry point must be such cells: checked at construction), so it
+  only blocks robots that want that very cell, which are upstream of it; claims, the dispatch
+  and the leave-the-dock rules also only make robots wait for downstream ones. So after every
+  step some robot inside has a grant beyond its cell or is unloading at its dock (the most
+  downstream stopped robot is unloading or gets its cells, unless a robot served before it took
+  them): some robot can always move, and since routes are finite every robot leaves once
+  arrivals stop. Waiting is not bounded per robot under endless arrivals (the paper's rules
+  allow a robot at a dock to wait while the ring is busy); claims make it FCFS against upstream
+  robots.
 """
 
 from __future__ import annotations
@@ -174,7 +189,6 @@ class _Model:
 
     def __init__(self, layout: QueueLayout) -> None:
         cfg = layout.config
-        self.layout = layout
         self.kind = layout.kind
         self.center = cfg.center
         pitch, diam = cfg.pitch, cfg.robot_diameter
@@ -222,6 +236,7 @@ class _Model:
 
         self.xy = np.array(self._xy)
         del self._xy
+        self._templates: dict[int | None, _Route] = {}
         n = len(self.xy)
         self.lines = self.entry_names + self.inner_names + self.exit_names
         self.line_xy = {ln: self.xy[ids] for ln, ids in self.line_ids.items()}
@@ -367,11 +382,55 @@ class _Model:
                     hits.add((int(c), int(ids[j]), int(ids[j + 1])))
         return hits
 
-    def route_ids(self, k: int) -> list[int]:
-        out: list[int] = []
-        for line, first in self.routes[k]:
-            out.extend(int(i) for i in self.line_ids[line][first:])
-        return out
+    def template(self, k: int | None) -> _Route:
+        """The route of template k (None: the single-queue entry line alone), cached."""
+        tpl = self._templates.get(k)
+        if tpl is None:
+            tpl = self._templates[k] = _Route.build(self, k)
+        return tpl
+
+    def route_ids(self, k: int) -> tuple[int, ...]:
+        return self.template(k).ids
+
+
+@dataclass(frozen=True, eq=False)
+class _Route:
+    """A robot's route: physical cell ids, their (line, cell) names, and route index by name
+    (aliases included)."""
+
+    ids: tuple[int, ...]
+    labels: tuple[tuple[str, int], ...]
+    lookup: dict[tuple[str, int], int]
+    entry_len: int
+    """Cells of its entry line (the first entry_len route cells)."""
+    complete: bool
+    """False for a single-queue robot not yet dispatched (entry line only)."""
+    inner: int = -1
+    dock_pos: int = -1
+    inner_end: int = -1
+    """Route index of the inner exit point (single)."""
+
+    @classmethod
+    def build(cls, m: _Model, k: int | None) -> _Route:
+        segments = m.routes[k] if k is not None else ((m.entry_names[0], 0),)
+        ids: list[int] = []
+        labels: list[tuple[str, int]] = []
+        lookup: dict[tuple[str, int], int] = {}
+        for line, first in segments:
+            line_ids = m.line_ids[line]
+            if first == 1:
+                lookup[(line, 0)] = len(ids) - 1  # alias of the previous line's last cell
+            for i in range(first, len(line_ids)):
+                lookup[(line, i)] = len(ids)
+                ids.append(int(line_ids[i]))
+                labels.append((line, i))
+        entry_len = len(m.line_ids[segments[0][0]])
+        if k is None:
+            return cls(tuple(ids), tuple(labels), lookup, entry_len, False)
+        inner = k if m.kind == "single" else -1
+        inner_end = entry_len - 2 + len(m.line_ids[m.inner_names[k]]) if inner >= 0 else -1
+        return cls(tuple(ids), tuple(labels), lookup, entry_len, True, inner,
+                   ids.index(m.dock_ids[k]), inner_end)
 
 
 _MODELS: weakref.WeakKeyDictionary[QueueLayout, _Model] = weakref.WeakKeyDictionary()
@@ -395,8 +454,8 @@ class _Robot:
     def __init__(self, name: str, entry: int, t: float) -> None:
         self.name = name
         self.entry = entry
-        self.route: list[int] = []
-        self.labels: list[tuple[str, int]] = []
+        self.route: tuple[int, ...] = ()
+        self.labels: tuple[tuple[str, int], ...] = ()
         self.lookup: dict[tuple[str, int], int] = {}
         self.pos = self.end = 0
         self.key = t
@@ -412,11 +471,21 @@ class DepotAdmission:
     """Grants queue cells to robots: FCFS, keep-clear, one robot per dock, two per inner
     queue (see the module docstring for every rule)."""
 
-    def __init__(self, layout: QueueLayout, *, lookahead: int = 8) -> None:
+    def __init__(
+        self, layout: QueueLayout, *, lookahead: int = 8, inner_rule: str = "any"
+    ) -> None:
         if lookahead < 1:
             raise ValueError(f"lookahead must be >= 1, got {lookahead}")
+        if inner_rule not in ("any", "own"):
+            raise ValueError(f"inner_rule must be 'any' or 'own', got {inner_rule!r}")
         self.layout = layout
         self.lookahead = lookahead
+        self.inner_rule = inner_rule
+        """Who counts in the single-queue dispatch and leave-the-dock rules: ``any`` robot
+        owning a cell of the inner queue (the paper read literally; our inner queues overlap on
+        the ring, so robots of other inner queues count too and the ring nearly serialises), or
+        only robots dispatched into that same inner queue (``own``; others are kept apart by
+        cell ownership and keep-clear alone). Both keep at most two robots per inner queue."""
         self._m = _model(layout)
         self._owner: list[str | None] = [None] * len(self._m.xy)
         self._robots: dict[str, _Robot] = {}
@@ -511,7 +580,9 @@ class DepotAdmission:
                 f"(now at {r.labels[r.pos]}, granted up to {r.labels[r.end]})"
             )
         if p < r.pos:
-            raise ValueError(f"{robot}: ({line}, {cell}) is behind its current cell {r.labels[r.pos]}")
+            raise ValueError(
+                f"{robot}: ({line}, {cell}) is behind its current cell {r.labels[r.pos]}"
+            )
         if p > r.end:
             raise ValueError(f"{robot}: ({line}, {cell}) is beyond its grant {r.labels[r.end]}")
         if p == r.pos:
@@ -543,7 +614,7 @@ class DepotAdmission:
         self._t = t
         m = self._m
         order = sorted(
-            self._robots.values(), key=lambda r: (-r.key, m.bearing[r.route[r.pos]], r.name)
+            self._robots.values(), key=lambda r: (r.key, m.bearing[r.route[r.pos]], r.name)
         )
         claims = np.full(len(m.xy), -1, dtype=int)
         for r in order:
@@ -613,27 +684,10 @@ class DepotAdmission:
 
     def _set_route(self, r: _Robot, k: int | None) -> None:
         """Route of template k (None: single-queue entry line only, before dispatch)."""
-        m = self._m
-        segments = m.routes[k] if k is not None else ((m.entry_names[0], 0),)
-        r.route, r.labels, r.lookup = [], [], {}
-        prev_last = None
-        for line, first in segments:
-            ids = m.line_ids[line]
-            if first == 1 and prev_last is not None:
-                r.lookup[(line, 0)] = prev_last  # alias of the previous line's last cell
-            for i in range(first, len(ids)):
-                r.lookup[(line, i)] = len(r.route)
-                r.route.append(int(ids[i]))
-                r.labels.append((line, i))
-            prev_last = len(r.route) - 1
-        r.entry_len = len(m.line_ids[segments[0][0]])
-        r.complete = k is not None
-        r.inner = r.dock_pos = r.inner_end = -1
-        if k is not None:
-            r.dock_pos = r.route.index(m.dock_ids[k])
-            if m.kind == "single":
-                r.inner = k
-                r.inner_end = r.entry_len - 1 + len(m.line_ids[m.inner_names[k]]) - 1
+        tpl = self._m.template(k)
+        r.route, r.labels, r.lookup = tpl.ids, tpl.labels, tpl.lookup
+        r.entry_len, r.complete = tpl.entry_len, tpl.complete
+        r.inner, r.dock_pos, r.inner_end = tpl.inner, tpl.dock_pos, tpl.inner_end
 
     def _free(self, c: int, robot: str) -> bool:
         own = self._owner
@@ -701,9 +755,11 @@ class DepotAdmission:
             if not r.unloaded:
                 return
             if m.kind == "single" and not self._may_leave_dock(r):
-                if stopped:
+                if stopped and self.inner_rule == "any":
                     ids = m.line_ids[m.inner_names[r.inner]]
                     self._claim(ids[self._dock_index[r.inner] + 1 :], rank, claims)
+                elif stopped:
+                    self._claim(self._needed_run(r), rank, claims)
                 return
         end = self._extension(r, claims)
         if end > r.end:
@@ -713,13 +769,18 @@ class DepotAdmission:
         if not r.complete and r.end == len(r.route) - 1:
             self._dispatch(r, claims)
 
+    def _holds(self, c: int, r: _Robot, k: int) -> bool:
+        """Another robot owns cell c of inner queue k, and counts for the inner-queue rules."""
+        o = self._owner[c]
+        return o is not None and o != r.name and (
+            self.inner_rule == "any" or self._robots[o].inner == k
+        )
+
     def _may_leave_dock(self, r: _Robot) -> bool:
         m = self._m
         ids = m.line_ids[m.inner_names[r.inner]]
-        for c in ids[self._dock_index[r.inner] + 1 :]:
-            o = self._owner[c]
-            if o is not None and o != r.name:
-                return False
+        if any(self._holds(c, r, r.inner) for c in ids[self._dock_index[r.inner] + 1 :]):
+            return False
         return self._free(int(ids[-1]), r.name)
 
     def _dispatch(self, r: _Robot, claims: np.ndarray) -> None:
@@ -728,7 +789,7 @@ class DepotAdmission:
         for k in self._dock_order:
             ids = m.line_ids[m.inner_names[k]]
             d = self._dock_index[k]
-            if any(self._owner[c] not in (None, r.name) for c in ids[1 : d + 1]):
+            if any(self._holds(c, r, k) for c in ids[1 : d + 1]):
                 continue
             if not self._free(int(ids[d]), r.name):
                 continue

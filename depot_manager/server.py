@@ -6,7 +6,7 @@ ROS-free. Each tick the server applies the reports in the order given, then lets
 ``last`` flag changed (sorted by robot id), plus one refusal (cell -1, with the reason) per
 refused join. Reports that cannot be applied (unknown robot, a cell not on the robot's route,
 an unknown kind, ...) are ignored and recorded in `errors`: one robot's bad report must not stop
-the depot.
+the depot. `history` keeps the entry-line queue lengths over time for the metrics.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ class DepotServer:
         self.layout: QueueLayout = make_layout(
             scenario.depot.queue, DepotGeometryConfig.from_scenario(scenario)
         )
-        self.admission = DepotAdmission(self.layout, lookahead=lookahead)
+        self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=scenario.depot.inner_rule)
         self.errors: list[str] = []
         """One line per report that could not be applied."""
         self.history: list[tuple[float, tuple[int, ...]]] = []

@@ -147,6 +147,12 @@ class DepotConfig:
     paper gives no value; 5 s is our choice."""
     dock_radius: float = 0.06
     """A robot unloads while its centre is within this distance of the dock stop [m]."""
+    inner_rule: Literal["own", "any"] = "own"
+    """Single-queue inner-queue rules (sec. IV-A: dispatch only if no robot is between the
+    inner entry point and the dock; leave the dock only if none is between it and the exit
+    point): `own` counts the robots dispatched into that inner queue (robots of other inner
+    queues are met at intersections, FCFS, as sec. IV-D says); `any` counts every robot on its
+    cells, which on our shared ring nearly serialises the docks."""
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,8 @@
 """Depot admission (queue_depot_traffic.md secs. III-V): cells, rules, FCFS + counter-clockwise
 right of way, and, in a tiny kinematic simulator, the invariants: one robot per dock, two per
-inner queue, no conflicting ownership, keep-clear, no gridlock (every robot leaves in time).
+inner queue, no conflicting ownership (centre distances, and no robot drives along its line
+within a robot diameter of another's cell), keep-clear, lookahead, FCFS, no gridlock (every
+robot leaves in time).
 
 Gridlock bound used below: after every step some robot inside either has a grant beyond its
 cell or is unloading at its dock (checked every tick). A robot with a grant moves with
@@ -773,7 +775,9 @@ def test_server_single_queue_layout_from_scenario():
     srv = DepotServer(_scenario("single"))
     assert srv.layout.kind == "single" and len(srv.layout.docks) == 4
     assert srv.admission.lines()[0] == "entry_line"
-    assert DepotServer(_scenario("single"), inner_rule="own").admission.inner_rule == "own"
+    assert srv.admission.inner_rule == "own"  # the scenario's default
+    any_rule = Scenario(depot=DepotConfig(delivery="docks", queue="single", inner_rule="any"))
+    assert DepotServer(any_rule).admission.inner_rule == "any"
     with pytest.raises(ValueError):
         DepotServer(_scenario("none"))
     with pytest.raises(ValueError, match="inner_rule"):
