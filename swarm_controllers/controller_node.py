@@ -84,13 +84,7 @@ class ControllerNode(Node):
         )
 
     def _on_protocol(self, data: bytes) -> None:
-        try:
-            messages = protocol.decode_messages(data)
-        except ValueError as exc:
-            self.get_logger().warning(f"dropping a malformed protocol message: {exc}")
-            return
-        for m in messages:
-            self.mailbox.post(m)
+        protocol.post_all(data, self.mailbox.post, self.get_logger().warning)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         stamp = decoded[0]

@@ -20,7 +20,7 @@ Topics (all reliable, deep, volatile: every message counts):
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from swarm_msgs_py.cdr import codec
@@ -105,3 +105,15 @@ def decode_messages(data: bytes) -> tuple[Any, ...]:
             raise ValueError(f"{status.name}: fields {sorted(values)}, expected {sorted(names)}")
         out.append(cls(*(_value(values[n], t, f"{status.name}.{n}") for n, t in zip(names, _TYPES[cls]))))
     return tuple(out)
+
+
+def post_all(data: bytes, post: Callable[[Any], None], warn: Callable[[str], None]) -> None:
+    """A node's raw subscription callback body: decode `data` and `post` every message; a
+    malformed array is dropped with a warning naming the problem (nothing else is lost)."""
+    try:
+        messages = decode_messages(data)
+    except ValueError as exc:
+        warn(f"dropping a malformed protocol message: {exc}")
+        return
+    for m in messages:
+        post(m)

@@ -90,13 +90,7 @@ class ServerNode(Node):
         )
 
     def _on_message(self, data: bytes) -> None:
-        try:
-            messages = protocol.decode_messages(data)
-        except ValueError as exc:
-            self.get_logger().warning(f"dropping a malformed message on {self.INBOUND}: {exc}")
-            return
-        for m in messages:
-            self.mailbox.post(m)
+        protocol.post_all(data, self.mailbox.post, self.get_logger().warning)
 
     def _on_clock(self, data: bytes) -> None:
         if self._ack_pub is None:
