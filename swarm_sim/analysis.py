@@ -61,11 +61,11 @@ def load_run(path: Path | str) -> RunTrace:
             trace.status[status.robot] = status
     if not trace.sim_seconds:  # the run was cut off before it could write its totals
         trace.sim_seconds = last_clock / NS_PER_S
-    trace.perimeter_entries = _perimeter_entries(trace, positions)
+    trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
     return trace
 
 
-def _perimeter_entries(trace: RunTrace, positions: dict[int, np.ndarray]) -> dict[str, list[float]]:
+def _perimeter_log(trace: RunTrace, positions: dict[int, np.ndarray]) -> tuple[dict, dict]:
     """Replay the recorded odometry through the `PerimeterLog` the batch runner feeds live (a
     robot missing from a tick keeps its previous position)."""
     depot = trace.config.depot
@@ -77,7 +77,7 @@ def _perimeter_entries(trace: RunTrace, positions: dict[int, np.ndarray]) -> dic
         xy[missing] = previous[missing]
         log.update(stamp / NS_PER_S, xy)
         previous = xy
-    return log.entries
+    return log.entries, log.exits
 
 
 def load_odometry(path: Path | str) -> dict[str, np.ndarray]:
@@ -201,7 +201,8 @@ def main(argv: list[str] | None = None) -> int:
             for key in ("scenario", "seed", "robots", "mode", "sim_seconds", "wall_seconds",
                         "resources_delivered", "total_resources", "collision_time_per_robot_s",
                         "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
-                        "resources_collected_pct", "dropoff_time_mean_s", "deliveries_outside_docks",
+                        "resources_collected_pct", "dropoff_time_mean_s", "perimeter_delay_mean_s",
+                        "deliveries_outside_docks",
                         "queue_length_mean", "queue_length_max", "resources_per_robot",
                         "foraging_rate_per_min", "regions", "plot", "trajectories"):
                 if key in summary:

@@ -78,7 +78,7 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
         trace.sim_seconds = world.t_ns / NS_PER_S
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
-        trace.perimeter_entries = perimeter.entries
+        trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
         depot = servers.get(DEPOT)
         if depot is not None:
             trace.queue_lengths = list(depot.history)

@@ -28,6 +28,8 @@ class PerimeterLog:
         self._inside = np.zeros(len(robots), dtype=bool)
         self.entries: dict[RobotId, list[float]] = {r: [] for r in robots}
         """Per robot, the sim times [s] it entered the perimeter disc."""
+        self.exits: dict[RobotId, list[float]] = {r: [] for r in robots}
+        """Per robot, the sim times [s] it left the perimeter disc."""
 
     def update(self, t: float, xy: np.ndarray) -> None:
         """`xy`: (robots, 2) positions at time `t` [m, world frame], in `robots` order."""
@@ -35,6 +37,8 @@ class PerimeterLog:
         inside = np.einsum("ij,ij->i", d, d) < self._r2
         for i in np.flatnonzero(inside & ~self._inside):
             self.entries[self.robots[i]].append(t)
+        for i in np.flatnonzero(~inside & self._inside):
+            self.exits[self.robots[i]].append(t)
         self._inside = inside
 
 
@@ -59,6 +63,8 @@ class RunTrace:
     """The scenario the run used (world facts the metrics need: docks, perimeter, regions)."""
     perimeter_entries: dict[RobotId, list[float]] = field(default_factory=dict)
     """`PerimeterLog.entries`."""
+    perimeter_exits: dict[RobotId, list[float]] = field(default_factory=dict)
+    """`PerimeterLog.exits`."""
     queue_lengths: list[tuple[float, tuple[int, ...]]] = field(default_factory=list)
     """(t [s], robots queued on each entry line) whenever it changed (depot manager runs)."""
 
@@ -103,6 +109,20 @@ def dropoff_times(trace: RunTrace) -> list[float]:
         entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
         if entered:
             out.append(t - entered[-1])
+    return out
+
+
+def perimeter_delays(trace: RunTrace) -> list[float]:
+    """Per delivery, the queue paper's *time delay* (sec. III): from the carrier's last entry
+    into the perimeter before the drop to its first exit after it [s]; deliveries whose robot
+    had not left again by the end of the run are skipped."""
+    out = []
+    for d in trace.drops:
+        t = d.stamp_ns / NS_PER_S
+        entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
+        left = [e for e in trace.perimeter_exits.get(d.robot, ()) if e >= t]
+        if entered and left:
+            out.append(left[0] - entered[-1])
     return out
 
 
@@ -165,6 +185,7 @@ def _paper_metrics(trace: RunTrace) -> dict[str, Any]:
     """The queue paper's and the MDBSA paper's per-run metrics."""
     delivered = resources_delivered(trace)
     dropoff = dropoff_times(trace)
+    delay = perimeter_delays(trace)
     queue_mean, queue_max = queue_length_stats(trace)
     minutes = trace.sim_seconds / 60.0
     cfg = trace.config
@@ -174,6 +195,7 @@ def _paper_metrics(trace: RunTrace) -> dict[str, Any]:
         if trace.total_resources else 0.0,
         "dropoff_time_mean_s": round(float(np.mean(dropoff)), 6) if dropoff else None,
         "dropoff_times_s": [round(v, 3) for v in dropoff],
+        "perimeter_delay_mean_s": round(float(np.mean(delay)), 6) if delay else None,
         "deliveries_outside_docks": deliveries_outside_docks(trace),
         "queue_length_mean": round(queue_mean, 6),
         "queue_length_max": queue_max,

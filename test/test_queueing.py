@@ -108,3 +108,12 @@ def test_segment_disc_intersection():
     assert not _segment_hits_disc((-3, 2), (3, 2), (0, 0), 1.0)
     assert not _segment_hits_disc((2, 0), (5, 0), (0, 0), 1.0)
     assert KEEP_OUT_BAND > 0
+
+
+def test_perimeter_delay_covers_the_drop_off(run):
+    """The paper's time delay (entering to leaving the perimeter) contains the drop-off time."""
+    _, result = run
+    summary = summarize(result.trace)
+    if summary["perimeter_delay_mean_s"] is not None:
+        assert summary["perimeter_delay_mean_s"] > 0
+        assert summary["dropoff_time_mean_s"] is not None
