@@ -12,7 +12,9 @@ Phases of a delivery, and the choices the paper leaves open:
 * **Foraging** (CPFA). Only carriers may enter the perimeter (sec. III): the CPFA keeps its
   sites and walk legs out of the perimeter disc (plus `KEEP_OUT_BAND`), a give-up return ends
   at its edge, and a non-carrier inside the band is steered out radially, or round the disc
-  along its tangent when its travel would cut through it. The CPFA is not stepped while the
+  the short way when its travel would cut through it, on a two-lane ring road (counter-
+  clockwise on the inner lane, clockwise on the outer) so that robots rounding the perimeter
+  in opposite directions do not meet head on. The CPFA is not stepped while the
   robot queues; when the robot has left the perimeter it is stepped again, sees the drop and
   lays pheromone / chooses its next site then (its view of the delivery time is the exit).
 * **Entry-point joining** (sec. V-A). The perimeter is cut into arcs whose preferred tangent
@@ -287,9 +289,12 @@ class QueueBehaviour:
             return Command(*go_to_point_twist(x, y, obs.pose.yaw, *goal, self._limits), messages)
         tx, ty = self._cpfa.target
         if _segment_hits_disc((x, y), (tx, ty), self._center, self._R + 0.5 * KEEP_OUT_BAND):
-            # Round the disc along its tangent, on the side of the target.
+            # Round the disc the short way, on a two-lane ring road: counter-clockwise on the
+            # inner lane, clockwise on the outer one, so robots rounding it never meet head on.
             side = 1.0 if (tx - x) * -uy + (ty - y) * ux >= 0 else -1.0
-            goal = (x - side * uy * 0.3 + ux * 0.05, y + side * ux * 0.3 + uy * 0.05)
+            rho = self._R + (0.6 if side > 0 else 1.6) * KEEP_OUT_BAND
+            phi = math.atan2(uy, ux) + side * 0.3 / rho
+            goal = (cx + rho * math.cos(phi), cy + rho * math.sin(phi))
             return Command(*go_to_point_twist(x, y, obs.pose.yaw, *goal, self._limits), messages)
         return Command(command.linear, command.angular, messages)
 
