@@ -63,7 +63,8 @@ def test_realtime_mode_runs_near_its_target_factor(tmp_path):
 
 def test_ctrl_c_stops_everything_and_leaves_a_valid_bag(tmp_path):
     bag = tmp_path / "interrupted"
-    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--robots", "4", "--duration", "600",
+    # Long enough that the run cannot end by itself before the Ctrl-C, even on a loaded machine.
+    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--robots", "4", "--duration", "36000",
            "--domain-id", os.environ["ROS_DOMAIN_ID"], *overrides(SMALL_ARENA)]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             cwd=Path(__file__).resolve().parents[1])
@@ -82,7 +83,7 @@ def test_ctrl_c_stops_everything_and_leaves_a_valid_bag(tmp_path):
     info = bag_info(bag)
     assert not info.truncated and info.message_counts["/clock"] > 20
     trace = load_run(bag)
-    assert 2.0 <= trace.sim_seconds < 600 and trace.wall_seconds > 0
+    assert 2.0 <= trace.sim_seconds < 36000 and trace.wall_seconds > 0
     assert "interrupted" in out
     # nothing of the run is left behind
     leftover = subprocess.run(["pgrep", "-f", str(bag)], capture_output=True, text=True).stdout
