@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 
 from swarm_controllers.api import server_channels
 from swarm_msgs_py import ack as ack_codec
@@ -38,6 +40,10 @@ from swarm_sim.bag import BagWriter
 from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
 from swarm_sim.world import World
+
+
+class Interrupted(Exception):
+    """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
 
 @dataclass(frozen=True)
@@ -246,9 +252,14 @@ class WorldNode(Node):
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
 
+    stop_requested = staticmethod(lambda: False)
+    """`main` replaces this with its signal flag."""
+
     def _spin(self, executor: Executor, timeout: float) -> float:
         """Spin once; returns the wall seconds the bag took (flush/split), which must not
-        count against the controllers' deadline."""
+        count against the controllers' deadline. Raises Interrupted once a stop is requested."""
+        if self.stop_requested():
+            raise Interrupted
         executor.spin_once(timeout_sec=timeout)
         if self.bag is None:
             return 0.0
@@ -368,14 +379,27 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
 
 def main(argv: list[str] | None = None) -> int:
     config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
-    rclpy.init(args=["swarm-world", *ros_args])
+    # Our own signal handling: rclpy's handler shuts the context down under the running loop,
+    # which then waited out tick timeouts instead of stopping. A flag checked at every spin
+    # stops the run promptly wherever it is.
+    rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
+    stop = {"requested": False}
+
+    def request_stop(*_: object) -> None:
+        stop["requested"] = True
+
+    signal.signal(signal.SIGINT, request_stop)
+    signal.signal(signal.SIGTERM, request_stop)
     try:
         node = WorldNode(config)
+        node.stop_requested = lambda: stop["requested"]
         executor = make_executor()
         executor.add_node(node)
         node.run(executor)
-    except (KeyboardInterrupt, ExternalShutdownException):
+        if stop["requested"]:
+            raise Interrupted
+    except (KeyboardInterrupt, ExternalShutdownException, Interrupted):
         print("[world] interrupted: closing the bag", flush=True)
     finally:
         if node is not None:
