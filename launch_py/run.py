@@ -65,6 +65,10 @@ def _stop(procs: list[subprocess.Popen], grace: float) -> None:
             p.wait()
 
 
+def _raise_interrupt(*_: object) -> None:
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="swarm-run", description=__doc__.splitlines()[0])
     add_scenario_arguments(parser)
@@ -78,6 +82,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--domain-id", type=int, help="ROS_DOMAIN_ID (default: a private one)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
+    # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
+    # (nohup, some CI shells and test runners), so install the handlers explicitly.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         scenario = load_scenario(args.scenario, args.overrides, **scenario_fields(args), seed=args.seed)
     except ScenarioError as exc:

@@ -76,9 +76,13 @@ def test_ctrl_c_stops_everything_and_leaves_a_valid_bag(tmp_path):
         proc.send_signal(signal.SIGINT)
         out, _ = proc.communicate(timeout=90)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+        if proc.poll() is None:  # SIGTERM makes the launcher stop its children too
+            proc.terminate()
+            try:
+                proc.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
     assert proc.returncode == 0, out
     info = bag_info(bag)
     assert not info.truncated and info.message_counts["/clock"] > 20
