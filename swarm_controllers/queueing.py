@@ -56,7 +56,7 @@ import numpy as np
 
 from depot_manager.admission import DepotAdmission
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
-from swarm_controllers.avoidance import AvoidThenEscape
+from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_sim.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, within_range
@@ -132,7 +132,9 @@ class QueueBehaviour:
             for i in np.flatnonzero(np.hypot(*(cells - dock.stop).T) < 1e-6)
         }
         self._exit_lines = {line.name for line in self._layout.exit_lines}
-        self._front = _front_rays(scenario)
+        self._front = tuple(
+            i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE
+        )
         self._phase = Phase.FORAGING
         self._carrying = False
         self._line = ""  # the line the robot is on (or joining)
@@ -436,14 +438,6 @@ class QueueBehaviour:
             if best is None or d[i] < best[0]:
                 best = (float(d[i]), line, i)
         return best[1], best[2]
-
-
-def _front_rays(scenario: Scenario) -> tuple[int, ...]:
-    scan = scenario.sensors.scan
-    n = scan.rays
-    step = scan.fov / n if scan.fov >= 2 * math.pi - 1e-9 else scan.fov / max(1, n - 1)
-    angles = [-scan.fov / 2 + i * step for i in range(n)]
-    return tuple(i for i, a in enumerate(angles) if abs(math.remainder(a, 2 * math.pi)) <= BRAKE_CONE)
 
 
 def _segment_hits_disc(p, q, c, radius: float) -> bool:

@@ -252,13 +252,13 @@ class WorldNode(Node):
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
 
-    stop_requested = staticmethod(lambda: False)
-    """`main` replaces this with its signal flag."""
+    stop_requested = False
+    """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
 
     def _spin(self, executor: Executor, timeout: float) -> float:
         """Spin once; returns the wall seconds the bag took (flush/split), which must not
         count against the controllers' deadline. Raises Interrupted once a stop is requested."""
-        if self.stop_requested():
+        if self.stop_requested:
             raise Interrupted
         executor.spin_once(timeout_sec=timeout)
         if self.bag is None:
@@ -384,20 +384,19 @@ def main(argv: list[str] | None = None) -> int:
     # stops the run promptly wherever it is.
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
-    stop = {"requested": False}
-
-    def request_stop(*_: object) -> None:
-        stop["requested"] = True
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
         node = WorldNode(config)
-        node.stop_requested = lambda: stop["requested"]
+
+        def request_stop(*_: object) -> None:
+            node.stop_requested = True
+
+        signal.signal(signal.SIGINT, request_stop)
+        signal.signal(signal.SIGTERM, request_stop)
         executor = make_executor()
         executor.add_node(node)
         node.run(executor)
-        if stop["requested"]:
+        if node.stop_requested:
             raise Interrupted
     except (KeyboardInterrupt, ExternalShutdownException, Interrupted):
         print("[world] interrupted: closing the bag", flush=True)

@@ -11,7 +11,11 @@ CORE_MODULES = [
     "swarm_sim.raycast", "swarm_sim.resources", "swarm_sim.world", "swarm_sim.metrics",
     "swarm_sim.bag", "swarm_sim.batch", "swarm_sim.analysis",
     "swarm_controllers.api", "swarm_controllers.motion", "swarm_controllers.avoidance",
-    "swarm_controllers.cpfa",
+    "swarm_controllers.cpfa", "swarm_controllers.ddsa", "swarm_controllers.mdbsa",
+    "swarm_controllers.queueing", "swarm_controllers.spiral", "swarm_controllers.center",
+    "swarm_sim.protocol", "swarm_sim.compare",
+    "depot_manager.geometry", "depot_manager.admission", "depot_manager.server",
+    "swarm_msgs_py.protocol", "swarm_msgs_py.server_state", "swarm_msgs_py.ack",
     "swarm_msgs_py.cdr", "swarm_msgs_py.clock", "swarm_msgs_py.odometry", "swarm_msgs_py.scan",
     "swarm_msgs_py.resources", "swarm_msgs_py.gripper", "swarm_msgs_py.twist",
     "swarm_msgs_py.pheromone", "swarm_msgs_py.diagnostics", "swarm_msgs_py.topics",
@@ -44,6 +48,9 @@ def test_core_modules_import_without_ros():
         from swarm_sim.scenario import load_scenario
         run = run_batch(load_scenario("cpfa", ["robots.count=4", "sim.duration=1.0"]))
         assert run.trace.sim_seconds == 1.0, run.trace.sim_seconds
+        for name in ("queue_qmt", "mdbsa_d"):  # with the depot manager / center cores
+            run = run_batch(load_scenario(name, ["robots.count=4", "sim.duration=1.0"]))
+            assert run.trace.sim_seconds == 1.0, (name, run.trace.sim_seconds)
         print("ok")
         """
     )
