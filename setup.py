@@ -43,8 +43,8 @@ setup(
         "console_scripts": [
             "swarm-run = launch_py.run:main",
             "swarm-batch = swarm_sim.batch:main",
-            "swarm-analyze = swarm_sim.analysis:main",
-            "swarm-world = swarm_sim.world_node:main",
+            "swarm-analyze = swarm_sim.analysis.cli:main",
+            "swarm-world = swarm_sim.nodes.world_node:main",
             "swarm-controllers = swarm_controllers.controller_node:main",
             "swarm-center = swarm_controllers.center_node:main",
             "swarm-depot-manager = depot_manager.node:main",

@@ -16,7 +16,7 @@ from depot_manager.server import DepotServer
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
 from swarm_sim.protocol import DEPOT
-from swarm_sim.server_node import ServerNode, ServerNodeConfig, run_server
+from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 from swarm_sim.types import NS_PER_S
 
 MARKER_PERIOD = 1.0

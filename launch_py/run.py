@@ -115,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
         subprocess.Popen([*python, SERVER_MODULES[channel], *common], env=env, start_new_session=True)
         for channel in servers
     ]
-    world_cmd = [*python, "swarm_sim.world_node", *common, "--mode", args.mode, "--bag", str(bag),
+    world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
     world = subprocess.Popen(world_cmd, env=env, start_new_session=True)
     interrupted = False
@@ -133,8 +133,8 @@ def main(argv: list[str] | None = None) -> int:
         _stop(controllers, grace=10.0)
         _stop([world], grace=60.0)
 
-    from swarm_sim.analysis import load_run
-    from swarm_sim.metrics import summarize
+    from swarm_sim.analysis.replay import load_run
+    from swarm_sim.analysis.metrics import summarize
 
     try:
         summary = summarize(load_run(bag))

@@ -15,7 +15,7 @@ from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
 from swarm_sim.protocol import CENTER
-from swarm_sim.server_node import ServerNode, ServerNodeConfig, run_server
+from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 
 _REGION = (0.6, 0.6, 0.6, 1.0)
 _PATH = (0.2, 0.6, 1.0, 0.8)

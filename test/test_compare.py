@@ -17,7 +17,7 @@ from swarm_sim.compare import (
     read_results, resource_layout, run_sweep, slim, spiral_mannwhitney_md, spiral_plans, stars,
     write_queue_report, write_spiral_report,
 )
-from swarm_sim.resources import place_resources
+from swarm_sim.world.resources import place_resources
 from swarm_sim.scenario import load_scenario
 
 QUEUE_KEYS = ("resources_collected_pct", "collision_time_per_robot_s", "dropoff_time_mean_s")

@@ -8,8 +8,8 @@ import textwrap
 
 CORE_MODULES = [
     "swarm_sim.types", "swarm_sim.scenario", "swarm_sim.geometry", "swarm_sim.messaging",
-    "swarm_sim.raycast", "swarm_sim.resources", "swarm_sim.world", "swarm_sim.metrics",
-    "swarm_sim.bag", "swarm_sim.batch", "swarm_sim.analysis",
+    "swarm_sim.world.raycast", "swarm_sim.world.resources", "swarm_sim.world", "swarm_sim.analysis.metrics",
+    "swarm_sim.bag", "swarm_sim.batch", "swarm_sim.analysis.replay", "swarm_sim.analysis.plots", "swarm_sim.analysis.cli",
     "swarm_controllers.api", "swarm_controllers.motion", "swarm_controllers.avoidance",
     "swarm_controllers.cpfa", "swarm_controllers.ddsa", "swarm_controllers.mdbsa",
     "swarm_controllers.queueing", "swarm_controllers.spiral", "swarm_controllers.center",

@@ -15,7 +15,7 @@ from swarm_controllers.api import behaviour_rng, known_behaviours, make_behaviou
 from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral import ddsa_path
-from swarm_sim.metrics import resources_delivered
+from swarm_sim.analysis.metrics import resources_delivered
 from swarm_sim.scenario import ScenarioError, SpiralConfig, load_scenario
 from swarm_sim.types import Command, Observation, Pose2D
 

@@ -16,7 +16,7 @@ import pytest
 from graph_helpers import SMALL_ARENA, overrides, run_graph
 from swarm_msgs_py import topics
 from swarm_sim.bag import bag_info, read_bag
-from swarm_sim.analysis import load_run
+from swarm_sim.analysis.replay import load_run
 
 ROBOTS = 8
 DURATION = 40.0

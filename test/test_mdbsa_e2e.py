@@ -10,10 +10,10 @@ import numpy as np
 from graph_helpers import run_graph
 from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import protocol, topics
-from swarm_sim.analysis import load_odometry, load_run
+from swarm_sim.analysis.replay import load_odometry, load_run
 from swarm_sim.bag import bag_info, read_bag
 from swarm_sim.batch import run_batch
-from swarm_sim.metrics import summarize
+from swarm_sim.analysis.metrics import summarize
 from swarm_sim.protocol import RegionAssignment
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from graph_helpers import run_graph
 from swarm_msgs_py import protocol, server_state, topics
-from swarm_sim.analysis import load_run
+from swarm_sim.analysis.replay import load_run
 from swarm_sim.bag import bag_info, read_bag
 from swarm_sim.batch import run_batch
-from swarm_sim.metrics import summarize
+from swarm_sim.analysis.metrics import summarize
 from swarm_sim.protocol import DepotGrant, DepotReport
 from swarm_sim.scenario import load_scenario
 

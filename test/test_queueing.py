@@ -11,7 +11,7 @@ import pytest
 
 from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
 from swarm_sim.batch import run_batch
-from swarm_sim.metrics import summarize
+from swarm_sim.analysis.metrics import summarize
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S
 

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.raycast import StaticScene, cast_scan, cast_scan_pybullet, scan_angles
+from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, scan_angles
 from swarm_sim.scenario import ObstacleConfig, ScanConfig, load_scenario
 from swarm_sim.types import Pose2D
 from swarm_sim.world import World

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.resources import place_one, place_resources, powerlaw_pile_sizes
+from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
 
 ARENA = ArenaConfig(size=12.0)

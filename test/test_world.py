@@ -68,7 +68,7 @@ def test_reset_observations_at_tick_zero(make_world):
 
 
 def test_inlined_wire_yaw_is_bit_identical():
-    from swarm_sim.world import _wire_yaw
+    from swarm_sim.world.core import _wire_yaw
 
     rng = np.random.default_rng(0)
     values = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-17, 7.0, -20.0, *rng.uniform(-10, 10, 2000)]
@@ -76,7 +76,7 @@ def test_inlined_wire_yaw_is_bit_identical():
 
 
 def test_fast_observation_constructor_equals_the_dataclass_one():
-    from swarm_sim.world import _new_observation
+    from swarm_sim.world.core import _new_observation
 
     args = ("robot_1", 5, Pose2D(1.0, 2.0, 0.5), 0.1, -0.2, np.ones(3, np.float32), ((1.0, 2.0),), True, ())
     fast, slow = _new_observation(*args), Observation(*args)

@@ -45,8 +45,8 @@ import numpy as np
 import pybullet as p
 
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
-from swarm_sim.raycast import StaticScene, cast_scan, cast_scan_pybullet
-from swarm_sim.resources import place_one, place_resources
+from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
+from swarm_sim.world.resources import place_one, place_resources
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import (
     Command,

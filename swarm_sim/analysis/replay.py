@@ -1,0 +1,89 @@
+"""A run's trace from its bag alone (no ROS running, no rclpy needed).
+
+``load_run(bag) -> RunTrace`` decodes the world's events and counters and the behaviours'
+status messages with the `swarm_msgs_py` codecs; the metric functions of
+`swarm_sim.analysis.metrics` then compute exactly what the batch runner computes.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from swarm_msgs_py import diagnostics, odometry, server_state, topics
+from swarm_msgs_py import clock as clock_codec
+from swarm_sim.bag import BagError, bag_info, read_bag
+from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
+from swarm_sim.scenario import scenario_from_dict
+from swarm_sim.types import NS_PER_S, DropEvent, robot_index
+
+
+def load_run(path: Path | str) -> RunTrace:
+    """Build the trace of a recorded run; raises BagError naming what is missing."""
+    path = Path(path)
+    info = bag_info(path)
+    meta = info.metadata
+    if "scenario" not in meta:
+        raise BagError(f"{path}: no swarmforage scenario in the bag's metadata (not a swarm-run bag?)")
+    scenario = scenario_from_dict(json.loads(meta["scenario"]))
+    trace = RunTrace(
+        scenario=scenario.name, seed=scenario.seed, robots=tuple(scenario.robot_names),
+        sim_seconds=float(meta.get("sim_seconds", 0.0)), wall_seconds=float(meta.get("wall_seconds", 0.0)),
+        total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
+    )
+    index = {r: i for i, r in enumerate(trace.robots)}
+    positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
+    last_clock = 0
+    for m in read_bag(path):
+        if m.topic.endswith("/" + topics.ODOM):
+            robot = m.topic[1:].partition("/")[0]
+            if robot in index:
+                stamp, pose, _, _ = odometry.decode_odometry(m.data)
+                if stamp not in positions:
+                    positions[stamp] = np.full((len(index), 2), np.nan)
+                positions[stamp][index[robot]] = (pose.x, pose.y)
+        elif m.topic == topics.DEPOT_STATE:
+            stamp, state = server_state.decode_state(m.data)
+            trace.queue_lengths.append((stamp / NS_PER_S, server_state.queue_lengths(state)))
+        elif m.topic == topics.CLOCK:
+            last_clock = max(last_clock, clock_codec.decode_clock(m.data))
+        elif m.topic == topics.WORLD_EVENTS:
+            for event in diagnostics.decode_events(m.data)[1]:
+                (trace.drops if isinstance(event, DropEvent) else trace.pickups).append(event)
+        elif m.topic == topics.WORLD_ROBOT_STATS:
+            trace.stats = diagnostics.decode_robot_stats(m.data)[1]
+        elif m.topic.endswith("/" + topics.STATUS):
+            status = diagnostics.decode_status(m.data)
+            trace.status[status.robot] = status
+    if not trace.sim_seconds:  # the run was cut off before it could write its totals
+        trace.sim_seconds = last_clock / NS_PER_S
+    trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
+    return trace
+
+
+def _perimeter_log(trace: RunTrace, positions: dict[int, np.ndarray]) -> tuple[dict, dict]:
+    """Replay the recorded odometry through the `PerimeterLog` the batch runner feeds live (a
+    robot missing from a tick keeps its previous position)."""
+    depot = trace.config.depot
+    log = PerimeterLog(trace.robots, depot.center, depot.perimeter_radius)
+    previous = np.full((len(trace.robots), 2), np.inf)
+    for stamp in sorted(positions):
+        xy = positions[stamp]
+        missing = np.isnan(xy[:, 0])
+        xy[missing] = previous[missing]
+        log.update(stamp / NS_PER_S, xy)
+        previous = xy
+    return log.entries, log.exits
+
+
+def load_odometry(path: Path | str) -> dict[str, np.ndarray]:
+    """Per robot, the (ticks, 4) array of odometry (t [s], x, y, yaw) the controllers received."""
+    rows: dict[str, list[tuple[float, float, float, float]]] = {}
+    for m in read_bag(Path(path)):
+        if m.topic.endswith("/" + topics.ODOM):
+            robot = m.topic.strip("/").split("/")[0]
+            stamp, pose, _, _ = odometry.decode_odometry(m.data)
+            rows.setdefault(robot, []).append((stamp / NS_PER_S, pose.x, pose.y, pose.yaw))
+    return {r: np.array(v) for r, v in sorted(rows.items(), key=lambda kv: robot_index(kv[0]))}
