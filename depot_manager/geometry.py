@@ -32,6 +32,8 @@ from typing import Literal
 
 import numpy as np
 
+from swarm_sim.sites import Dock, docks
+
 ARC_STEP = 0.04
 """Maximum waypoint spacing along discretised arcs [m]; chords cut inside an arc by at most
 ARC_STEP**2 / (8 r), under 0.5 mm here, which is the tolerance on every lane distance."""
@@ -41,8 +43,8 @@ ARC_STEP**2 / (8 r), under 0.5 mm here, which is the tolerance on every lane dis
 class DepotGeometryConfig:
     """Depot and queue dimensions (sec. III and Table I / sec. VII of the paper).
 
-    A view of the scenario's `depot` and `robots` sections (`from_scenario`), which are the one
-    place these facts live; constructing it directly is for tests and the drawing command.
+    A view of the scenario's `depot` and `robots` sections and the queue strategies'
+    ``controller.queue`` section (`from_scenario`), which are the one place these facts live; constructing it directly is for tests and the drawing command.
     """
 
     depot_center: tuple[float, float] = (0.0, 0.0)
@@ -64,8 +66,8 @@ class DepotGeometryConfig:
     def from_scenario(cls, scenario) -> DepotGeometryConfig:
         d = scenario.depot
         return cls(
-            depot_center=tuple(d.center), depot_radius=d.radius,
-            perimeter_radius=d.perimeter_radius, docks=d.docks, lane_spacing=d.lane_spacing,
+            depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=d.perimeter_radius,
+            docks=d.docks, lane_spacing=scenario.controller.section("queue").lane_spacing,
             robot_diameter=scenario.robots.diameter,
         )
 
@@ -224,19 +226,6 @@ def segment_intersections(a: np.ndarray, b: np.ndarray, eps: float = 1e-12) -> n
 
 
 @dataclass(frozen=True, eq=False)
-class Dock:
-    """A dock on the depot boundary (green square, Fig. 2)."""
-
-    index: int
-    angle: float
-    """Bearing from the depot centre [rad, world frame, CCW from +x]."""
-    position: np.ndarray
-    """Point on the depot boundary [m, world frame]."""
-    stop: np.ndarray
-    """Where an unloading robot's centre waits, one robot radius outside [m, world frame]."""
-
-
-@dataclass(frozen=True, eq=False)
 class Crossing:
     """Where two lines intersect (sec. IV-D: FCFS, ties counter-clockwise)."""
 
@@ -323,14 +312,8 @@ def _join(*parts: np.ndarray) -> np.ndarray:
 
 
 def make_docks(cfg: DepotGeometryConfig) -> tuple[Dock, ...]:
-    """K docks evenly spaced on the depot boundary, CCW from +x (Fig. 2)."""
-    docks = []
-    for k in range(cfg.docks):
-        a = 2 * math.pi * k / cfg.docks
-        docks.append(
-            Dock(k, a, _polar(cfg, cfg.depot_radius, a), _polar(cfg, cfg.dock_stop_radius, a))
-        )
-    return tuple(docks)
+    """K docks evenly spaced on the depot boundary, CCW from +x (Fig. 2): the scenario's sites."""
+    return docks(cfg.depot_center, cfg.depot_radius, cfg.robot_diameter, cfg.docks)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -63,7 +63,7 @@ class DepotManagerNode(ServerNode):
 
     def _markers(self, stamp_ns: int, occupied) -> list:
         layout, adm = self.server.layout, self.server.admission
-        lanes = self.scenario.depot.lane_spacing
+        lanes = self.scenario.controller.section("queue").lane_spacing
         owned = {(line, cell) for line, cell, _ in occupied}
         cells = [(line, i, p) for line in adm.lines() for i, p in enumerate(adm.cells(line))]
         free = np.array([p for line, i, p in cells if (line, i) not in owned]).reshape(-1, 2)

@@ -23,15 +23,18 @@ class DepotServer:
     """Depot manager core, stepped once per tick (see `swarm_sim.protocol`)."""
 
     def __init__(self, scenario, *, lookahead: int = 8) -> None:
-        self.layout: QueueLayout = make_layout(
-            scenario.depot.queue, DepotGeometryConfig.from_scenario(scenario)
-        )
-        self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=scenario.depot.inner_rule)
+        queue = scenario.controller.section("queue")
+        self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
+        self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule)
         self.errors: list[str] = []
         """One line per report that could not be applied."""
         self.history: list[tuple[float, tuple[int, ...]]] = []
         """(t [s], robots per entry line), appended whenever the queue lengths change."""
         self._last: dict[str, bool] = {}
+
+    def series(self) -> dict[str, list[tuple[float, tuple[int, ...]]]]:
+        """The run trace's ``queue_lengths``: (t [s], robots queued per entry line) on change."""
+        return {"queue_lengths": list(self.history)}
 
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[DepotGrant, ...]:
         t = stamp_ns / NS_PER_S

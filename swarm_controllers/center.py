@@ -303,12 +303,12 @@ def region_bounds(scenario: Scenario) -> list[tuple[np.ndarray, np.ndarray]]:
     regions are then one gap apart, like the lines within a spiral (no stripe left between
     regions, none walked twice), and a wall keeps the same margin as in DDSA.
     """
-    sp = scenario.controller.spiral
-    size = scenario.arena.size
-    half_side = region_side(sp.regions, size) / 2.0 - sp.gap / 2.0
+    sp = scenario.controller.section("spiral")
+    size, regions = scenario.arena.size, scenario.regions.count
+    half_side = region_side(regions, size) / 2.0 - sp.gap / 2.0
     wall = size / 2.0 - sp.arena_margin
     return [(np.maximum(c - half_side, -wall), np.minimum(c + half_side, wall))
-            for c in region_centers(sp.regions, size)]
+            for c in region_centers(regions, size)]
 
 
 def region_spiral(center: np.ndarray, lo: np.ndarray, hi: np.ndarray, gap: float,
@@ -378,8 +378,8 @@ def region_paths(scenario: Scenario) -> list[SpiralPath]:
     (``resources.margin`` = 0.3 m from the walls) is then within detection range of some
     spiral (tested for 4, 16 and 64 regions).
     """
-    sp = scenario.controller.spiral
-    centers = region_centers(sp.regions, scenario.arena.size)
+    sp = scenario.controller.section("spiral")
+    centers = region_centers(scenario.regions.count, scenario.arena.size)
     redundant = scenario.sensors.resource_detection_radius - sp.gap / 2.0
     return [SpiralPath(region_spiral(c, lo, hi, sp.gap, redundant))
             for c, (lo, hi) in zip(centers, region_bounds(scenario))]
@@ -414,7 +414,7 @@ class CenterServer:
         self.assigner = RegionAssigner(self.paths, scenario.robot_names)
         cx, cy = scenario.depot.center
         self._center = (float(cx), float(cy))
-        self._range = float(scenario.controller.spiral.center_range)
+        self._range = float(scenario.controller.section("spiral").center_range)
         self._told_stop: dict[RobotId, float] = {}
         self.ignored = 0
         """Reports dropped: sent out of range, from an unknown robot or about an unknown region."""
@@ -426,6 +426,10 @@ class CenterServer:
     def in_range(self, x: float, y: float) -> bool:
         """Whether a robot at (x, y) [m, world frame] can talk to the center."""
         return math.hypot(x - self._center[0], y - self._center[1]) <= self._range
+
+    def series(self) -> dict[str, list]:
+        """No time series for the run trace (the center's state is recorded on /center/state)."""
+        return {}
 
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[RegionAssignment, ...]:
         t = stamp_ns / NS_PER_S
@@ -461,3 +465,13 @@ class CenterServer:
         return RegionAssignment(stamp_ns=stamp_ns, robot=robot, region=a.region,
                                 direction=a.direction, s0=float(a.s0), stop_s=float(a.stop_s),
                                 shared=a.shared)
+
+
+def planned_paths(scenario: Scenario) -> list[np.ndarray]:
+    """Every region's spiral waypoints [m, world frame] (drawn under recorded trajectories)."""
+    return [p.waypoints for p in region_paths(scenario)]
+
+
+def region_count(trace) -> int:
+    """The run's number of regions N_R (a JSON result field of MDBSA runs)."""
+    return trace.config.regions.count

@@ -33,11 +33,11 @@ class CenterNode(ServerNode):
             topics.type_of(topics.CENTER_MARKERS), topics.CENTER_MARKERS, STATE_LATCHED
         )
         self._last_state = None
-        sp, size = self.scenario.controller.spiral, self.scenario.arena.size
-        half = region_side(sp.regions, size) / 2
+        regions, size = self.scenario.regions.count, self.scenario.arena.size
+        half = region_side(regions, size) / 2
         squares = [
             [(x - half, y - half), (x + half, y - half), (x + half, y + half), (x - half, y + half), (x - half, y - half)]
-            for x, y in region_centers(sp.regions, size)
+            for x, y in region_centers(regions, size)
         ]
         drawn = markers.line_markers("regions", squares, _REGION, 0.02) + markers.line_markers(
             "planned_paths", [p.waypoints for p in region_paths(self.scenario)], _PATH, 0.01

@@ -30,13 +30,13 @@ Rules, in the paper's words, and how they are realised here:
   steps, CPFA-ROS in seconds; seconds match `CpfaConfig.rate_of_informed_search_decay` [1/s].
 * **Find resource, sense local density** (H&M Algorithm 1: count the resources c near the
   find): the world picks a resource up when an empty robot reaches it; on the tick
-  `obs.carrying` turns True the robot records the site (its own position) and
-  c = len(obs.resources), the *other* resources within the detection radius (the carried one
+  `obs.sensed.carrying` turns True the robot records the site (its own position) and
+  c = len(obs.sensed.resources), the *other* resources within the detection radius (the carried one
   no longer lies on the floor). ARGoS counts the found one as well (its density starts at 1).
   No survey pause: sensing the neighbourhood is instantaneous here (later ARGoS versions
   disable their 4 s survey wait too). Then RETURNING.
 * **Return to nest**: straight for the depot centre. The world drops the resource when the
-  carrier enters a drop zone; `obs.carrying` turning False completes a trip (trips += 1). A
+  carrier enters a drop zone; `obs.sensed.carrying` turning False completes a trip (trips += 1). A
   robot that gave up has arrived when it is inside the depot disc.
 * **Lay pheromone** (H&M: with probability POIS(c, lambda_lp)): after a delivery the robot
   sends a `PheromoneMessage` (the site, stamped now) with that tick's command. POIS is the
@@ -157,7 +157,7 @@ class CpfaBehaviour:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
         give-up return ends at its edge. None: the depot disc (the plain CPFA)."""
-        cfg = scenario.controller.cpfa
+        cfg = scenario.controller.section("cpfa")
         dt = scenario.sim.dt
         self.robot = robot
         self._rng = rng
@@ -277,7 +277,7 @@ class CpfaBehaviour:
         if obs.messages:
             self._receive(obs.messages, obs.stamp_ns)
         out: tuple[object, ...] = ()
-        carrying = bool(obs.carrying)
+        carrying = bool(obs.sensed.carrying)
         if carrying != self._carrying:
             self._carrying = carrying
             if carrying:
@@ -374,7 +374,7 @@ class CpfaBehaviour:
         # Plain floats: the site travels in a PheromoneMessage, whose repr orders the mailbox;
         # a numpy scalar would print differently from the float a graph receiver decodes.
         self._site = (float(obs.pose.x), float(obs.pose.y))
-        self._site_count = len(obs.resources)
+        self._site_count = len(obs.sensed.resources)
         self._state = CpfaState.RETURNING
 
     def _at_nest(self, obs: Observation, delivered: bool) -> tuple[object, ...]:

@@ -19,18 +19,18 @@ Choices where the paper leaves a detail open:
   corners are not cut by more than a quarter of the line spacing.
 * **Finding**: the world picks a resource up only within ``pickup_radius`` (0.05 m) while the
   paper's robots detect at 0.13 m and the lines are 0.18 m apart, so a searcher that sees a
-  resource (``obs.resources``, nearest first) steers to the nearest one; otherwise a resource
+  resource (``obs.sensed.resources``, nearest first) steers to the nearest one; otherwise a resource
   half-way between two lines would be seen and never collected. Once it disappears (picked up
   by us or someone else) the robot heads for its next waypoint again.
 * **"Where it found it"** is the robot's *progress* along its path, an arc length s [m]: the
   arc length of the last waypoint reached plus the projection of the robot's position onto
   the current leg (clamped to the leg, never decreasing). The find position is s at the tick
-  ``obs.carrying`` turns True. RESUMING drives straight to ``path.point_at(s)`` and SEARCHING
+  ``obs.sensed.carrying`` turns True. RESUMING drives straight to ``path.point_at(s)`` and SEARCHING
   continues from there, so the remaining resources of a cluster, seen from that point, are
   collected on the following trips. A pickup outside SEARCHING (driving over a resource while
   resuming) keeps the old s: the robot delivers it and resumes where it was.
 * **Returning**: straight for the depot centre; the world drops the resource in the depot
-  drop zone, and ``obs.carrying`` turning False completes a trip (trips += 1).
+  drop zone, and ``obs.sensed.carrying`` turning False completes a trip (trips += 1).
 * **DONE**: the path's last waypoint reached, the robot drives back into the depot disc and
   stops there (no further instructions exist without a centre). A parked robot sends (0, 0)
   and no longer runs obstacle avoidance, so other robots' traffic does not count as its
@@ -112,7 +112,7 @@ class LaneAvoidance:
         """A robot this close to a point of its lane [m] drives onto it in lane mode: the general
         avoidance keeps it `AvoidanceConfig.distance` from everything ahead, so it could never
         reach the outer lanes (``arena_margin`` = 0.2 m from the walls) head on."""
-        self.half_width = scenario.controller.spiral.gap / 2.0
+        self.half_width = scenario.controller.section("spiral").gap / 2.0
         self.yield_timeout = float(yield_timeout)
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
         self._rays = [(i, math.cos(a), abs(math.sin(a)))
@@ -191,7 +191,7 @@ class DdsaBehaviour:
         i = robot_index(robot) + 1
         if not 1 <= i <= r:
             raise ValueError(f"{robot} is not one of the scenario's {r} robots")
-        sp = scenario.controller.spiral
+        sp = scenario.controller.section("spiral")
         half = scenario.arena.size / 2.0 - sp.arena_margin
         center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self.path = SpiralPath(ddsa_path(center, r, i, sp.gap, half))
@@ -261,7 +261,7 @@ class DdsaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
-        carrying = bool(obs.carrying)
+        carrying = bool(obs.sensed.carrying)
         if carrying != self._carrying:
             self._carrying = carrying
             if carrying:
@@ -308,8 +308,8 @@ class DdsaBehaviour:
             self._state = DdsaState.DONE
             return self._to_depot(obs)
         self._update_progress(x, y)
-        if obs.resources and not self._carrying:
-            rx, ry = obs.resources[0]
+        if obs.sensed.resources and not self._carrying:
+            rx, ry = obs.sensed.resources[0]
             return go_to_point_twist(x, y, pose.yaw, float(rx), float(ry), self._limits)
         tx, ty = self._lane_target()
         return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
@@ -376,3 +376,9 @@ class DdsaBehaviour:
         if d2 < self._arrival2:
             return 0.0, 0.0
         return go_to_point_twist(x, y, pose.yaw, cx, cy, self._limits)
+
+
+def planned_paths(scenario: Scenario) -> list[np.ndarray]:
+    """Every robot's spiral waypoints [m, world frame] (drawn under recorded trajectories)."""
+    rng = np.random.default_rng(0)  # the path does not depend on it
+    return [DdsaBehaviour(scenario, r, rng).path.waypoints for r in scenario.robot_names]

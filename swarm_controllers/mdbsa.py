@@ -5,8 +5,8 @@ is split into N_R square regions with one square spiral each (`center.region_pat
 (3)-(5)). A robot asks the center (`center.CenterServer`, over `swarm_sim.protocol`) for a
 region, walks that region's spiral from ``s0`` in ``direction`` up to ``stop_s``, carries
 every resource it finds to the drop zone, goes back to where it found it and resumes; when
-its walk is over it returns to the center for a new one. MDBSA-C (``distributed=False``)
-delivers to the central depot, MDBSA-D (``distributed=True``) to its region's own center.
+its walk is over it returns to the center for a new one. MDBSA-C (``depot.delivery: depot``)
+delivers to the central depot, MDBSA-D (``depot.delivery: region_centers``) to its region's own center.
 
 Talking to the center (it hears robots only within ``controller.spiral.center_range`` of the
 depot centre, and answers two ticks later):
@@ -38,7 +38,7 @@ Choices where the paper leaves a detail open:
   clamped to the stop.
 * **Lane following, finding, resuming, avoidance**: as the DDSA behaviour (`ddsa.py`): steer
   one gap ahead of the progress on the current leg; steer to the nearest resource seen while
-  searching; the find position is the progress when ``obs.carrying`` turns True, and the
+  searching; the find position is the progress when ``obs.sensed.carrying`` turns True, and the
   robot drives back to it (TRAVELING to the walk's start is the same motion); `LaneAvoidance`
   on the lane and on the last ``approach_radius`` to it (a reverse walk starts on the outer
   lane, 0.2 m from the wall, which the general avoidance would never let a robot reach head
@@ -67,6 +67,7 @@ from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath
 from swarm_sim.protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
+from swarm_sim.sites import drop_zones
 from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, RobotId
 
 ASK_RETRY = 2.0
@@ -130,28 +131,19 @@ class MdbsaBehaviour:
     """One robot of MDBSA-C or MDBSA-D. See the module docstring for the rules and choices."""
 
     def __init__(self, scenario: Scenario, robot: RobotId,
-                 rng: np.random.Generator | None = None, *, distributed: bool) -> None:
+                 rng: np.random.Generator | None = None) -> None:
         if robot not in scenario.robot_names:
             raise ValueError(f"{robot} is not one of the scenario's {scenario.robots.count} robots")
         self.robot = robot
-        self.distributed = bool(distributed)
-        sp = scenario.controller.spiral
+        self.distributed = scenario.depot.delivery == "region_centers"
+        """MDBSA-D (each region's resources go to its centre) rather than MDBSA-C (all to the
+        depot): the world's delivery sites say which."""
+        sp = scenario.controller.section("spiral")
         self.paths: list[SpiralPath] = region_paths(scenario)
         """Every region's spiral [m, world frame], as the center has them."""
-        zones = {z.name: z for z in scenario.all_drop_zones()}
-        if self.distributed:
-            names = [f"region_{i}" for i in range(len(self.paths))]
-            missing = [n for n in names if n not in zones]
-            if missing:
-                raise ValueError("mdbsa_d delivers to the region centers: set "
-                                 "depot.delivery: region_centers (no drop zone "
-                                 f"{missing[0]!r})")
-            self._drops = [(float(zones[n].center[0]), float(zones[n].center[1])) for n in names]
-        else:
-            if "depot" not in zones:
-                raise ValueError("mdbsa_c delivers to the depot: set depot.delivery: depot")
-            z = zones["depot"]
-            self._drops = [(float(z.center[0]), float(z.center[1]))]
+        zones = {z.name: z for z in drop_zones(scenario)}
+        names = [f"region_{i}" for i in range(len(self.paths))] if self.distributed else ["depot"]
+        self._drops = [(float(zones[n].center[0]), float(zones[n].center[1])) for n in names]
         self._center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
@@ -230,7 +222,7 @@ class MdbsaBehaviour:
         for m in obs.messages:
             if isinstance(m, RegionAssignment) and m.robot == self.robot:
                 self._on_assignment(m, obs.t)
-        self._on_carrying(bool(obs.carrying))
+        self._on_carrying(bool(obs.sensed.carrying))
         state = self._state
         if state is MdbsaState.WAITING or state is MdbsaState.IDLE:
             self._parked(obs)
@@ -376,8 +368,8 @@ class MdbsaBehaviour:
             self._project(w, x, y)
         if w.over:
             return self._walk_over(obs)
-        if obs.resources and not self._carrying:
-            rx, ry = obs.resources[0]
+        if obs.sensed.resources and not self._carrying:
+            rx, ry = obs.sensed.resources[0]
             return go_to_point_twist(x, y, pose.yaw, float(rx), float(ry), self._limits)
         tx, ty = self._lane_target(w)
         return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)

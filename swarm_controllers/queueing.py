@@ -107,20 +107,18 @@ class QueueBehaviour:
     """One robot foraging with the CPFA and delivering through the depot's queues."""
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
-        depot = scenario.depot
-        if depot.queue == "none":
-            raise ValueError("behaviour 'queue' needs depot.queue: single or multi")
+        depot, queue = scenario.depot, scenario.controller.section("queue")
         self.robot = robot
         self._rng = rng
         self._limits = DriveLimits.from_scenario(scenario)
         self._center = (float(depot.center[0]), float(depot.center[1]))
         self._R = depot.perimeter_radius
-        self._lane = depot.lane_spacing
+        self._lane = queue.lane_spacing
         self._gamma = scenario.robots.radio_range
-        self._tail = depot.joining == "tail"
+        self._tail = queue.joining == "tail"
         self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._R + KEEP_OUT_BAND)
         self._avoid = AvoidThenEscape(scenario, escape_distance=0.1)
-        self._layout, self._cells = _queues(DepotGeometryConfig.from_scenario(scenario), depot.queue)
+        self._layout, self._cells = _queues(DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
         self._entry_lines = tuple(line.name for line in self._layout.entry_lines)
         self._entry_angles = np.array(
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
@@ -175,7 +173,7 @@ class QueueBehaviour:
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
         out: list[object] = []
-        carrying = bool(obs.carrying)
+        carrying = bool(obs.sensed.carrying)
         dropped = self._carrying and not carrying
         self._carrying = carrying
         self._handle(obs, out)

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from swarm_sim.sites import region_centers  # noqa: F401 - re-exported: the planners' region grid
+
 DEFAULT_GAP = 0.18
 """Distance g between adjacent spiral lines [m] (paper Sec. IV)."""
 
@@ -209,24 +211,6 @@ def ddsa_path(center: tuple[float, float] | np.ndarray, r: int, i: int, gap: flo
         # Arena too small for robot i's ring: nothing left to search, a one-point path.
         return np.clip(start, lo, hi)[None, :]
     return _walk_truncated(start, legs, lo, hi)
-
-
-def region_centers(n_regions: int, arena_size: float) -> np.ndarray:
-    """(N_R, 2) centers [m, world frame] of the N_R = 4^k equal square regions, eq. (3).
-
-    (x_i, y_j) = (L/2 (1 - (2i+1)/sqrt(N_R)), L/2 (1 - (2j+1)/sqrt(N_R))), i the row, j the column,
-    arena centered at (0, 0). Row index = region_id // sqrt(N_R), column = region_id % sqrt(N_R);
-    region 0 is therefore the (+x, +y) corner region. The paper assigns regions "by robot id"
-    without fixing an order; this row-major order of eq. (3)'s (i, j) is our choice.
-    """
-    n = int(round(np.sqrt(n_regions)))
-    k = int(round(np.log(n_regions) / np.log(4))) if n_regions >= 1 else -1
-    if n_regions < 1 or 4**k != n_regions:
-        raise ValueError(f"the number of regions must be 4^k, got {n_regions}")
-    idx = np.arange(n)
-    coord = arena_size / 2.0 * (1.0 - (2 * idx + 1) / n)
-    ii, jj = np.meshgrid(idx, idx, indexing="ij")
-    return np.stack([coord[ii.ravel()], coord[jj.ravel()]], axis=1)
 
 
 def region_side(n_regions: int, arena_size: float) -> float:

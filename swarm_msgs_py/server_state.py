@@ -17,7 +17,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from swarm_msgs_py import topics
 from swarm_msgs_py.cdr import codec
+from swarm_sim.types import NS_PER_S
 from swarm_msgs_py.diagnostics import OK, TYPE_NAME, decode_diagnostics, encode_diagnostics
 
 
@@ -64,3 +66,12 @@ def decode_state(data: bytes) -> tuple[int, dict[str, dict[str, str]]]:
 def queue_lengths(state: dict[str, dict[str, str]]) -> tuple[int, ...]:
     """Per entry line, robots queued, from a decoded `/depot/state`."""
     return tuple(int(v) for v in state.get("queues", {}).values())
+
+
+def replay_depot_state(topic: str, data: bytes) -> list[tuple[str, float, tuple[int, ...]]]:
+    """A recorded `/depot/state` message as the run trace's ``queue_lengths`` series point
+    (what the batch runner takes from `DepotServer.series`); other topics add nothing."""
+    if topic != topics.DEPOT_STATE:
+        return []
+    stamp_ns, state = decode_state(data)
+    return [("queue_lengths", stamp_ns / NS_PER_S, queue_lengths(state))]

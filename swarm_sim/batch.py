@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm_controllers.api import behaviour_rng, make_behaviour, make_servers
+from swarm_controllers.api import behaviour_rng
 from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.messaging import Router
-from swarm_sim.protocol import DEPOT, ROBOTS
+from swarm_sim.protocol import ROBOTS
+from swarm_sim.registry import make_behaviour, make_servers
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
@@ -79,9 +80,8 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
         trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
-        depot = servers.get(DEPOT)
-        if depot is not None:
-            trace.queue_lengths = list(depot.history)
+        for server in servers.values():
+            trace.series.update(server.series())
     finally:
         world.close()
     trace.wall_seconds = time.monotonic() - wall0

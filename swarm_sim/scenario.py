@@ -121,8 +121,8 @@ class ResourceConfig:
 
 @dataclass(frozen=True)
 class DepotConfig:
-    """The central depot and, for the queue strategies, its docks and queue area
-    (queue_depot_traffic.md sec. III; geometry built by `depot_manager.geometry`)."""
+    """The central depot: its disc, its docks and the perimeter around it (queue paper sec. III).
+    World facts only; where the docks are is worked out by `swarm_sim.sites`."""
 
     center: tuple[float, float] = (0.0, 0.0)
     """[m, world frame]"""
@@ -131,28 +131,28 @@ class DepotConfig:
     delivery: Literal["depot", "docks", "region_centers"] = "depot"
     """Where resources are delivered: `depot` anywhere in the depot disc (CPFA, DDSA,
     MDBSA-C); `docks` only at the docks after `unload_time` (queue strategies);
-    `region_centers` at each MDBSA region's center (MDBSA-D)."""
-    queue: Literal["none", "single", "multi"] = "none"
-    """Queue wrapping strategy inside the perimeter (sec. IV); needs delivery `docks`."""
-    joining: Literal["entry", "tail"] = "entry"
-    """Endpoint finding (sec. V): entry-point joining or tail joining."""
+    `region_centers` at each region's center (MDBSA-D; see `regions`)."""
     perimeter_radius: float = 2.0
-    """Radius of the perimeter (red circle) [m]; only carriers may enter it."""
+    """Radius of the perimeter (red circle) [m] around the depot; the queue paper's drop-off
+    time runs from a carrier's entry into it."""
     docks: int = 4
     """Number K of docks on the depot boundary."""
-    lane_spacing: float = 0.20
-    """Distance between adjacent queue lanes [m] (sec. VII)."""
     unload_time: float = 5.0
     """T_unload: a robot stays at its dock this long before its resource is dropped [s]. The
-    paper gives no value; 5 s is our choice."""
+    queue paper gives no value; 5 s is our choice."""
     dock_radius: float = 0.06
     """A robot unloads while its centre is within this distance of the dock stop [m]."""
-    inner_rule: Literal["own", "any"] = "own"
-    """Single-queue inner-queue rules (sec. IV-A: dispatch only if no robot is between the
-    inner entry point and the dock; leave the dock only if none is between it and the exit
-    point): `own` counts the robots dispatched into that inner queue (robots of other inner
-    queues are met at intersections, FCFS, as sec. IV-D says); `any` counts every robot on its
-    cells, which on our shared ring nearly serialises the docks."""
+
+
+@dataclass(frozen=True)
+class RegionConfig:
+    """The arena split into N_R = 4^k equal square regions (MDBSA paper eq. (3)); each region's
+    centre is a drop zone when ``depot.delivery`` is `region_centers`."""
+
+    count: int = 16
+    """N_R, a power of 4 (the MDBSA paper's experiment 1 default is 16)."""
+    center_radius: float = 0.25
+    """Radius of each region centre's drop zone [m]."""
 
 
 @dataclass(frozen=True)
@@ -183,39 +183,6 @@ class ObstacleConfig:
 
 
 @dataclass(frozen=True)
-class CpfaConfig:
-    """Central-place foraging algorithm parameters (Hecker & Moses 2015, Table 1/3).
-
-    Defaults are the values BCLab's CPFA implementation labels "according to Beyond
-    Pheromones"; p_s and p_r are per draw of the reference controller (see `draw_rate`) and are
-    rescaled to our tick by the behaviour.
-    """
-
-    probability_of_switching_to_searching: float = 0.045
-    """p_s: chance per draw that a departing robot stops travelling and starts searching."""
-    probability_of_returning_to_nest: float = 0.01
-    """p_r: chance per draw that a searching robot gives up and returns."""
-    uninformed_search_variation: float = 0.4
-    """omega [rad]: std of the heading change of the correlated random walk."""
-    rate_of_informed_search_decay: float = 0.1666
-    """lambda_id [1/s]."""
-    rate_of_site_fidelity: float = 5.0
-    """lambda_sf: site fidelity with probability POIS(c, lambda_sf)."""
-    rate_of_laying_pheromone: float = 5.0
-    """lambda_lp: lay a pheromone waypoint with probability POIS(c, lambda_lp)."""
-    rate_of_pheromone_decay: float = 0.025
-    """lambda_pd [1/s]: strength exp(-lambda_pd * age)."""
-    pheromone_threshold: float = 0.001
-    """Waypoints weaker than this are forgotten."""
-    search_step: float = 0.08
-    """Distance between heading changes of the random walk [m]."""
-    draw_rate: float = 0.2
-    """How often [Hz] p_s and p_r are drawn in the reference implementation: the CPFA-ARGoS
-    controller of the queue paper's lab draws both once every 5 s of its 16 Hz loop. The
-    behaviour applies the same hazard per second at every tick of ours."""
-
-
-@dataclass(frozen=True)
 class AvoidanceConfig:
     distance: float = 0.3
     """Obstacles within this range of the robot's centre in the front sector trigger avoidance [m]."""
@@ -226,30 +193,36 @@ class AvoidanceConfig:
 
 
 @dataclass(frozen=True)
-class SpiralConfig:
-    """Square-spiral search (DDSA / MDBSA, Lu & Luna 2023)."""
-
-    gap: float = 0.18
-    """Distance g between adjacent spiral lines [m] (paper Sec. IV: 0.13 m detection radius
-    plus room for encoder noise)."""
-    arena_margin: float = 0.2
-    """Spirals are clipped to the arena square shrunk by this much on every side [m]."""
-    regions: int = 16
-    """MDBSA: number of square regions N_R = 4^k (paper's experiment 1 default 16)."""
-    center_range: float = 0.75
-    """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
-    region_center_radius: float = 0.25
-    """MDBSA-D: radius of each region's own drop zone around the region center [m]."""
-
-
-@dataclass(frozen=True)
 class ControllerConfig:
+    """The robots' controller: which registered algorithm runs (`swarm_sim.registry`), the
+    settings every behaviour shares, and the algorithms' own sections.
+
+    An algorithm's section (``controller.cpfa``, ``controller.queue``...) is a frozen dataclass
+    the algorithm declares in its registry record; `load_scenario` builds and checks it, and
+    `section` hands it out. Sections left out of the file take their defaults.
+    """
+
     behaviour: str = "cpfa"
-    cpfa: CpfaConfig = field(default_factory=CpfaConfig)
+    """The registered algorithm (`swarm_sim.registry.known`)."""
     avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
     arrival_tolerance: float = 0.1
     """A target counts as reached within this distance [m]."""
-    spiral: SpiralConfig = field(default_factory=SpiralConfig)
+    sections: tuple[tuple[str, Any], ...] = ()
+    """(name, built section) for the sections given; see `section`."""
+
+    def section(self, name: str) -> Any:
+        """The algorithm section `name`, its defaults if the scenario did not give it."""
+        for key, value in self.sections:
+            if key == name:
+                return value
+        from swarm_sim.registry import config_section
+
+        return config_section(name)()
+
+    def with_section(self, name: str, value: Any) -> ControllerConfig:
+        """A copy with section `name` replaced (tests and sweeps)."""
+        rest = tuple((k, v) for k, v in self.sections if k != name)
+        return dataclasses.replace(self, sections=tuple(sorted((*rest, (name, value)))))
 
 
 @dataclass(frozen=True)
@@ -262,8 +235,9 @@ class Scenario:
     sensors: SensorConfig = field(default_factory=SensorConfig)
     resources: ResourceConfig = field(default_factory=ResourceConfig)
     depot: DepotConfig = field(default_factory=DepotConfig)
+    regions: RegionConfig = field(default_factory=RegionConfig)
     drop_zones: tuple[DropZoneConfig, ...] = ()
-    """Extra drop zones; the depot disc is always one (see `all_drop_zones`)."""
+    """Extra drop zones besides the ones ``depot.delivery`` implies (`swarm_sim.sites.drop_zones`)."""
     obstacles: tuple[ObstacleConfig, ...] = ()
     controller: ControllerConfig = field(default_factory=ControllerConfig)
 
@@ -279,31 +253,6 @@ class Scenario:
     @property
     def robot_names(self) -> list[str]:
         return [f"robot_{i}" for i in range(self.robots.count)]
-
-    def all_drop_zones(self) -> tuple[DropZoneConfig, ...]:
-        """The zones the world drops resources in: `drop_zones` plus the ones `depot.delivery`
-        implies (the depot disc, the docks, or the MDBSA region centers)."""
-        d = self.depot
-        if d.delivery == "docks":
-            from depot_manager.geometry import DepotGeometryConfig, make_docks
-
-            implied = tuple(
-                DropZoneConfig(f"dock_{k.index}", (float(k.stop[0]), float(k.stop[1])),
-                               d.dock_radius, d.unload_time, "dock")
-                for k in make_docks(DepotGeometryConfig.from_scenario(self))
-            )
-        elif d.delivery == "region_centers":
-            from swarm_controllers.spiral import region_centers
-
-            sp = self.controller.spiral
-            implied = tuple(
-                DropZoneConfig(f"region_{i}", (float(x), float(y)), sp.region_center_radius, 0.0,
-                               "region_center")
-                for i, (x, y) in enumerate(region_centers(sp.regions, self.arena.size))
-            )
-        else:
-            implied = (DropZoneConfig("depot", d.center, d.radius, 0.0, "depot"),)
-        return (*implied, *self.drop_zones)
 
 
 # --------------------------------------------------------------------------- loading
@@ -370,6 +319,8 @@ def _convert(value: Any, tp: Any, key: str) -> Any:
 
 
 def _build(cls: type, data: dict[str, Any], prefix: str) -> Any:
+    if cls is ControllerConfig:
+        data = _with_sections(data, prefix)
     hints = typing.get_type_hints(cls)
     names = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(data) - names)
@@ -386,6 +337,25 @@ def _build(cls: type, data: dict[str, Any], prefix: str) -> Any:
         return cls(**kwargs)
     except TypeError as exc:  # a field without default left out
         raise ScenarioError(f"{prefix or 'scenario'}: {exc}") from None
+
+
+def _with_sections(data: dict[str, Any], prefix: str) -> dict[str, Any]:
+    """The ``controller`` mapping with the algorithms' sections built into ``sections``: every
+    key that is not a field of ControllerConfig must name a registered section."""
+    from swarm_sim.registry import config_section, config_sections
+
+    fixed = {f.name for f in dataclasses.fields(ControllerConfig)} - {"sections"}
+    out = {k: v for k, v in data.items() if k in fixed}
+    sections = []
+    for name in sorted(set(data) - fixed):
+        if name not in config_sections():
+            known = ", ".join(sorted(fixed | set(config_sections())))
+            raise ScenarioError(f"unknown key {prefix}.{name} (known keys: {known})")
+        value = data[name] if data[name] is not None else {}
+        sections.append((name, _convert(value, config_section(name), f"{prefix}.{name}")))
+    if sections:
+        out["sections"] = tuple(sections)
+    return out
 
 
 def _set_path(data: dict[str, Any], dotted: str, value: Any) -> None:
@@ -455,13 +425,17 @@ def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
     """Plain-data form (for bag metadata and JSON results); `_build` accepts it back."""
 
     def plain(value: Any) -> Any:
+        if dataclasses.is_dataclass(value):
+            return {f.name: plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
         if isinstance(value, tuple):
             return [plain(v) for v in value]
-        if isinstance(value, dict):
-            return {k: plain(v) for k, v in value.items()}
         return value
 
-    return plain(dataclasses.asdict(scenario))
+    data = plain(scenario)
+    controller = data["controller"]
+    for name, section in controller.pop("sections"):
+        controller[name] = section
+    return data
 
 
 def scenario_from_dict(data: dict[str, Any]) -> Scenario:
@@ -537,39 +511,34 @@ def validate(s: Scenario) -> None:
         _require(z.radius > 0, f"drop_zones[{i}].radius: must be positive")
         _require(z.dwell >= 0, f"drop_zones[{i}].dwell: must not be negative")
         _require(_inside(z.center, half, 0.0), f"drop_zones[{i}].center: {z.center} is outside the arena")
-    names = [z.name for z in s.all_drop_zones()]
+    from swarm_sim.sites import drop_zones
+
+    names = [z.name for z in drop_zones(s)]
     _require(len(set(names)) == len(names), "drop_zones: zone names must be unique ('depot' is taken)")
     for i, o in enumerate(s.obstacles):
         _require(min(o.size) > 0, f"obstacles[{i}].size: must be positive")
         _require(_inside(o.center, half, 0.0), f"obstacles[{i}].center: {o.center} is outside the arena")
     _require(s.controller.arrival_tolerance > 0, "controller.arrival_tolerance: must be positive")
-    sp = s.controller.spiral
-    _require(sp.gap > 0, "controller.spiral.gap: must be positive")
-    _require(sp.arena_margin >= 0, "controller.spiral.arena_margin: must not be negative")
-    _require(sp.arena_margin < half, "controller.spiral.arena_margin: leaves no arena to search")
-    k = round(math.log(sp.regions, 4)) if sp.regions >= 1 else -1
-    _require(k >= 0 and 4**k == sp.regions, f"controller.spiral.regions: {sp.regions} is not a power of 4")
-    _require(sp.center_range > 0, "controller.spiral.center_range: must be positive")
-    _require(sp.region_center_radius > 0, "controller.spiral.region_center_radius: must be positive")
     _require(r.radio_range > 0, "robots.radio_range: must be positive")
+    g = s.regions
+    k = round(math.log(g.count, 4)) if g.count >= 1 else -1
+    _require(k >= 0 and 4**k == g.count, f"regions.count: {g.count} is not a power of 4")
+    _require(g.center_radius > 0, "regions.center_radius: must be positive")
     d = s.depot
     _require(d.unload_time >= 0, "depot.unload_time: must not be negative")
     _require(d.dock_radius > 0, "depot.dock_radius: must be positive")
+    _require(d.docks >= 1, "depot.docks: need at least one dock")
+    stop = d.radius + r.diameter / 2
     _require(
-        d.queue == "none" or d.delivery == "docks",
-        f"depot.queue: {d.queue!r} queues lead to docks; set depot.delivery: docks",
+        d.docks == 1 or 2 * stop * math.sin(math.pi / d.docks) >= r.diameter,
+        f"depot.docks: {d.docks} docks do not fit side by side on a depot of radius {d.radius} m",
     )
+    _require(d.perimeter_radius > d.radius, "depot.perimeter_radius: must exceed depot.radius")
     if d.delivery == "docks":
-        from depot_manager.geometry import DepotGeometryConfig, make_layout
-
-        try:
-            geometry = DepotGeometryConfig.from_scenario(s)
-            geometry.validate()
-            if d.queue != "none":
-                make_layout(d.queue, geometry)
-        except ValueError as exc:
-            raise ScenarioError(f"depot: {exc}") from None
         _require(
             _inside(d.center, half, d.perimeter_radius),
             f"depot.perimeter_radius: a perimeter of {d.perimeter_radius} m does not fit in the arena",
         )
+    from swarm_sim.registry import check_scenario
+
+    check_scenario(s)

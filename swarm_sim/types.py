@@ -11,6 +11,7 @@ nanoseconds so that graph and batch runs compare exactly.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -82,10 +83,9 @@ class Observation:
     ranges: np.ndarray
     """Laser scan ranges [m], float32, ray i at angle ``angle_min + i * angle_increment``
     relative to the heading; ``inf`` where nothing is within range (REP 117)."""
-    resources: tuple[tuple[float, float], ...]
-    """Positions of resources within the detection radius [m, world frame], nearest first."""
-    carrying: bool
-    """True while the gripper holds a resource."""
+    sensed: Any
+    """What the world task lets the robot sense besides odometry and scan, e.g.
+    `swarm_sim.world.tasks.foraging.ForagingSense` (resources in range, gripper)."""
     messages: tuple[object, ...] = ()
     """Messages from other nodes stamped before this tick, in a deterministic order."""
 
@@ -104,8 +104,7 @@ class Observation:
             and self.linear_velocity == other.linear_velocity
             and self.angular_velocity == other.angular_velocity
             and np.array_equal(self.ranges, other.ranges)
-            and self.resources == other.resources
-            and self.carrying == other.carrying
+            and self.sensed == other.sensed
             and self.messages == other.messages
         )
 

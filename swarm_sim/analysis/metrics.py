@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from swarm_sim.scenario import Scenario
+from swarm_sim.sites import scenario_docks
 from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent, RobotId, RobotStats
 
 
@@ -65,8 +66,9 @@ class RunTrace:
     """`PerimeterLog.entries`."""
     perimeter_exits: dict[RobotId, list[float]] = field(default_factory=dict)
     """`PerimeterLog.exits`."""
-    queue_lengths: list[tuple[float, tuple[int, ...]]] = field(default_factory=list)
-    """(t [s], robots queued on each entry line) whenever it changed (depot manager runs)."""
+    series: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
+    """Servers' time series by name, (t [s], value) whenever it changed: e.g. the depot
+    manager's ``queue_lengths`` (robots queued on each entry line)."""
 
 
 def resources_delivered(trace: RunTrace) -> int:
@@ -130,24 +132,11 @@ def deliveries_outside_docks(trace: RunTrace) -> int | None:
     """Drops farther than the dock radius from every dock stop (None without a scenario)."""
     if trace.config is None:
         return None
-    from depot_manager.geometry import DepotGeometryConfig, make_docks
-
-    stops = np.array([k.stop for k in make_docks(DepotGeometryConfig.from_scenario(trace.config))])
+    stops = np.array([k.stop for k in scenario_docks(trace.config)])
     radius = trace.config.depot.dock_radius + 1e-6
     return sum(
         1 for d in trace.drops if np.min(np.hypot(stops[:, 0] - d.x, stops[:, 1] - d.y)) > radius
     )
-
-
-def queue_length_stats(trace: RunTrace) -> tuple[float, int]:
-    """Time-weighted mean and the maximum of the total entry-line queue length."""
-    if not trace.queue_lengths:
-        return 0.0, 0
-    times = [t for t, _ in trace.queue_lengths] + [trace.sim_seconds]
-    totals = [sum(q) for _, q in trace.queue_lengths]
-    weights = np.diff(times)
-    mean = float(np.dot(weights, totals) / weights.sum()) if weights.sum() > 0 else float(totals[-1])
-    return mean, max(totals)
 
 
 def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
@@ -177,19 +166,18 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "trips_by_robot": trips,
         "stale_ticks": sum(s.stale_ticks for s in trace.stats.values()),
         "clamped_commands": sum(s.clamped_commands for s in trace.stats.values()),
-        **_paper_metrics(trace),
+        **_registered_metrics(trace),
     }
 
 
-def _paper_metrics(trace: RunTrace) -> dict[str, Any]:
-    """The queue paper's and the MDBSA paper's per-run metrics."""
+def foraging_metrics(trace: RunTrace) -> dict[str, Any]:
+    """The foraging task's per-run metrics: the queue paper's (resources collected, drop-off
+    time, time delay, deliveries outside docks) and the MDBSA paper's (resources per robot,
+    foraging rate)."""
     delivered = resources_delivered(trace)
     dropoff = dropoff_times(trace)
     delay = perimeter_delays(trace)
-    queue_mean, queue_max = queue_length_stats(trace)
     minutes = trace.sim_seconds / 60.0
-    cfg = trace.config
-    mdbsa = cfg is not None and cfg.controller.behaviour in ("mdbsa_c", "mdbsa_d")
     return {
         "resources_collected_pct": round(100.0 * delivered / trace.total_resources, 6)
         if trace.total_resources else 0.0,
@@ -197,9 +185,22 @@ def _paper_metrics(trace: RunTrace) -> dict[str, Any]:
         "dropoff_times_s": [round(v, 3) for v in dropoff],
         "perimeter_delay_mean_s": round(float(np.mean(delay)), 6) if delay else None,
         "deliveries_outside_docks": deliveries_outside_docks(trace),
-        "queue_length_mean": round(queue_mean, 6),
-        "queue_length_max": queue_max,
         "resources_per_robot": round(delivered / len(trace.robots), 6) if trace.robots else 0.0,
         "foraging_rate_per_min": round(delivered / minutes, 6) if minutes > 0 else 0.0,
-        "regions": cfg.controller.spiral.regions if mdbsa else None,
     }
+
+
+def _registered_metrics(trace: RunTrace) -> dict[str, Any]:
+    """The world task's metrics, then every metric an algorithm registers (runs of algorithms
+    that do not declare one report its default, so every run has the same fields)."""
+    from swarm_sim import registry
+
+    ours = registry.of(trace.config) if trace.config is not None else None
+    task = registry.task(ours.task if ours is not None else "foraging")
+    out = registry.resolve(task.metrics)(trace) if task.metrics else {}
+    mine = {m.name for m in ours.metrics} if ours is not None else set()
+    for a in registry.algorithms():
+        for m in a.metrics:
+            if m.name not in out:
+                out[m.name] = registry.resolve(m.function)(trace) if m.name in mine else m.default
+    return out

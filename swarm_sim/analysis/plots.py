@@ -10,7 +10,9 @@ import numpy as np
 from swarm_sim.analysis.metrics import RunTrace, delivered_over_time, summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.bag import bag_info
+from swarm_sim import registry
 from swarm_sim.scenario import scenario_from_dict
+from swarm_sim.sites import drop_zones
 
 
 def plot_run(trace: RunTrace, out: Path) -> Path:
@@ -20,8 +22,8 @@ def plot_run(trace: RunTrace, out: Path) -> Path:
     import matplotlib.pyplot as plt
 
     summary = summarize(trace)
-    queues = bool(trace.queue_lengths)
-    fig, axes = plt.subplots(1, 4 if queues else 3, figsize=(20 if queues else 15, 4))
+    series = sorted(trace.series.items())
+    fig, axes = plt.subplots(1, 3 + len(series), figsize=(15 + 5 * len(series), 4))
     ax1, ax2, ax3 = axes[:3]
     times, counts = delivered_over_time(trace)
     ax1.step(times, counts, where="post")
@@ -34,33 +36,17 @@ def plot_run(trace: RunTrace, out: Path) -> Path:
     ax3.bar(idx, [summary["oae_by_robot"][r] for r in names], color="tab:orange")
     ax3.bar(idx, [summary["trips_by_robot"][r] for r in names], color="tab:green", alpha=0.7)
     ax3.set(xlabel="robot", ylabel="count", title="obstacle-avoidance events (orange), trips (green)")
-    if queues:
-        times = [t for t, _ in trace.queue_lengths] + [trace.sim_seconds]
-        lengths = np.array([q for _, q in trace.queue_lengths] + [trace.queue_lengths[-1][1]])
-        for j in range(lengths.shape[1]):
-            axes[3].step(times, lengths[:, j], where="post", label=f"entry line {j}")
-        axes[3].set(xlabel="sim time [s]", ylabel="robots queued", title="queue lengths")
-        axes[3].legend(fontsize=7)
+    for ax, (name, points) in zip(axes[3:], series):  # the servers' series, e.g. queue lengths
+        times = [t for t, _ in points] + [trace.sim_seconds]
+        values = np.array([v for _, v in points] + [points[-1][1]], dtype=float).reshape(len(times), -1)
+        for j in range(values.shape[1]):
+            ax.step(times, values[:, j], where="post", label=f"{j}")
+        ax.set(xlabel="sim time [s]", ylabel=name.replace("_", " "), title=name.replace("_", " "))
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out, dpi=100)
     plt.close(fig)
     return out
-
-
-def planned_paths(scenario) -> list[np.ndarray]:
-    """The spirals the search behaviours plan: one per robot (DDSA) or per region (MDBSA);
-    empty for the other behaviours. Built by the behaviours' own code, not re-derived."""
-    behaviour = scenario.controller.behaviour
-    if behaviour == "ddsa":
-        from swarm_controllers.ddsa import DdsaBehaviour
-
-        rng = np.random.default_rng(0)
-        return [DdsaBehaviour(scenario, r, rng).path.waypoints for r in scenario.robot_names]
-    if behaviour in ("mdbsa_c", "mdbsa_d"):
-        from swarm_controllers.center import region_paths
-
-        return [p.waypoints for p in region_paths(scenario)]
-    return []
 
 
 def plot_trajectories(path: Path | str, out: Path, *, start: float = 0.0, end: float | None = None) -> Path:
@@ -76,9 +62,10 @@ def plot_trajectories(path: Path | str, out: Path, *, start: float = 0.0, end: f
     fig, ax = plt.subplots(figsize=(8, 8))
     half = scenario.arena.size / 2
     ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="black", lw=1)
-    for waypoints in planned_paths(scenario):
+    paths = registry.of(scenario).paths
+    for waypoints in (registry.resolve(paths)(scenario) if paths else []):
         ax.plot(waypoints[:, 0], waypoints[:, 1], color="0.75", lw=0.6)
-    for zone in scenario.all_drop_zones():
+    for zone in drop_zones(scenario):
         ax.add_patch(plt.Circle(zone.center, zone.radius, color="tab:green", alpha=0.3))
     cmap = plt.get_cmap("tab10")
     for i, (robot, rows) in enumerate(odometry_rows.items()):

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm_msgs_py import diagnostics, odometry, server_state, topics
+from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_sim import registry
 from swarm_msgs_py import clock as clock_codec
 from swarm_sim.bag import BagError, bag_info, read_bag
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
@@ -33,6 +34,7 @@ def load_run(path: Path | str) -> RunTrace:
         sim_seconds=float(meta.get("sim_seconds", 0.0)), wall_seconds=float(meta.get("wall_seconds", 0.0)),
         total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
     )
+    replayers = [registry.resolve(s.replay) for s in registry.of(scenario).servers if s.replay]
     index = {r: i for i, r in enumerate(trace.robots)}
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
     last_clock = 0
@@ -44,9 +46,10 @@ def load_run(path: Path | str) -> RunTrace:
                 if stamp not in positions:
                     positions[stamp] = np.full((len(index), 2), np.nan)
                 positions[stamp][index[robot]] = (pose.x, pose.y)
-        elif m.topic == topics.DEPOT_STATE:
-            stamp, state = server_state.decode_state(m.data)
-            trace.queue_lengths.append((stamp / NS_PER_S, server_state.queue_lengths(state)))
+        elif replayers and not m.topic.startswith("/robot_"):
+            for replay in replayers:  # the servers' recorded state (a few messages per tick)
+                for name, t, value in replay(m.topic, m.data):
+                    trace.series.setdefault(name, []).append((t, value))
         elif m.topic == topics.CLOCK:
             last_clock = max(last_clock, clock_codec.decode_clock(m.data))
         elif m.topic == topics.WORLD_EVENTS:

@@ -1,5 +1,17 @@
-"""The simulated world: the `World` core (physics, robots, scan) and its world tasks."""
+"""The simulated world: the `World` core (physics, robots, scan) and its world tasks.
 
-from swarm_sim.world.core import World
+`World` is imported on first use, so that importing a task's sense type (as the controller
+processes do) does not load pybullet.
+"""
+
+from typing import Any
 
 __all__ = ["World"]
+
+
+def __getattr__(name: str) -> Any:
+    if name == "World":
+        from swarm_sim.world.core import World
+
+        return World
+    raise AttributeError(name)

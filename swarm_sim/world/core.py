@@ -18,17 +18,17 @@ adds the vz that returns the body to z = height/2. Robot-robot contact is counte
 from pybullet's contact points (distance <= CONTACT_TOLERANCE).
 
 Determinism. Everything random comes from ``numpy.random.SeedSequence(seed)``, split into
-independent streams (resources, start headings, odometry noise, respawns), so switching
-odometry noise on does not move the resources. pybullet runs with deterministic overlapping
+independent streams (start headings, odometry noise, and two for the world task: for foraging
+resources and respawns), so switching odometry noise on does not move the resources. pybullet runs with deterministic overlapping
 pairs and a fresh simulation per `reset`, so the same seed and the same command sequence give
 bit-identical observations.
 
 Order within a tick: commands are applied (missing robot: previous command; NaN/inf -> 0 and
 above-limit -> limit, both counted in ``stats.clamped_commands``), the physics substeps run
 (robot-robot contacts counted each substep), the pose is read, odometry is integrated, then
-robots are processed in index order: a carrying robot may drop, an empty one may pick up.
-Events are stamped with the new tick's time, which is also the stamp of the observations
-`step` returns.
+the world task does its bookkeeping (`swarm_sim.world.tasks`; foraging: drops and pick-ups,
+robots in index order). Its events are stamped with the new tick's time, which is also the
+stamp of the observations `step` returns.
 """
 
 from __future__ import annotations
@@ -46,17 +46,9 @@ import pybullet as p
 
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
-from swarm_sim.world.resources import place_one, place_resources
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import (
-    Command,
-    DropEvent,
-    Observation,
-    PickupEvent,
-    Pose2D,
-    RobotId,
-    RobotStats,
-)
+from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.tasks import TaskFactory, WorldTask
 
 ROBOT_MASS = 1.0
 """[kg]; only the ratio between robots matters (they all weigh the same)."""
@@ -129,17 +121,17 @@ def _observation_factory():
     ordinary constructor (test_world checks both give equal objects).
     """
     expected = ("robot", "stamp_ns", "pose", "linear_velocity", "angular_velocity", "ranges",
-                "resources", "carrying", "messages")
+                "sensed", "messages")
     fields = tuple(f.name for f in dataclasses.fields(Observation))
     plain = hasattr(Observation, "__slots__") and not hasattr(Observation, "__post_init__")
     if fields != expected or not plain:
         return lambda *values: Observation(*values)
-    robot, stamp, pose, lin, ang, ranges, res, carrying, messages = (
+    robot, stamp, pose, lin, ang, ranges, sensed, messages = (
         getattr(Observation, name).__set__ for name in expected
     )
     new = object.__new__
 
-    def make(r, s, q, v, w, g, d, c, m):  # noqa: PLR0913 - one argument per field
+    def make(r, s, q, v, w, g, d, m):  # noqa: PLR0913 - one argument per field
         o = new(Observation)
         robot(o, r)
         stamp(o, s)
@@ -147,8 +139,7 @@ def _observation_factory():
         lin(o, v)
         ang(o, w)
         ranges(o, g)
-        res(o, d)
-        carrying(o, c)
+        sensed(o, d)
         messages(o, m)
         return o
 
@@ -178,10 +169,15 @@ class World:
     """One object owns the pybullet client (p.DIRECT) and passes its id to every call.
 
     Crazyswarm2-like backend: ``step(commands) -> observations``; PettingZoo-like dicts keyed by
-    robot. `scan_threads` is rayTestBatch's numThreads for the pybullet scan backend.
+    robot. The experiment's world logic is the `task` (default: the one the scenario's
+    algorithm registers), rebuilt with the world at every reset. `scan_threads` is
+    rayTestBatch's numThreads for the pybullet scan backend.
     """
 
-    def __init__(self, scenario: Scenario, seed: int | None = None, *, scan_threads: int = 1) -> None:
+    def __init__(
+        self, scenario: Scenario, seed: int | None = None, *, task: TaskFactory | None = None,
+        scan_threads: int = 1,
+    ) -> None:
         tune_malloc()
         self.scenario = scenario
         self.seed = scenario.seed if seed is None else seed
@@ -201,12 +197,11 @@ class World:
         self._noisy = noise.linear_std != 0.0 or noise.angular_std != 0.0
         self._scene = StaticScene.from_scenario(scenario)
         self._scan_threads = scan_threads
-        zones = scenario.all_drop_zones()
-        self._zones = zones
-        self._zone_xy = np.array([z.center for z in zones], dtype=float).reshape(-1, 2)
-        self._zone_r2 = np.array([z.radius**2 for z in zones])
-        self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
-        self._ground_version = 0
+        if task is None:
+            from swarm_sim.registry import task_factory
+
+            task = task_factory(scenario)
+        self._task_factory = task
         with _quiet_stdout():
             self._client: int | None = p.connect(p.DIRECT)
         try:
@@ -228,10 +223,11 @@ class World:
             deterministicOverlappingPairs=1, numSolverIterations=SOLVER_ITERATIONS,
             contactERP=CONTACT_ERP, physicsClientId=cid,
         )
+        # Four independent streams of the run's seed: the start headings, the odometry noise and
+        # two that belong to the task (for foraging: resource placement and respawns).
         seeds = np.random.SeedSequence(self.seed).spawn(4)
-        rng_resources, rng_start, self._rng_odometry, self._rng_respawn = (
-            np.random.default_rng(x) for x in seeds
-        )
+        rng_start, self._rng_odometry = (np.random.default_rng(x) for x in seeds[1:3])
+        task_seeds = (seeds[0], seeds[3])
 
         # Robots first, so their body ids are 0..n-1.
         n = self._n
@@ -280,26 +276,17 @@ class World:
                 )
                 p.createMultiBody(0.0, col, -1, [o.center[0], o.center[1], self._z0], physicsClientId=cid)
 
-        # Resources: every resource ever placed keeps its index; `_on_ground` says where it is.
-        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, s.all_drop_zones())
-        self._on_ground = np.ones(len(self._res_xy), dtype=bool)
-        self._ground_changed()
-
         self._v = np.zeros(n)
         self._w = np.zeros(n)
-        self._carrying = np.full(n, -1, dtype=np.int64)
-        self._inside_ticks = np.zeros((n, len(self._zones)), dtype=np.int64)
         self._contact_substeps = np.zeros(n, dtype=np.int64)
         self.stats: dict[RobotId, RobotStats] = {r: RobotStats() for r in self.robots}
-        self._events: list[PickupEvent | DropEvent] = []
-        self.resources_delivered = 0
         self.tick = 0
         self._read_state()
         self._odo = np.column_stack([self._pos, self._yaw])
         self._meas_v = np.zeros(n)
         self._meas_w = np.zeros(n)
         self._obs_cache: dict[RobotId, Observation] | None = None
-        self._near_cache: tuple[int, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self.task: WorldTask = self._task_factory(self, task_seeds)
         self._fresh = True
 
     def _static_box(
@@ -347,14 +334,19 @@ class World:
             )
             self._z[i] = self._z0
 
-    def _ground_changed(self) -> None:
-        """Refresh the ground index after a pick-up or a respawn."""
-        self._ground_ids = np.nonzero(self._on_ground)[0]
-        self._ground_xy = self._res_xy[self._ground_ids]
-        self._ground_by_x = np.argsort(self._ground_xy[:, 0], kind="stable")
-        self._ground_x_sorted = self._ground_xy[self._ground_by_x, 0]
-        self._ground_version += 1
-        self._near_cache = None
+    @property
+    def positions(self) -> np.ndarray:
+        """(n, 2) true robot positions [m, world frame] in robot order (read-only view for tasks)."""
+        return self._pos
+
+    @property
+    def dt_ns(self) -> int:
+        """The control tick [ns]."""
+        return self._dt_ns
+
+    def drain_events(self) -> list:
+        """The task's events since the last drain (pick-ups, drops, ...), in order."""
+        return self.task.drain_events()
 
     @property
     def t_ns(self) -> int:
@@ -385,7 +377,7 @@ class World:
         self._physics()
         self._read_state()
         self._odometry(pos0, yaw0)
-        self._gripper((self.tick + 1) * self._dt_ns)
+        self.task.post_step((self.tick + 1) * self._dt_ns)
         self.tick += 1
         return self.observe()
 
@@ -462,101 +454,6 @@ class World:
         self._meas_v = forward / self._dt
         self._meas_w = turn / self._dt
 
-    def _near_resources(self, radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(robot index, ground index, squared distance) of ground resources within `radius` of a
-        robot centre, sorted by robot, then distance, then resource index."""
-        if len(self._ground_ids) == 0:
-            empty = np.zeros(0, dtype=np.int64)
-            return empty, empty, np.zeros(0)
-        rx = self._pos[:, 0]
-        lo = np.searchsorted(self._ground_x_sorted, rx - radius, side="left")
-        hi = np.searchsorted(self._ground_x_sorted, rx + radius, side="right")
-        count = hi - lo
-        total = int(count.sum())
-        if total == 0:
-            empty = np.zeros(0, dtype=np.int64)
-            return empty, empty, np.zeros(0)
-        robot = np.repeat(np.arange(self._n), count)
-        starts = np.cumsum(count) - count
-        g = self._ground_by_x[np.arange(total) - starts[robot] + lo[robot]]
-        dx = self._ground_xy[g, 0] - rx[robot]
-        dy = self._ground_xy[g, 1] - self._pos[robot, 1]
-        d2 = dx * dx + dy * dy
-        keep = d2 <= radius * radius
-        robot, g, d2 = robot[keep], g[keep], d2[keep]
-        order = np.lexsort((g, d2, robot))  # ground order is resource-index order
-        return robot[order], g[order], d2[order]
-
-    def _near_cached(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """`_near_resources` for the larger of the detection and pick-up radii, once per state."""
-        key = self._ground_version
-        if self._near_cache is None or self._near_cache[0] != key:
-            sensors = self.scenario.sensors
-            radius = max(sensors.resource_detection_radius, sensors.pickup_radius)
-            self._near_cache = (key, *self._near_resources(radius))
-        return self._near_cache[1:]
-
-    def _gripper(self, stamp_ns: int) -> None:
-        """Drops and pick-ups for the tick that ends at `stamp_ns`, robots in index order."""
-        self._near_cache = None  # the robots moved
-        carrying = self._carrying >= 0
-        # Dwell: consecutive ticks a carrying robot has been seen inside each zone (the rows of
-        # robots that carry nothing stay zero).
-        droppers = np.zeros(0, dtype=np.int64)
-        ready = np.zeros((0, len(self._zones)), dtype=bool)
-        if carrying.any():
-            holders = np.flatnonzero(carrying)
-            dz = self._pos[holders, None, :] - self._zone_xy[None, :, :]
-            inside = dz[..., 0] ** 2 + dz[..., 1] ** 2 <= self._zone_r2[None, :]
-            ticks = np.where(inside, self._inside_ticks[holders] + 1, 0)
-            self._inside_ticks[holders] = ticks
-            ready_rows = (ticks > 0) & ((ticks - 1) * self._dt_ns >= self._zone_dwell_ns)
-            some = ready_rows.any(axis=1)
-            droppers, ready = holders[some], ready_rows[some]
-
-        robot, g, d2 = self._near_cached()
-        candidate = (d2 <= self.scenario.sensors.pickup_radius ** 2) & ~carrying[robot]
-        pickers = robot[candidate]
-        if len(droppers) == 0 and len(pickers) == 0:
-            return
-        zone_of = {int(i): self._zones[int(np.argmax(row))] for i, row in zip(droppers, ready)}
-
-        taken: set[int] = set()
-        changed = False
-        for i in sorted(set(droppers.tolist()) | set(pickers.tolist())):
-            name = self.robots[i]
-            x, y = float(self._pos[i, 0]), float(self._pos[i, 1])
-            if carrying[i]:
-                zone = zone_of[i]
-                resource = int(self._carrying[i])
-                self._carrying[i] = -1
-                self._inside_ticks[i] = 0
-                self._events.append(DropEvent(name, stamp_ns, resource, zone.name, x, y))
-                self.resources_delivered += 1
-                self.stats[name].deliveries += 1
-                if self.scenario.resources.respawn:
-                    s = self.scenario
-                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy, s.all_drop_zones())
-                    self._res_xy = np.vstack([self._res_xy, new[None, :]])
-                    self._on_ground = np.append(self._on_ground, True)
-                    changed = True
-            else:
-                mine = np.nonzero((robot == i) & candidate)[0]
-                for k in mine.tolist():
-                    resource = int(self._ground_ids[g[k]])
-                    if resource in taken:
-                        continue
-                    taken.add(resource)
-                    self._carrying[i] = resource
-                    self._on_ground[resource] = False
-                    rx, ry = self._res_xy[resource]
-                    self._events.append(PickupEvent(name, stamp_ns, resource, float(rx), float(ry)))
-                    self.stats[name].pickups += 1
-                    changed = True
-                    break
-        if changed:
-            self._ground_changed()
-
     def observe(self) -> dict[RobotId, Observation]:
         """Observations for the current tick (wire-rounded; messages=())."""
         if self._obs_cache is not None:
@@ -573,43 +470,20 @@ class World:
         ranges.flags.writeable = False
         rows = list(ranges)
 
-        detected: list[tuple[tuple[float, float], ...]] = [()] * self._n
-        robot, g, d2 = self._near_cached()
-        if len(robot):
-            keep = d2 <= self.scenario.sensors.resource_detection_radius ** 2
-            robot, g = robot[keep].tolist(), self._ground_xy[g[keep]].tolist()
-            start = 0
-            for k in range(1, len(robot) + 1):
-                if k == len(robot) or robot[k] != robot[start]:
-                    detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
-                    start = k
-
+        sensed = self.task.sense()
         stamp = self.t_ns
         xs = self._odo[:, 0].tolist()
         ys = self._odo[:, 1].tolist()
         yaws = self._odo[:, 2].tolist()
         vs = self._meas_v.tolist()
         ws = self._meas_w.tolist()
-        carrying = (self._carrying >= 0).tolist()
         new = _new_observation
         obs = {
-            r: new(
-                r, stamp, Pose2D(xs[i], ys[i], _wire_yaw(yaws[i])), vs[i], ws[i], rows[i],
-                detected[i], carrying[i], (),
-            )
+            r: new(r, stamp, Pose2D(xs[i], ys[i], _wire_yaw(yaws[i])), vs[i], ws[i], rows[i], sensed[i], ())
             for i, r in enumerate(self.robots)
         }
         self._obs_cache = obs
         return dict(obs)
-
-    def drain_events(self) -> list[PickupEvent | DropEvent]:
-        """Pick-up and drop events since the last drain, in the order they happened."""
-        events, self._events = self._events, []
-        return events
-
-    def resource_positions(self) -> np.ndarray:
-        """(M, 2) positions of the resources lying on the ground [m, world frame]."""
-        return self._ground_xy.copy()
 
     def true_poses(self) -> dict[RobotId, Pose2D]:
         """Ground-truth poses [m, rad; world frame] (the observed odometry may be noisy)."""
@@ -627,11 +501,6 @@ class World:
         xs, ys, yaws = self._odo[:, 0].tolist(), self._odo[:, 1].tolist(), self._odo[:, 2].tolist()
         return {r: Pose2D(xs[i], ys[i], yaws[i]) for i, r in enumerate(self.robots)}
 
-    def carried_resource(self, robot: RobotId) -> int | None:
-        """Index of the resource `robot` holds, or None."""
-        k = int(self._carrying[self._index[robot]])
-        return None if k < 0 else k
-
     def teleport(self, poses: Mapping[RobotId, Pose2D]) -> None:
         """Put robots at `poses` (at rest), for tests and scripted set-ups; odometry follows."""
         cid = self._cid
@@ -648,7 +517,7 @@ class World:
             i = self._index[robot]
             self._odo[i] = (self._pos[i, 0], self._pos[i, 1], self._yaw[i])
         self._obs_cache = None
-        self._near_cache = None
+        self.task.moved()
 
     def close(self) -> None:
         """Disconnect from pybullet (idempotent)."""

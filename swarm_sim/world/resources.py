@@ -162,7 +162,7 @@ def place_resources(
     zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
     """Initial resource positions, (cfg.count, 2) [m, world frame], deterministic per `rng`;
-    `zones`: the drop zones to keep clear (`Scenario.all_drop_zones`).
+    `zones`: the drop zones to keep clear (`swarm_sim.sites.drop_zones`).
 
     Raises ScenarioError naming the key when the layout cannot be placed.
     """

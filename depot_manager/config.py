@@ -1,0 +1,39 @@
+"""The queue strategies' scenario section (``controller.queue``), read by the depot manager and
+by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Literal
+
+if TYPE_CHECKING:
+    from swarm_sim.scenario import Scenario
+
+
+@dataclass(frozen=True)
+class QueueConfig:
+    wrapping: Literal["single", "multi"] = "multi"
+    """Queue wrapping inside the perimeter (sec. IV): single-queue or multi-queue wrapping."""
+    joining: Literal["entry", "tail"] = "entry"
+    """Endpoint finding (sec. V): entry-point joining or tail joining."""
+    lane_spacing: float = 0.20
+    """Distance between adjacent queue lanes [m] (sec. VII)."""
+    inner_rule: Literal["own", "any"] = "own"
+    """Single-queue inner-queue rules (sec. IV-A: dispatch only if no robot is between the
+    inner entry point and the dock; leave the dock only if none is between it and the exit
+    point): `own` counts the robots dispatched into that inner queue (robots of other inner
+    queues are met at intersections, FCFS, as sec. IV-D says); `any` counts every robot on its
+    cells, which on our shared ring nearly serialises the docks."""
+
+
+def check_queue(scenario: Scenario) -> None:
+    """The queue layout must fit the scenario's depot (ValueError naming the parameter)."""
+    from depot_manager.geometry import DepotGeometryConfig, make_layout
+
+    q: QueueConfig = scenario.controller.section("queue")
+    try:
+        geometry = DepotGeometryConfig.from_scenario(scenario)
+        geometry.validate()
+        make_layout(q.wrapping, geometry)
+    except ValueError as exc:
+        raise ValueError(f"controller.queue: {exc}") from None

@@ -1,0 +1,48 @@
+"""How a world task's sense travels: one topic per field, each with its ROS type and codec.
+
+The world node publishes, and a controller node subscribes to, the odometry and the scan of
+every robot plus the topics of its task's `Sensing`; a controller steps once it holds every one
+of them stamped with the same tick. The record is data, so adding a task adds no code to the
+nodes: only its sense type, its codecs and one `Sensing` value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class SenseTopic:
+    """One field of a sense on its own robot topic."""
+
+    name: str
+    """Relative topic name under the robot's namespace (``resources`` -> ``/robot_3/resources``)."""
+    type_name: str
+    """ROS type string (``geometry_msgs/msg/PoseArray``): standard types only."""
+    field: str
+    """The sense's field it carries."""
+    encode: Callable[[int, Any], bytes]
+    """(stamp_ns, value) -> CDR bytes."""
+    decode: Callable[[bytes], tuple[int, Any]]
+    """CDR bytes -> (stamp_ns, value); raises CodecError (a ValueError) on malformed bytes."""
+
+
+@dataclass(frozen=True)
+class Sensing:
+    """A task's sense type and the topics of its fields (every field on exactly one topic)."""
+
+    sense: type
+    """The sense type (a NamedTuple or frozen dataclass), built as ``sense(**fields)``."""
+    topics: tuple[SenseTopic, ...]
+
+    def __post_init__(self) -> None:
+        fields = getattr(self.sense, "_fields", None) or tuple(self.sense.__dataclass_fields__)
+        if sorted(t.field for t in self.topics) != sorted(fields):
+            raise ValueError(f"{self.sense.__name__}: topics carry {[t.field for t in self.topics]}, "
+                             f"expected each of {list(fields)} once")
+
+    def encode_all(self, stamp_ns: int, sense: Any) -> dict[str, bytes]:
+        """Topic name -> the bytes of `sense`'s field on it."""
+        return {t.name: t.encode(stamp_ns, getattr(sense, t.field)) for t in self.topics}

@@ -1,0 +1,75 @@
+"""The shipped algorithms and world tasks: one registry record each (`swarm_sim.registry`).
+
+Adding an algorithm means adding its own modules and one `register` call here (or in a plug-in
+module named by ``SWARMFORAGE_PLUGINS``); nothing else in the tree lists algorithms.
+"""
+
+from swarm_sim.registry import Algorithm, Metric, ServerSpec, TaskSpec, register, register_task
+
+register_task(TaskSpec(
+    name="foraging",
+    core="swarm_sim.world.tasks.foraging:ForagingTask",
+    sensing="swarm_msgs_py.foraging:SENSING",
+    metrics="swarm_sim.analysis.metrics:foraging_metrics",
+))
+
+_CPFA_SECTION = ("cpfa", "swarm_controllers.config:CpfaConfig")
+_SPIRAL_SECTION = ("spiral", "swarm_controllers.config:SpiralConfig")
+_CENTER = ServerSpec(
+    channel="center", core="swarm_controllers.center:CenterServer",
+    node="swarm_controllers.center_node", script="swarm-center",
+    family="swarm_msgs_py.center_protocol:CENTER",
+)
+
+register(Algorithm(
+    name="cpfa",
+    paper="Hecker & Moses 2015 (Beyond pheromones); the queue paper's baseline (queue_depot_traffic.md sec. VII)",
+    behaviour="swarm_controllers.cpfa:CpfaBehaviour",
+    config=(_CPFA_SECTION,),
+    peers=("swarm_msgs_py.pheromone:PHEROMONES",),
+    comparison="swarm_sim.compare.queue_paper:QUEUE_COMPARISON",
+))
+
+register(Algorithm(
+    name="queue",
+    paper="queue_depot_traffic.md secs. III-V: Q_SE, Q_ST, Q_ME, Q_MT",
+    behaviour="swarm_controllers.queueing:QueueBehaviour",
+    config=(_CPFA_SECTION, ("queue", "depot_manager.config:QueueConfig")),
+    checks=("depot_manager.config:check_queue",),
+    servers=(ServerSpec(
+        channel="depot", core="depot_manager.server:DepotServer", node="depot_manager.node",
+        script="swarm-depot-manager", family="swarm_msgs_py.depot_protocol:DEPOT",
+        replay="swarm_msgs_py.server_state:replay_depot_state",
+    ),),
+    peers=("swarm_msgs_py.pheromone:PHEROMONES", "swarm_msgs_py.depot_protocol:RADIO"),
+    deliveries=("docks",),
+    metrics=(
+        Metric("queue_length_mean", "depot_manager.metrics:queue_length_mean", 0.0),
+        Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
+    ),
+    comparison="swarm_sim.compare.queue_paper:QUEUE_COMPARISON",
+))
+
+register(Algorithm(
+    name="ddsa",
+    paper="mdbsa_spiral_search.md sec. III (Lu & Luna 2023): DDSA",
+    behaviour="swarm_controllers.ddsa:DdsaBehaviour",
+    config=(_SPIRAL_SECTION,),
+    checks=("swarm_controllers.config:check_spiral",),
+    paths="swarm_controllers.ddsa:planned_paths",
+    comparison="swarm_sim.compare.spiral_paper:SPIRAL_COMPARISON",
+))
+
+for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
+    register(Algorithm(
+        name=_name,
+        paper=f"mdbsa_spiral_search.md sec. IV (Lu & Luna 2023): MDBSA-{_name[-1].upper()}",
+        behaviour="swarm_controllers.mdbsa:MdbsaBehaviour",
+        config=(_SPIRAL_SECTION,),
+        checks=("swarm_controllers.config:check_spiral",),
+        servers=(_CENTER,),
+        deliveries=(_delivery,),
+        metrics=(Metric("regions", "swarm_controllers.center:region_count", None),),
+        paths="swarm_controllers.center:planned_paths",
+        comparison="swarm_sim.compare.spiral_paper:SPIRAL_COMPARISON",
+    ))

@@ -1,0 +1,242 @@
+"""The algorithm registry: one declarative record per algorithm, read by everything else.
+
+ARGoS registers its controllers and loop functions by name, rosbags keeps a table of storage
+plug-ins; here an `Algorithm` record says everything the rest of the code needs to know about
+an algorithm: its behaviour, its world task, its scenario sections and checks, the servers it
+needs, the message families its robots exchange, the drop zones it works with, its metrics, its
+planned paths and its paper comparison. The launcher, the batch runner, the nodes, the launch
+file, analysis and the comparisons read these records; no other module switches on an
+algorithm's name. The shipped records are in `swarm_sim.algorithms`.
+
+Records name code by ``"module:attribute"`` strings that are imported when first used, so the
+registry (and the scenario loader that asks it for sections) imports no algorithm package, and
+a behaviour's module loads only when a run uses it.
+
+Plug-ins: a module named in the environment variable ``SWARMFORAGE_PLUGINS`` (comma-separated)
+is imported before the registry is first read and may call `register` / `register_task`; the
+graph's child processes inherit the variable, so a plug-in algorithm runs on the graph too.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from swarm_sim.protocol import Server
+    from swarm_sim.scenario import Scenario
+
+PLUGINS_ENV = "SWARMFORAGE_PLUGINS"
+
+
+@dataclass(frozen=True)
+class ServerSpec:
+    """A node core other than the world and the robots (`swarm_sim.protocol.Server`)."""
+
+    channel: str
+    """The channel its inbound messages travel on; also its name on ``/lockstep/ack``."""
+    core: str
+    """``module:Class``, built as ``Class(scenario)``."""
+    node: str
+    """Module of its ROS node, started as ``python -m node`` (it has a ``main``)."""
+    script: str
+    """The node's console script (what the launch file starts)."""
+    family: str
+    """``module:FAMILY``: the message family (`swarm_msgs_py.records.MessageFamily`) it speaks
+    with the robots: it hears the family's messages on its channel and sends the others."""
+    replay: str | None = None
+    """``module:function`` ``(topic, data) -> [(series, t [s], value), ...]``: what its
+    recorded state topics add to a run trace's ``series`` (None: nothing)."""
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """A world task (`swarm_sim.world.tasks`)."""
+
+    name: str
+    core: str
+    """``module:Class``, built as ``Class(world, seeds)`` when the world builds tick 0."""
+    sensing: str
+    """``module:SENSING`` (`swarm_msgs_py.sensing.Sensing`): the sense's type and the topic,
+    ROS type and codec of each of its fields."""
+    metrics: str | None = None
+    """``module:function`` ``(trace) -> dict`` of the task's JSON result fields."""
+
+
+@dataclass(frozen=True)
+class Metric:
+    """A JSON result field an algorithm adds; runs of other algorithms report `default`."""
+
+    name: str
+    function: str
+    """``module:function`` ``(trace) -> value``."""
+    default: Any = None
+
+
+@dataclass(frozen=True)
+class Algorithm:
+    """Everything about one algorithm that code outside its own modules needs."""
+
+    name: str
+    """What ``controller.behaviour`` says."""
+    paper: str
+    """Where it is specified (a file of ../shared/papers and the section)."""
+    behaviour: str
+    """``module:Class``, built as ``Class(scenario, robot, rng)`` (`swarm_controllers.api.Behaviour`)."""
+    task: str = "foraging"
+    """The world task it runs in."""
+    config: tuple[tuple[str, str], ...] = ()
+    """(section, ``module:Dataclass``): its ``controller.<section>`` scenario sections."""
+    checks: tuple[str, ...] = ()
+    """``module:function`` ``(scenario) -> None`` raising ValueError naming the key at fault."""
+    servers: tuple[ServerSpec, ...] = ()
+    peers: tuple[str, ...] = ()
+    """``module:FAMILY``: message families its robots send each other (every robot hears and
+    sends all of them)."""
+    deliveries: tuple[str, ...] = ("depot",)
+    """The ``depot.delivery`` sites it works with (the drop zones it implies)."""
+    metrics: tuple[Metric, ...] = ()
+    paths: str | None = None
+    """``module:function`` ``(scenario) -> [(N, 2) waypoints]``: its planned paths, drawn
+    under the recorded trajectories (None: it plans none)."""
+    comparison: str | None = None
+    """``module:OBJECT`` (`swarm_sim.compare.comparison.Comparison`): its paper's comparison."""
+
+
+_ALGORITHMS: dict[str, Algorithm] = {}
+_TASKS: dict[str, TaskSpec] = {}
+_loaded = False
+
+
+def _load_entries() -> None:
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True
+    importlib.import_module("swarm_sim.algorithms")
+    for module in filter(None, (m.strip() for m in os.environ.get(PLUGINS_ENV, "").split(","))):
+        importlib.import_module(module)
+
+
+def register(algorithm: Algorithm) -> Algorithm:
+    """Make `algorithm` known; refuses a second record of the same name or a section name
+    already declared with another dataclass."""
+    if algorithm.name in _ALGORITHMS:
+        raise ValueError(f"algorithm {algorithm.name!r} is already registered")
+    for name, path in algorithm.config:
+        for other in _ALGORITHMS.values():
+            if dict(other.config).get(name, path) != path:
+                raise ValueError(f"section controller.{name} is already declared as {dict(other.config)[name]}")
+    _ALGORITHMS[algorithm.name] = algorithm
+    return algorithm
+
+
+def register_task(task: TaskSpec) -> TaskSpec:
+    if task.name in _TASKS:
+        raise ValueError(f"world task {task.name!r} is already registered")
+    _TASKS[task.name] = task
+    return task
+
+
+def resolve(path: str) -> Any:
+    """``"package.module:attribute"`` -> the attribute (imported on first use)."""
+    module, _, attribute = path.partition(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+def known() -> tuple[str, ...]:
+    _load_entries()
+    return tuple(sorted(_ALGORITHMS))
+
+
+def algorithms() -> tuple[Algorithm, ...]:
+    _load_entries()
+    return tuple(_ALGORITHMS[name] for name in sorted(_ALGORITHMS))
+
+
+def algorithm(name: str) -> Algorithm:
+    """The record of `name`; ValueError naming the known ones."""
+    _load_entries()
+    try:
+        return _ALGORITHMS[name]
+    except KeyError:
+        raise ValueError(
+            f"controller.behaviour: unknown behaviour {name!r} (known: {', '.join(known())})"
+        ) from None
+
+
+def of(scenario: Scenario) -> Algorithm:
+    """The algorithm a scenario runs."""
+    return algorithm(scenario.controller.behaviour)
+
+
+def task(name: str) -> TaskSpec:
+    _load_entries()
+    try:
+        return _TASKS[name]
+    except KeyError:
+        raise ValueError(f"unknown world task {name!r} (known: {', '.join(sorted(_TASKS))})") from None
+
+
+def config_sections() -> dict[str, str]:
+    """Every registered ``controller.<section>`` -> its ``module:Dataclass``."""
+    _load_entries()
+    return {name: path for a in _ALGORITHMS.values() for name, path in a.config}
+
+
+@cache
+def _section_class(path: str) -> type:
+    return resolve(path)
+
+
+def config_section(name: str) -> type:
+    """The dataclass of section ``controller.<name>``."""
+    sections = config_sections()
+    if name not in sections:
+        raise ValueError(f"no algorithm declares a section controller.{name}")
+    return _section_class(sections[name])
+
+
+def check_scenario(scenario: Scenario) -> None:
+    """The algorithm-specific half of loading a scenario: the behaviour is registered, the
+    delivery sites suit it and its own checks pass (ScenarioError naming the key)."""
+    from swarm_sim.scenario import ScenarioError
+
+    try:
+        a = of(scenario)
+        if scenario.depot.delivery not in a.deliveries:
+            raise ValueError(
+                f"depot.delivery: {a.name} delivers to {' or '.join(a.deliveries)}, "
+                f"not {scenario.depot.delivery!r}"
+            )
+        for check in a.checks:
+            resolve(check)(scenario)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+
+
+# --------------------------------------------------------------------------- building cores
+
+
+def make_behaviour(scenario: Scenario, robot: str, rng: np.random.Generator) -> Any:
+    """The behaviour of the scenario's algorithm for `robot`."""
+    from swarm_sim.types import robot_index
+
+    robot_index(robot)  # refuse ids that are not robot_<i>
+    return resolve(of(scenario).behaviour)(scenario, robot, rng)
+
+
+def make_servers(scenario: Scenario) -> dict[str, Server]:
+    """The server cores the scenario's algorithm needs, by channel."""
+    return {s.channel: resolve(s.core)(scenario) for s in of(scenario).servers}
+
+
+def task_factory(scenario: Scenario) -> Callable[..., Any]:
+    """The world task class of the scenario's algorithm."""
+    return resolve(task(of(scenario).task).core)

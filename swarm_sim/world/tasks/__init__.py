@@ -1,0 +1,61 @@
+"""World tasks: an experiment's world logic, in the manner of ARGoS loop functions.
+
+The `World` core owns physics, the robots and the scan. A task owns everything specific to one
+experiment: what it places (resources, a light, a movable object, landmarks), what each robot
+additionally senses (its *sense*: one reading per robot and tick, carried by the observation as
+``Observation.sensed``), the events it emits and its per-step bookkeeping. Foraging
+(`swarm_sim.world.tasks.foraging`) is the first task. Which task a scenario runs is the
+registered algorithm's choice (`swarm_sim.registry`); how a sense travels on the graph (one
+topic per field) is declared next to its codecs in `swarm_msgs_py`.
+
+The hooks, called by the world in this order:
+
+- construction (inside `World` building tick 0, after the robots and walls exist): place things,
+  with two seed sequences of the run's seed that belong to the task;
+- `post_step(stamp_ns)` after every tick's physics and odometry (ARGoS PostStep);
+- `sense()` when the world builds the observations of the current tick;
+- `moved()` when robots were teleported (scripted set-ups);
+- `drain_events()`, `placed()`, `progress()` for the nodes, the batch runner and markers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from swarm_sim.world.core import World
+
+
+class WorldTask(Protocol):
+    """One experiment's world logic."""
+
+    def post_step(self, stamp_ns: int) -> None:
+        """Bookkeeping for the tick that ends at `stamp_ns` (robots already moved)."""
+        ...
+
+    def sense(self) -> Sequence[Any]:
+        """Each robot's extra reading for the current tick, in the world's robot order."""
+        ...
+
+    def moved(self) -> None:
+        """Robots were put somewhere else outside a step: drop what depends on positions."""
+        ...
+
+    def drain_events(self) -> list[Any]:
+        """Events since the last drain, in the order they happened."""
+        ...
+
+    def placed(self) -> Mapping[str, np.ndarray]:
+        """Named (M, 2) point sets the task has placed in the world now [m, world frame]."""
+        ...
+
+    def progress(self) -> str:
+        """A few words for progress lines (``delivered=12``)."""
+        ...
+
+
+TaskFactory = Callable[["World", tuple[np.random.SeedSequence, np.random.SeedSequence]], WorldTask]
+"""Builds a task for a world being built: (world, the task's two seed sequences)."""

@@ -1,0 +1,209 @@
+"""The foraging task: resources on the ground, grippers, drop zones (ARGoS foraging loop functions).
+
+What it places: the scenario's resources (`swarm_sim.world.resources`), kept clear of every drop
+zone (`swarm_sim.sites.drop_zones`). What robots additionally sense (`ForagingSense`): the
+resources within the detection radius, nearest first, and whether the gripper holds one. Its
+bookkeeping after each tick, robots in index order: a carrying robot that has stayed inside a
+drop zone for the zone's dwell time drops its resource there (a `DropEvent`; respawn if the
+scenario asks); an empty robot within the pick-up radius of a resource picks up the nearest one
+(a `PickupEvent`). Events are stamped with the new tick's time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from swarm_sim.sites import drop_zones
+from swarm_sim.types import DropEvent, PickupEvent, RobotId
+from swarm_sim.world.resources import place_one, place_resources
+
+if TYPE_CHECKING:
+    from swarm_sim.world.core import World
+
+
+class ForagingSense(NamedTuple):
+    """What a foraging robot senses besides odometry and scan (a NamedTuple: built for every
+    robot on every tick, it must be cheap)."""
+
+    resources: tuple[tuple[float, float], ...]
+    """Positions of resources within the detection radius [m, world frame], nearest first."""
+    carrying: bool
+    """True while the gripper holds a resource."""
+
+
+class ForagingTask:
+    """Resources, pick-up and delivery for one world; rebuilt with it at every reset."""
+
+    def __init__(self, world: World, seeds: tuple[np.random.SeedSequence, np.random.SeedSequence]) -> None:
+        s = world.scenario
+        self._world = world
+        self._scenario = s
+        rng_resources, self._rng_respawn = (np.random.default_rng(x) for x in seeds)
+        n = len(world.robots)
+        self._zones = zones = drop_zones(s)
+        self._zone_xy = np.array([z.center for z in zones], dtype=float).reshape(-1, 2)
+        self._zone_r2 = np.array([z.radius**2 for z in zones])
+        self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
+        self._detect_r = s.sensors.resource_detection_radius
+        self._pickup_r = s.sensors.pickup_radius
+        self._ground_version = 0
+        # Every resource ever placed keeps its index; `_on_ground` says where it is.
+        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, zones)
+        self._on_ground = np.ones(len(self._res_xy), dtype=bool)
+        self._carrying = np.full(n, -1, dtype=np.int64)
+        self._inside_ticks = np.zeros((n, len(zones)), dtype=np.int64)
+        self._events: list[PickupEvent | DropEvent] = []
+        self.resources_delivered = 0
+        self._near_cache: tuple[int, np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._ground_changed()
+
+    # ------------------------------------------------------------------ the ground index
+
+    def _ground_changed(self) -> None:
+        """Refresh the ground index after a pick-up or a respawn."""
+        self._ground_ids = np.nonzero(self._on_ground)[0]
+        self._ground_xy = self._res_xy[self._ground_ids]
+        self._ground_by_x = np.argsort(self._ground_xy[:, 0], kind="stable")
+        self._ground_x_sorted = self._ground_xy[self._ground_by_x, 0]
+        self._ground_version += 1
+        self._near_cache = None
+
+    def _near_resources(self, radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(robot index, ground index, squared distance) of ground resources within `radius` of a
+        robot centre, sorted by robot, then distance, then resource index."""
+        empty = np.zeros(0, dtype=np.int64)
+        if len(self._ground_ids) == 0:
+            return empty, empty, np.zeros(0)
+        pos = self._world.positions
+        rx = pos[:, 0]
+        lo = np.searchsorted(self._ground_x_sorted, rx - radius, side="left")
+        hi = np.searchsorted(self._ground_x_sorted, rx + radius, side="right")
+        count = hi - lo
+        total = int(count.sum())
+        if total == 0:
+            return empty, empty, np.zeros(0)
+        robot = np.repeat(np.arange(len(rx)), count)
+        starts = np.cumsum(count) - count
+        g = self._ground_by_x[np.arange(total) - starts[robot] + lo[robot]]
+        dx = self._ground_xy[g, 0] - rx[robot]
+        dy = self._ground_xy[g, 1] - pos[robot, 1]
+        d2 = dx * dx + dy * dy
+        keep = d2 <= radius * radius
+        robot, g, d2 = robot[keep], g[keep], d2[keep]
+        order = np.lexsort((g, d2, robot))  # ground order is resource-index order
+        return robot[order], g[order], d2[order]
+
+    def _near_cached(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """`_near_resources` for the larger of the detection and pick-up radii, once per state."""
+        key = self._ground_version
+        if self._near_cache is None or self._near_cache[0] != key:
+            radius = max(self._detect_r, self._pickup_r)
+            self._near_cache = (key, *self._near_resources(radius))
+        return self._near_cache[1:]
+
+    # ------------------------------------------------------------------ WorldTask
+
+    def moved(self) -> None:
+        self._near_cache = None
+
+    def post_step(self, stamp_ns: int) -> None:
+        """Drops and pick-ups for the tick that ends at `stamp_ns`, robots in index order."""
+        self._near_cache = None  # the robots moved
+        pos = self._world.positions
+        carrying = self._carrying >= 0
+        # Dwell: consecutive ticks a carrying robot has been seen inside each zone (the rows of
+        # robots that carry nothing stay zero).
+        droppers = np.zeros(0, dtype=np.int64)
+        ready = np.zeros((0, len(self._zones)), dtype=bool)
+        if carrying.any():
+            holders = np.flatnonzero(carrying)
+            dz = pos[holders, None, :] - self._zone_xy[None, :, :]
+            inside = dz[..., 0] ** 2 + dz[..., 1] ** 2 <= self._zone_r2[None, :]
+            ticks = np.where(inside, self._inside_ticks[holders] + 1, 0)
+            self._inside_ticks[holders] = ticks
+            ready_rows = (ticks > 0) & ((ticks - 1) * self._world.dt_ns >= self._zone_dwell_ns)
+            some = ready_rows.any(axis=1)
+            droppers, ready = holders[some], ready_rows[some]
+
+        robot, g, d2 = self._near_cached()
+        candidate = (d2 <= self._pickup_r ** 2) & ~carrying[robot]
+        pickers = robot[candidate]
+        if len(droppers) == 0 and len(pickers) == 0:
+            return
+        zone_of = {int(i): self._zones[int(np.argmax(row))] for i, row in zip(droppers, ready)}
+        names, stats = self._world.robots, self._world.stats
+        s = self._scenario
+
+        taken: set[int] = set()
+        changed = False
+        for i in sorted(set(droppers.tolist()) | set(pickers.tolist())):
+            name = names[i]
+            x, y = float(pos[i, 0]), float(pos[i, 1])
+            if carrying[i]:
+                zone = zone_of[i]
+                resource = int(self._carrying[i])
+                self._carrying[i] = -1
+                self._inside_ticks[i] = 0
+                self._events.append(DropEvent(name, stamp_ns, resource, zone.name, x, y))
+                self.resources_delivered += 1
+                stats[name].deliveries += 1
+                if s.resources.respawn:
+                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy, self._zones)
+                    self._res_xy = np.vstack([self._res_xy, new[None, :]])
+                    self._on_ground = np.append(self._on_ground, True)
+                    changed = True
+            else:
+                mine = np.nonzero((robot == i) & candidate)[0]
+                for k in mine.tolist():
+                    resource = int(self._ground_ids[g[k]])
+                    if resource in taken:
+                        continue
+                    taken.add(resource)
+                    self._carrying[i] = resource
+                    self._on_ground[resource] = False
+                    rx, ry = self._res_xy[resource]
+                    self._events.append(PickupEvent(name, stamp_ns, resource, float(rx), float(ry)))
+                    stats[name].pickups += 1
+                    changed = True
+                    break
+        if changed:
+            self._ground_changed()
+
+    def sense(self) -> list[ForagingSense]:
+        n = len(self._world.robots)
+        detected: list[tuple[tuple[float, float], ...]] = [()] * n
+        robot, g, d2 = self._near_cached()
+        if len(robot):
+            keep = d2 <= self._detect_r ** 2
+            robot, g = robot[keep].tolist(), self._ground_xy[g[keep]].tolist()
+            start = 0
+            for k in range(1, len(robot) + 1):
+                if k == len(robot) or robot[k] != robot[start]:
+                    detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
+                    start = k
+        carrying = (self._carrying >= 0).tolist()
+        return [ForagingSense(d, c) for d, c in zip(detected, carrying)]
+
+    def drain_events(self) -> list[PickupEvent | DropEvent]:
+        events, self._events = self._events, []
+        return events
+
+    def placed(self) -> Mapping[str, np.ndarray]:
+        return {"resources": self.resource_positions()}
+
+    def progress(self) -> str:
+        return f"delivered={self.resources_delivered}"
+
+    # ------------------------------------------------------------------ queries
+
+    def resource_positions(self) -> np.ndarray:
+        """(M, 2) positions of the resources lying on the ground [m, world frame]."""
+        return self._ground_xy.copy()
+
+    def carried_resource(self, robot: RobotId) -> int | None:
+        """Index of the resource `robot` holds, or None."""
+        k = int(self._carrying[self._world.robots.index(robot)])
+        return None if k < 0 else k
