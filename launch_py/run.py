@@ -1,5 +1,6 @@
 """swarm-run: start the world node (which records the bag), the controller nodes and the
-servers the scenario needs (the center for MDBSA, the depot manager for the queue strategies).
+servers the scenario's algorithm registers (`swarm_sim.registry`: the center for MDBSA, the
+depot manager for the queue strategies).
 
 Controllers run all in one process by default; ``--controller-processes K`` spreads them over
 K processes and ``0`` gives every robot its own process, as on real hardware. DDS stays on
@@ -20,13 +21,9 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import loopback_env, private_domain_id
-from swarm_controllers.api import server_channels
 from swarm_sim.cli import add_scenario_arguments, scenario_fields
+from swarm_sim import registry
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-
-
-SERVER_MODULES = {"center": "swarm_controllers.center_node", "depot": "depot_manager.node"}
-"""The node module that hosts each server channel (see `swarm_sim.protocol`)."""
 
 
 def split_robots(robots: list[str], processes: int) -> list[list[str]]:
@@ -96,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
     bag.parent.mkdir(parents=True, exist_ok=True)
     groups = split_robots(scenario.robot_names, args.controller_processes)
     domain = args.domain_id if args.domain_id is not None else private_domain_id()
-    servers = server_channels(scenario)
+    servers = registry.of(scenario).servers
     env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ)
     common = scenario_args(args, scenario)
     print(
@@ -112,8 +109,8 @@ def main(argv: list[str] | None = None) -> int:
         for group in groups
     ]
     controllers += [
-        subprocess.Popen([*python, SERVER_MODULES[channel], *common], env=env, start_new_session=True)
-        for channel in servers
+        subprocess.Popen([*python, spec.node, *common], env=env, start_new_session=True)
+        for spec in servers
     ]
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]

@@ -18,13 +18,12 @@ def _nodes(context):
     seed = LaunchConfiguration("seed").perform(context)
     bag = LaunchConfiguration("bag").perform(context)
     common = ["--scenario", scenario, "--seed", seed, "--set", f"robots.count={robots}"]
-    from swarm_controllers.api import server_channels
+    from swarm_sim import registry
     from swarm_sim.scenario import load_scenario
 
-    servers = server_channels(load_scenario(scenario, [f"robots.count={robots}"]))
-    scripts = {"center": "swarm-center", "depot": "swarm-depot-manager"}
+    servers = registry.of(load_scenario(scenario, [f"robots.count={robots}"])).servers
     return [
-        *[ExecuteProcess(cmd=[scripts[c], *common], output="screen") for c in servers],
+        *[ExecuteProcess(cmd=[spec.script, *common], output="screen") for spec in servers],
         ExecuteProcess(cmd=["swarm-controllers", "--robots",
                             *[f"robot_{i}" for i in range(robots)], *common], output="screen"),
         ExecuteProcess(cmd=["swarm-world", *common, "--bag", bag], output="screen"),

@@ -1,7 +1,8 @@
 """A controller node: one robot's behaviour under the robot's namespace.
 
-The node caches the tick's four observation messages (odom, scan, resources, gripper) by
-stamp; when all four carry the same stamp it builds the `Observation`, hands it the messages
+The node caches the tick's observation messages (odometry, scan and the world task's sense
+topics, `swarm_msgs_py.sensing`) by stamp; when all of them carry the same stamp it builds the
+`Observation`, hands it the messages
 from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviour, publishes
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
@@ -21,13 +22,14 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_controllers.api import Behaviour, behaviour_rng, make_behaviour, server_channels
-from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, protocol, resources, scan, topics, twist
+from swarm_controllers.api import Behaviour, behaviour_rng
+from swarm_msgs_py import diagnostics, odometry, pheromone, protocol, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import CENTER, DEPOT
+from swarm_sim import registry
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import Observation, PheromoneMessage, robot_index
 
@@ -50,18 +52,20 @@ class ControllerNode(Node):
         self.robot = robot
         self.config = cfg = declare_config(self, ControllerConfig, config)
         self.scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
-        self.behaviour: Behaviour = make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
+        self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
+        algorithm = registry.of(self.scenario)
+        self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
         self.mailbox = Mailbox()
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
         self._answer = b""
         decoders = {
-            topics.ODOM: odometry.decode_odometry,
-            topics.SCAN: scan.decode_scan,
-            topics.RESOURCES: resources.decode_resources,
-            topics.GRIPPER: gripper.decode_gripper,
+            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry),
+            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan),
+            **{t.name: (t.type_name, t.decode) for t in self.sensing.topics},
         }
+        self._expected = len(decoders)
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
         self.create_subscription(
@@ -72,9 +76,9 @@ class ControllerNode(Node):
         for topic in inbound:
             self.create_subscription(topics.type_of(topic), topic, self._on_protocol, EVENTS, raw=True)
         self._protocol_pubs = {t: self.create_publisher(topics.type_of(t), t, EVENTS) for t in outbound}
-        for name, decode in decoders.items():
+        for name, (type_name, decode) in decoders.items():
             self.create_subscription(
-                topics.type_of(name), name,
+                topics.import_type(type_name), name,
                 lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
             )
         self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
@@ -92,15 +96,15 @@ class ControllerNode(Node):
             self._cmd_pub.publish(self._answer)
             return
         self._latest[name] = decoded
-        if len(self._latest) == 4 and all(v[0] == stamp for v in self._latest.values()):
+        if len(self._latest) == self._expected and all(v[0] == stamp for v in self._latest.values()):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
         _, pose, v, w = self._latest[topics.ODOM]
+        sensed = self.sensing.sense(**{t.field: self._latest[t.name][1] for t in self.sensing.topics})
         obs = Observation(
             robot=self.robot, stamp_ns=stamp_ns, pose=pose, linear_velocity=v, angular_velocity=w,
-            ranges=self._latest[topics.SCAN][1], resources=self._latest[topics.RESOURCES][1],
-            carrying=self._latest[topics.GRIPPER][1], messages=self.mailbox.take_before(stamp_ns),
+            ranges=self._latest[topics.SCAN][1], sensed=sensed, messages=self.mailbox.take_before(stamp_ns),
         )
         command = self.behaviour.step(obs)
         by_topic: dict[str, list] = defaultdict(list)
@@ -127,14 +131,14 @@ def protocol_topics(scenario: Scenario) -> tuple[tuple[str, ...], tuple[str, ...
     """(topics a controller listens to, topics it sends on) besides its own and the
     pheromones: the servers' topics when the scenario runs them, the radio for tail joining."""
     inbound, outbound = [], []
-    channels = server_channels(scenario)
+    channels = [spec.channel for spec in registry.of(scenario).servers]
     if CENTER in channels:
         inbound.append(topics.CENTER_ASSIGNMENTS)
         outbound.append(topics.CENTER_REPORTS)
     if DEPOT in channels:
         inbound.append(topics.DEPOT_GRANTS)
         outbound.append(topics.DEPOT_REPORTS)
-        if scenario.depot.joining == "tail":
+        if scenario.controller.section("queue").joining == "tail":
             inbound.append(topics.RADIO)
             outbound.append(topics.RADIO)
     return tuple(inbound), tuple(outbound)

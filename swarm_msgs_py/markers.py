@@ -4,7 +4,8 @@ Rarely published (static parts latched once, dynamic parts at a low rate), so th
 builds rclpy message objects and serializes them. Everything is in the ``world`` frame.
 
 Namespaces and ids: ``walls`` (one LINE_STRIP), ``drop_zones`` (one flat CYLINDER per zone,
-the depot first), ``obstacles`` (CUBE or CYLINDER each), ``resources`` (one SPHERE_LIST),
+the depot first), ``obstacles`` (CUBE or CYLINDER each), one SPHERE_LIST per point set the world task placed
+(``resources`` for foraging),
 ``robots`` (one CYLINDER per robot, id = robot index, orange while carrying).
 """
 
@@ -23,6 +24,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from swarm_msgs_py.cdr import split_stamp
 from swarm_sim.geometry import yaw_to_quaternion
 from swarm_sim.scenario import Scenario
+from swarm_sim.sites import drop_zones
 from swarm_sim.types import Pose2D, RobotId, robot_index
 
 WORLD_FRAME = "world"
@@ -35,7 +37,9 @@ _WALL = ColorRGBA(r=0.3, g=0.3, b=0.3, a=1.0)
 _DEPOT = ColorRGBA(r=0.2, g=0.7, b=0.2, a=0.5)
 _ZONE = ColorRGBA(r=0.2, g=0.4, b=0.9, a=0.5)
 _OBSTACLE = ColorRGBA(r=0.5, g=0.35, b=0.2, a=1.0)
-_RESOURCE = ColorRGBA(r=0.95, g=0.85, b=0.1, a=1.0)
+_PLACED = (ColorRGBA(r=0.95, g=0.85, b=0.1, a=1.0), ColorRGBA(r=0.6, g=0.3, b=0.9, a=1.0),
+           ColorRGBA(r=0.1, g=0.7, b=0.7, a=1.0))
+"""Colours of the task's point sets, in order (resources: yellow)."""
 _ROBOT = ColorRGBA(r=0.1, g=0.3, b=0.8, a=1.0)
 _ROBOT_CARRYING = ColorRGBA(r=1.0, g=0.5, b=0.0, a=1.0)
 
@@ -66,7 +70,7 @@ def static_markers(scenario: Scenario, stamp_ns: int = 0) -> list[Marker]:
     walls.points = [Point(x=x, y=y, z=0.0) for x, y in corners]
     walls.scale.x = scenario.arena.wall_thickness
     markers.append(walls)
-    for i, zone in enumerate(scenario.all_drop_zones()):
+    for i, zone in enumerate(drop_zones(scenario)):
         m = _marker(stamp_ns, "drop_zones", i, Marker.CYLINDER, _DEPOT if i == 0 else _ZONE)
         m.pose = _pose(zone.center[0], zone.center[1], 0.005)
         m.scale = Vector3(x=2 * zone.radius, y=2 * zone.radius, z=0.01)
@@ -80,14 +84,18 @@ def static_markers(scenario: Scenario, stamp_ns: int = 0) -> list[Marker]:
     return markers
 
 
-def resource_markers(positions: np.ndarray, stamp_ns: int = 0) -> list[Marker]:
-    """One SPHERE_LIST of the resources lying on the ground; `positions` (n, 2) [m, world]."""
-    m = _marker(stamp_ns, "resources", 0, Marker.SPHERE_LIST, _RESOURCE)
-    d = RESOURCE_DIAMETER
-    m.scale = Vector3(x=d, y=d, z=d)
-    pts = np.asarray(positions, dtype=float).reshape(-1, 2)
-    m.points = [Point(x=x, y=y, z=d / 2) for x, y in pts.tolist()]
-    return [m]
+def placed_markers(placed: Mapping[str, np.ndarray], stamp_ns: int = 0) -> list[Marker]:
+    """One SPHERE_LIST per point set the world task has placed (`WorldTask.placed`, e.g. the
+    resources lying on the ground), namespace = its name; (n, 2) [m, world] each."""
+    out = []
+    for k, (name, positions) in enumerate(placed.items()):
+        m = _marker(stamp_ns, name, 0, Marker.SPHERE_LIST, _PLACED[k % len(_PLACED)])
+        d = RESOURCE_DIAMETER
+        m.scale = Vector3(x=d, y=d, z=d)
+        pts = np.asarray(positions, dtype=float).reshape(-1, 2)
+        m.points = [Point(x=x, y=y, z=d / 2) for x, y in pts.tolist()]
+        out.append(m)
+    return out
 
 
 def robot_markers(
@@ -127,8 +135,8 @@ def encode_static_markers(scenario: Scenario, stamp_ns: int = 0) -> bytes:
     return serialize_markers(static_markers(scenario, stamp_ns))
 
 
-def encode_resource_markers(positions: np.ndarray, stamp_ns: int = 0) -> bytes:
-    return serialize_markers(resource_markers(positions, stamp_ns))
+def encode_placed_markers(placed: Mapping[str, np.ndarray], stamp_ns: int = 0) -> bytes:
+    return serialize_markers(placed_markers(placed, stamp_ns))
 
 
 def encode_robot_markers(
@@ -143,14 +151,14 @@ def encode_robot_markers(
 def encode_markers(
     scenario: Scenario,
     stamp_ns: int,
-    resources: np.ndarray,
+    placed: Mapping[str, np.ndarray],
     robot_poses: Mapping[RobotId, Pose2D] | np.ndarray,
     carrying: np.ndarray | None = None,
 ) -> bytes:
-    """Everything in one array: static parts, resources on the ground (M, 2), robots."""
+    """Everything in one array: static parts, what the task placed, robots."""
     return serialize_markers(
         static_markers(scenario, stamp_ns)
-        + resource_markers(resources, stamp_ns)
+        + placed_markers(placed, stamp_ns)
         + robot_markers(scenario, robot_poses, carrying, stamp_ns)
     )
 

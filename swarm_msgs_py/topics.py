@@ -20,9 +20,9 @@ RESOURCES = "resources"
 GRIPPER = "gripper"
 CMD_VEL = "cmd_vel"
 STATUS = "status"
-OBSERVATION_TOPICS = (ODOM, SCAN, RESOURCES, GRIPPER)
-"""What the world publishes to each robot every tick; a controller steps once it has all four
-stamped with the same tick."""
+"""Every tick the world publishes ODOM and SCAN to each robot, plus its task's sense topics
+(`swarm_msgs_py.sensing`; foraging: RESOURCES and GRIPPER); a controller steps once it has all of
+them stamped with the same tick."""
 
 # Absolute names.
 CLOCK = "/clock"
@@ -109,9 +109,10 @@ def type_name(msg_class: Any) -> str:
 
 
 def robot_topic(robot: RobotId, name: str) -> str:
-    """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"``."""
-    if name not in ROBOT_TOPIC_TYPES:
-        raise ValueError(f"unknown robot topic {name!r} (known: {', '.join(ROBOT_TOPIC_TYPES)})")
+    """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"`` (any relative name: tasks add
+    their own sense topics)."""
+    if not name or "/" in name:
+        raise ValueError(f"robot topic {name!r}: expected a relative name such as {ODOM!r}")
     return f"/{robot}/{name}"
 
 

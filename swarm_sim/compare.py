@@ -374,7 +374,7 @@ def spiral_plans(
         setting = {"robots": exp.robots, "resources": exp.resources, "regions": exp.regions, exp.vary: value}
         base = (
             f"robots.count={setting['robots']}",
-            f"controller.spiral.regions={setting['regions']}",
+            f"regions.count={setting['regions']}",
             f"sim.duration={exp.duration_s}",
             *resource_layout(setting["resources"], layout),
         )

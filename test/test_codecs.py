@@ -577,7 +577,7 @@ def test_markers_deserialize_with_expected_counts():
     res = np.array([[1.0, 1.0], [2.0, 2.0], [3.0, 1.0]])
     poses = np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 1.0]])
     world = deserialize_message(
-        encode_markers(scenario, 10**9 + 5, res, poses, np.array([False, True])), MarkerArray
+        encode_markers(scenario, 10**9 + 5, {"resources": res}, poses, np.array([False, True])), MarkerArray
     )
     assert len(world.markers) == 5 + 1 + 2
     spheres = [m for m in world.markers if m.type == Marker.SPHERE_LIST]
@@ -588,7 +588,7 @@ def test_markers_deserialize_with_expected_counts():
     assert (world.markers[0].header.stamp.sec, world.markers[0].header.stamp.nanosec) == (1, 5)
     # the world hands its true poses as {robot: Pose2D}: marker ids are the robot indices
     by_name = {"robot_4": Pose2D(1.0, 2.0, 0.5), "robot_2": Pose2D(-1.0, 0.0, 0.0)}
-    world = deserialize_message(encode_markers(scenario, 0, res[:0], by_name), MarkerArray)
+    world = deserialize_message(encode_markers(scenario, 0, {"resources": res[:0]}, by_name), MarkerArray)
     robots = [m for m in world.markers if m.ns == "robots"]
     assert [(m.id, m.pose.position.x) for m in robots] == [(4, 1.0), (2, -1.0)]
     assert len(world.markers) == 5 + 1 + 2

@@ -194,7 +194,7 @@ def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
         # the mdbsa scenarios are written elsewhere; the overrides must hold on the ddsa file
         s = load_scenario("ddsa", plan.overrides, **dict(plan.fields))
         assert s.arena.size == 8.0 and s.resources.distribution == layout
-        setting = {"regions": s.controller.spiral.regions, "robots": s.robots.count,
+        setting = {"regions": s.regions.count, "robots": s.robots.count,
                    "resources": s.resources.count}
         if plan.cell is None:
             assert plan.strategy == "ddsa" and experiment == 1

@@ -11,12 +11,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_controllers.api import behaviour_rng, known_behaviours, make_behaviour
+from swarm_controllers.api import behaviour_rng
+from swarm_sim.registry import known as known_behaviours
+from swarm_sim.registry import make_behaviour
 from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral import ddsa_path
 from swarm_sim.analysis.metrics import resources_delivered
-from swarm_sim.scenario import ScenarioError, SpiralConfig, load_scenario
+from swarm_controllers.config import SpiralConfig
+from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import Command, Observation, Pose2D
 
 BASE = load_scenario("ddsa", robots__count=4)
@@ -32,8 +36,8 @@ def behaviour(s=BASE, robot: str = "robot_2") -> DdsaBehaviour:
 
 
 def obs(k, x, y, yaw, *, carrying=False, resources=(), ranges=CLEAR, robot="robot_2"):
-    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, ranges, resources,
-                       carrying, ())
+    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, ranges,
+                       ForagingSense(resources, carrying), ())
 
 
 class Unicycle:
@@ -64,15 +68,15 @@ def dist_to_polyline(p: np.ndarray, pts: np.ndarray) -> float:
 def test_registered_and_config_defaults():
     assert "ddsa" in known_behaviours()
     assert BASE.controller.behaviour == "ddsa"
-    assert BASE.controller.spiral == SpiralConfig(gap=0.18, arena_margin=0.2)
-    assert load_scenario("cpfa").controller.spiral == SpiralConfig()
+    assert BASE.controller.section("spiral") == SpiralConfig(gap=0.18, arena_margin=0.2)
+    assert load_scenario("cpfa").controller.section("spiral") == SpiralConfig()
     with pytest.raises(ScenarioError, match="controller.spiral.gap"):
         load_scenario("ddsa", ["controller.spiral.gap=0"])
 
 
 def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():
     b = behaviour(robot="robot_2")
-    half = BASE.arena.size / 2 - BASE.controller.spiral.arena_margin
+    half = BASE.arena.size / 2 - BASE.controller.section("spiral").arena_margin
     np.testing.assert_allclose(b.path.waypoints, ddsa_path((0.0, 0.0), 4, 3, 0.18, half))
     assert np.all(np.abs(b.path.waypoints) <= half + 1e-9)
     with pytest.raises(ValueError):
@@ -189,7 +193,7 @@ def lane(**kw) -> LaneAvoidance:
 
 
 @settings(max_examples=200, deadline=None)
-@given(x=st.floats(-0.6, 0.6), y=st.floats(BASE.controller.spiral.gap, 0.6), side=st.sampled_from([-1, 1]))
+@given(x=st.floats(-0.6, 0.6), y=st.floats(BASE.controller.section("spiral").gap, 0.6), side=st.sampled_from([-1, 1]))
 def test_robots_on_the_next_lanes_never_block_the_lane(x, y, side):
     """Any robot whose centre is a gap or more to the side (on an adjacent lane or beyond)."""
     assert not lane().lane_blocked(circle_ranges(x, side * y))

@@ -33,7 +33,8 @@ from depot_manager.geometry import (
 )
 from depot_manager.server import DepotServer
 from swarm_sim.protocol import DepotGrant, DepotReport, ProgressReport
-from swarm_sim.scenario import DepotConfig, Scenario
+from depot_manager.config import QueueConfig
+from swarm_sim.scenario import ControllerConfig, DepotConfig, Scenario
 
 P_MIN = 0.3
 T_UNLOAD = 4
@@ -706,8 +707,9 @@ def test_heavy_single_queue_six_docks(inner_rule):
 # ------------------------------------------------------------------ server
 
 
-def _scenario(queue: str) -> Scenario:
-    return Scenario(depot=DepotConfig(delivery="docks", queue=queue))
+def _scenario(wrapping: str, **queue) -> Scenario:
+    controller = ControllerConfig(behaviour="queue").with_section("queue", QueueConfig(wrapping=wrapping, **queue))
+    return Scenario(depot=DepotConfig(delivery="docks"), controller=controller)
 
 
 def test_server_refusals_grants_history_errors():
@@ -776,7 +778,7 @@ def test_server_single_queue_layout_from_scenario():
     assert srv.layout.kind == "single" and len(srv.layout.docks) == 4
     assert srv.admission.lines()[0] == "entry_line"
     assert srv.admission.inner_rule == "own"  # the scenario's default
-    any_rule = Scenario(depot=DepotConfig(delivery="docks", queue="single", inner_rule="any"))
+    any_rule = _scenario("single", inner_rule="any")
     assert DepotServer(any_rule).admission.inner_rule == "any"
     with pytest.raises(ValueError):
         DepotServer(_scenario("none"))

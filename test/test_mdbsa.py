@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_controllers.api import make_behaviour
+from swarm_sim.registry import make_behaviour
 from swarm_controllers.center import (
     FORWARD,
     REVERSE,
@@ -31,7 +31,9 @@ from swarm_controllers.spiral import (
 )
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import CENTER, ROBOTS, DepotReport, ProgressReport, RegionAssignment
-from swarm_sim.scenario import load_scenario
+from swarm_sim.sites import drop_zones
+from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import DropEvent, Observation, PheromoneMessage, Pose2D, robot_name
 
 C = load_scenario("mdbsa_c")
@@ -39,7 +41,7 @@ D = load_scenario("mdbsa_d")
 DT, DT_NS = C.sim.dt, C.dt_ns
 CLEAR = np.full(C.sensors.scan.rays, np.inf, dtype=np.float32)
 SMALL = load_scenario(  # 2.4 m arena, 4 regions of 1.2 m: spirals of ~8 m, walked in ~1 min
-    "mdbsa_c", ["controller.spiral.regions=4"], robots__count=3, arena__size=2.4,
+    "mdbsa_c", ["regions.count=4"], robots__count=3, arena__size=2.4,
     resources__clusters=1, resources__count=16,
 )
 
@@ -61,26 +63,27 @@ def test_scenarios_are_experiment_1_with_16_regions():
     ddsa = load_scenario("ddsa")
     for s, name in ((C, "mdbsa_c"), (D, "mdbsa_d")):
         assert s.controller.behaviour == name
-        assert s.controller.spiral.regions == 16
+        assert s.regions.count == 16
         assert (s.arena, s.robots, s.resources, s.sim) == (ddsa.arena, ddsa.robots, ddsa.resources, ddsa.sim)
     assert C.depot.delivery == "depot"
-    assert [z.name for z in C.all_drop_zones()] == ["depot"]
+    assert [z.name for z in drop_zones(C)] == ["depot"]
     # MDBSA-D: the region centers are the drop zones and the depot disc is not one, so a
     # carrier crossing the depot keeps its load.
     assert D.depot.delivery == "region_centers"
-    zones = D.all_drop_zones()
+    zones = drop_zones(D)
     assert [z.name for z in zones] == [f"region_{i}" for i in range(16)]
     np.testing.assert_allclose([z.center for z in zones], region_centers(16, 8.0))
-    assert all(z.radius == D.controller.spiral.region_center_radius for z in zones)
+    assert all(z.radius == D.regions.center_radius for z in zones)
 
 
-def test_behaviour_refuses_a_scenario_with_the_wrong_drop_zones():
-    with pytest.raises(ValueError, match="region_centers"):
-        MdbsaBehaviour(C, "robot_0", None, distributed=True)
-    with pytest.raises(ValueError, match="depot.delivery: depot"):
-        MdbsaBehaviour(D, "robot_0", None, distributed=False)
+def test_a_scenario_with_the_wrong_drop_zones_is_refused():
+    with pytest.raises(ScenarioError, match="depot.delivery: mdbsa_d delivers to region_centers"):
+        load_scenario("mdbsa_d", ["depot.delivery=depot"])
+    with pytest.raises(ScenarioError, match="depot.delivery: mdbsa_c delivers to depot"):
+        load_scenario("mdbsa_c", ["depot.delivery=region_centers"])
     with pytest.raises(ValueError, match="robot_8"):
-        MdbsaBehaviour(C, "robot_8", None, distributed=False)
+        MdbsaBehaviour(C, "robot_8", None)
+    assert not MdbsaBehaviour(C, "robot_0", None).distributed and MdbsaBehaviour(D, "robot_0", None).distributed
     assert isinstance(make_behaviour(D, "robot_0", np.random.default_rng(0)), MdbsaBehaviour)
 
 
@@ -99,15 +102,15 @@ def test_region_spiral_in_a_centred_box_is_mdbsa_path(side, margin, cx, cy):
 
 @pytest.mark.parametrize("regions", [4, 16, 64])
 def test_region_paths_stay_in_their_boxes_and_cover_the_resource_area(regions):
-    s = load_scenario("mdbsa_d", [f"controller.spiral.regions={regions}"])
+    s = load_scenario("mdbsa_d", [f"regions.count={regions}"])
     paths = region_paths(s)
     bounds = region_bounds(s)
     side = region_side(regions, s.arena.size)
-    wall = s.arena.size / 2 - s.controller.spiral.arena_margin
+    wall = s.arena.size / 2 - s.controller.section("spiral").arena_margin
     for p, (lo, hi), c in zip(paths, bounds, region_centers(regions, s.arena.size)):
         np.testing.assert_allclose(p.start, c)  # eq. (3): the spiral starts at the region center
         assert np.all(p.waypoints >= lo - 1e-9) and np.all(p.waypoints <= hi + 1e-9)
-        assert np.all(np.abs(p.waypoints - c) <= side / 2 - s.controller.spiral.gap / 2 + 1e-9)
+        assert np.all(np.abs(p.waypoints - c) <= side / 2 - s.controller.section("spiral").gap / 2 + 1e-9)
         assert np.all(np.abs(p.waypoints) <= wall + 1e-9)
     # No line is walked by two regions (neighbouring outer lines are a gap apart).
     for i in range(len(paths)):
@@ -123,7 +126,7 @@ def test_region_paths_stay_in_their_boxes_and_cover_the_resource_area(regions):
 
 def test_server_and_behaviours_use_the_same_spirals():
     server = CenterServer(D)
-    b = MdbsaBehaviour(D, "robot_3", None, distributed=True)
+    b = MdbsaBehaviour(D, "robot_3", None)
     assert len(server.paths) == len(b.paths) == 16
     for p, q in zip(server.paths, b.paths):
         np.testing.assert_array_equal(p.waypoints, q.waypoints)
@@ -150,7 +153,7 @@ def test_server_hands_out_the_initial_regions_sorted_by_robot():
 
 def test_server_ignores_reports_from_out_of_range_and_other_messages():
     server = CenterServer(C)
-    r = C.controller.spiral.center_range
+    r = C.controller.section("spiral").center_range
     far = report("robot_0", x=r + 0.01)
     unknown = report("robot_99")
     bad_region = report("robot_1", region=16, s=1.0, done=False)
@@ -164,7 +167,7 @@ def test_server_ignores_reports_from_out_of_range_and_other_messages():
 
 
 def test_server_idles_robots_beyond_two_per_region_and_again_when_they_ask():
-    one = load_scenario("mdbsa_c", ["controller.spiral.regions=1"], robots__count=3)
+    one = load_scenario("mdbsa_c", ["regions.count=1"], robots__count=3)
     server = CenterServer(one)
     out = server.step(DT_NS, [report(robot_name(k)) for k in range(3)])
     length = server.paths[0].length
@@ -176,7 +179,7 @@ def test_server_idles_robots_beyond_two_per_region_and_again_when_they_ask():
 
 
 def test_server_shares_the_partners_frontier_and_reassigns_when_done():
-    s4 = load_scenario("mdbsa_c", ["controller.spiral.regions=4"], robots__count=5)
+    s4 = load_scenario("mdbsa_c", ["regions.count=4"], robots__count=5)
     server = CenterServer(s4)
     first = server.step(DT_NS, [report(robot_name(k)) for k in range(5)])
     assert [(m.region, m.direction) for m in first] == [
@@ -219,7 +222,7 @@ def test_server_answers_a_robot_once_per_tick_and_is_deterministic():
 
 
 def obs(robot, k, x, y, yaw=0.0, messages=(), carrying=False, resources=()):
-    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, CLEAR, resources, carrying,
+    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, CLEAR, ForagingSense(resources, carrying),
                        tuple(messages))
 
 
@@ -239,7 +242,7 @@ class Unicycle:
 
 
 def test_asks_at_once_when_in_range_and_again_only_after_the_retry_time():
-    b = MdbsaBehaviour(C, "robot_1", None, distributed=False)
+    b = MdbsaBehaviour(C, "robot_1", None)
     c = b.step(obs("robot_1", 0, 0.0, -0.4))
     assert (c.linear, c.angular) == (0.0, 0.0) and b.state is MdbsaState.WAITING
     assert c.messages == (ProgressReport(0, "robot_1", 0.0, -0.4, -1, 0.0, True),)
@@ -251,7 +254,7 @@ def test_asks_at_once_when_in_range_and_again_only_after_the_retry_time():
 
 
 def test_drives_into_range_before_asking():
-    b = MdbsaBehaviour(C, "robot_0", None, distributed=False)
+    b = MdbsaBehaviour(C, "robot_0", None)
     u = Unicycle(b, 1.5, 0.4, math.pi)
     for _ in range(300):
         c = u.step()
@@ -259,12 +262,12 @@ def test_drives_into_range_before_asking():
             break
     assert b.state is MdbsaState.WAITING
     (m,) = c.messages
-    assert math.hypot(m.x, m.y) <= C.controller.spiral.center_range - ASK_MARGIN + 1e-9
-    assert math.hypot(m.x, m.y) > C.controller.spiral.center_range - ASK_MARGIN - 0.05
+    assert math.hypot(m.x, m.y) <= C.controller.section("spiral").center_range - ASK_MARGIN + 1e-9
+    assert math.hypot(m.x, m.y) > C.controller.section("spiral").center_range - ASK_MARGIN - 0.05
 
 
 def test_idle_robots_wait_and_ask_again_every_idle_retry():
-    b = MdbsaBehaviour(C, "robot_2", None, distributed=False)
+    b = MdbsaBehaviour(C, "robot_2", None)
     b.step(obs("robot_2", 0, 0.4, 0.0))
     mine = RegionAssignment(DT_NS, "robot_2", -1, 0, 0.0, 0.0, False)
     other = RegionAssignment(DT_NS, "robot_3", 5, FORWARD, 0.0, 20.0, False)
@@ -280,7 +283,7 @@ def test_idle_robots_wait_and_ask_again_every_idle_retry():
 def test_a_waiting_robot_takes_only_an_answer_stamped_after_its_ask():
     """An MDBSA-C robot may ask right after a pass report whose update is still in flight;
     that update (stamped no later than the ask) must not be taken for the answer."""
-    b = MdbsaBehaviour(C, "robot_0", None, distributed=False)
+    b = MdbsaBehaviour(C, "robot_0", None)
     b.step(obs("robot_0", 3, 0.3, 0.0))  # asks, stamped tick 3
     stale = RegionAssignment(3 * DT_NS, "robot_0", 4, FORWARD, 2.0, 9.0, False)
     b.step(obs("robot_0", 4, 0.3, 0.0, messages=[stale]))
@@ -291,7 +294,7 @@ def test_a_waiting_robot_takes_only_an_answer_stamped_after_its_ask():
 
 
 def test_reverse_walk_starts_at_the_far_end_and_reports_arc_length_from_the_start():
-    b = MdbsaBehaviour(SMALL, "robot_0", None, distributed=False)
+    b = MdbsaBehaviour(SMALL, "robot_0", None)
     path = b.paths[2]
     stop = 0.4 * path.length
     u = Unicycle(b, 0.0, 0.0)
@@ -324,7 +327,7 @@ def test_reverse_walk_starts_at_the_far_end_and_reports_arc_length_from_the_star
 
 
 def test_an_update_from_the_center_moves_the_stop_toward_the_robot_only():
-    b = MdbsaBehaviour(SMALL, "robot_0", None, distributed=False)
+    b = MdbsaBehaviour(SMALL, "robot_0", None)
     L = b.paths[1].length
     b.step(obs("robot_0", 0, 0.0, 0.0))
     b.step(obs("robot_0", 2, 0.0, 0.0, messages=[RegionAssignment(DT_NS, "robot_0", 1, FORWARD, 0.0, L, False)]))
@@ -338,13 +341,13 @@ def test_an_update_from_the_center_moves_the_stop_toward_the_robot_only():
 # ---------------------------------------------------------------- a kinematic swarm with the center
 
 
-def kinematic_run(s, seconds, *, distributed=False):
+def kinematic_run(s, seconds):
     """Unicycles (no physics, no resources) + the real CenterServer, messages routed as the
     batch runner does: robots at tick k see what was stamped before k, the server runs after
     the robots."""
     server = CenterServer(s)
     robots = s.robot_names
-    bs = {r: MdbsaBehaviour(s, r, None, distributed=distributed) for r in robots}
+    bs = {r: MdbsaBehaviour(s, r, None) for r in robots}
     side = math.ceil(math.sqrt(len(robots)))
     pitch = s.robots.start_spacing
     pose = {r: [(i % side - (side - 1) / 2) * pitch, (i // side - (side - 1) / 2) * pitch, 0.0]
@@ -355,7 +358,7 @@ def kinematic_run(s, seconds, *, distributed=False):
         inbox = router.take_before(ROBOTS, t_ns)
         for r, b in bs.items():
             x, y, yaw = pose[r]
-            c = b.step(Observation(r, t_ns, Pose2D(x, y, yaw), 0.0, 0.0, CLEAR, (), False, inbox))
+            c = b.step(Observation(r, t_ns, Pose2D(x, y, yaw), 0.0, 0.0, CLEAR, ForagingSense((), False), inbox))
             for m in c.messages:
                 router.post(m)
             yaw = math.remainder(yaw + c.angular * DT, 2 * math.pi)
@@ -372,7 +375,7 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
     assert all(r.finished for r in snap) and all(not r.walkers for r in snap)
     assert server.ignored == 0
     assert all(b.state is MdbsaState.IDLE for b in bs.values())
-    assert all(math.hypot(x, y) <= SMALL.controller.spiral.center_range for x, y, _ in pose.values())
+    assert all(math.hypot(x, y) <= SMALL.controller.section("spiral").center_range for x, y, _ in pose.values())
     walks = {(r, region, d) for _, r, state, region, d in log
              if state is MdbsaState.SEARCHING}
     assert {region for _, region, _ in walks} == {0, 1, 2, 3}
@@ -428,7 +431,7 @@ def test_mdbsa_d_robots_stay_in_their_regions_and_deliver_to_their_region_center
     """8 robots, 4 regions, 180 s: robots 0-3 walk regions 0-3 from the center, robots 4-7 the
     same regions from the far end. Tolerance: while a robot works its walk (searching, carrying
     a find to the region center, resuming) it stays within its region's square + 0.3 m."""
-    s = load_scenario("mdbsa_d", ["controller.spiral.regions=4", "sim.duration=180"])
+    s = load_scenario("mdbsa_d", ["regions.count=4", "sim.duration=180"])
     run, built, log, server = _recorded_batch(monkeypatch, s)
     assert server.ignored == 0
     centers, half = region_centers(4, s.arena.size), region_side(4, s.arena.size) / 2

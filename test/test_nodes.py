@@ -134,7 +134,7 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
     peer.create_subscription(topics.type_of(topics.STATUS), "/robot_0/status",
                              lambda d: statuses.append(diagnostics.decode_status(d)), EVENTS, raw=True)
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
-            for n in topics.OBSERVATION_TOPICS}
+            for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
     laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS)
     original_step = node.behaviour.step
     node.behaviour.step = lambda obs: (inbox.append(obs.messages), original_step(obs))[1]

@@ -13,6 +13,7 @@ from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _se
 from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import NS_PER_S
 
 ROBOTS = 16
@@ -63,9 +64,9 @@ def test_only_carriers_enter_the_perimeter(run):
 
 def test_queue_lengths_are_recorded(run):
     scenario, result = run
-    lines = 1 if scenario.depot.queue == "single" else scenario.depot.docks
-    assert result.trace.queue_lengths, "the depot server recorded no queue lengths"
-    assert all(len(q) == lines for _, q in result.trace.queue_lengths)
+    lines = 1 if scenario.controller.section("queue").wrapping == "single" else scenario.depot.docks
+    assert result.trace.series["queue_lengths"], "the depot server recorded no queue lengths"
+    assert all(len(q) == lines for _, q in result.trace.series["queue_lengths"])
 
 
 def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
@@ -97,7 +98,7 @@ def test_a_non_carrier_is_steered_out_of_the_perimeter():
     from swarm_sim.types import Observation, Pose2D
 
     ranges = np.full(scenario.sensors.scan.rays, np.inf, dtype=np.float32)
-    obs = Observation("robot_0", 0, Pose2D(1.0, 0.0, math.pi), 0.0, 0.0, ranges, (), False)
+    obs = Observation("robot_0", 0, Pose2D(1.0, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), False))
     cmd = b.step(obs)  # facing the depot: turn round (outward) before driving
     assert b.phase is Phase.FORAGING
     assert abs(cmd.angular) > 0.5 and cmd.linear < 0.05

@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes
+from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
 
 ARENA = ArenaConfig(size=12.0)
@@ -149,7 +150,7 @@ def test_resources_keep_out_of_every_drop_zone(seed):
     from swarm_sim.scenario import load_scenario
 
     s = load_scenario("mdbsa_d", seed=seed)
-    zones = s.all_drop_zones()
+    zones = drop_zones(s)
     xy = place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), zones)
     for z in zones:
         d = np.hypot(xy[:, 0] - z.center[0], xy[:, 1] - z.center[1])

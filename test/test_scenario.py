@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import (
     SCENARIO_DIR,
     Scenario,
@@ -27,7 +28,7 @@ def test_overrides_and_fields():
     assert (s.robots.count, s.resources.respawn, s.sim.duration, s.seed) == (8, True, 12.5, 7)
     assert s.ticks == 125
     assert s.robot_names[:2] == ["robot_0", "robot_1"]
-    assert [z.name for z in s.all_drop_zones()] == ["depot"]
+    assert [z.name for z in drop_zones(s)] == ["depot"]
 
 
 @pytest.mark.parametrize(

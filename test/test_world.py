@@ -58,7 +58,7 @@ def test_reset_observations_at_tick_zero(make_world):
     assert list(obs) == list(w.robots) and w.tick == 0 and w.t_ns == 0
     truth = w.true_poses()
     for r, o in obs.items():
-        assert o.robot == r and o.stamp_ns == 0 and o.messages == () and not o.carrying
+        assert o.robot == r and o.stamp_ns == 0 and o.messages == () and not o.sensed.carrying
         assert type(o.pose.x) is float and type(o.pose.yaw) is float and type(o.linear_velocity) is float
         assert o.pose.x == truth[r].x and o.pose.y == truth[r].y
         assert o.pose.yaw == wire_yaw(truth[r].yaw)
@@ -78,13 +78,13 @@ def test_inlined_wire_yaw_is_bit_identical():
 def test_fast_observation_constructor_equals_the_dataclass_one():
     from swarm_sim.world.core import _new_observation
 
-    args = ("robot_1", 5, Pose2D(1.0, 2.0, 0.5), 0.1, -0.2, np.ones(3, np.float32), ((1.0, 2.0),), True, ())
+    args = ("robot_1", 5, Pose2D(1.0, 2.0, 0.5), 0.1, -0.2, np.ones(3, np.float32), ("sensed",), ())
     fast, slow = _new_observation(*args), Observation(*args)
     assert type(fast) is Observation and fast == slow
     for f in dataclasses.fields(Observation):
         assert getattr(fast, f.name) is getattr(slow, f.name)
     with pytest.raises(dataclasses.FrozenInstanceError):
-        fast.carrying = False
+        fast.sensed = None
 
 
 def test_reset_after_teleport_restores_the_start(make_world):
@@ -165,11 +165,11 @@ def test_robots_stay_upright_at_fixed_height(make_world):
 
 def test_detected_resources_are_nearest_first(make_world):
     w = make_world(scenario(1))
-    xy = w.resource_positions()
+    xy = w.task.resource_positions()
     corner = xy[np.lexsort((xy[:, 1], xy[:, 0]))[0]]  # the lower-left corner of a cluster
     at = (float(corner[0]) + 0.07, float(corner[1]) + 0.06)
     w.teleport({"robot_0": Pose2D(*at, 0.0)})
-    found = w.observe()["robot_0"].resources
+    found = w.observe()["robot_0"].sensed.resources
     # the grid points at offsets (0.1, 0.1), (0.1, 0), (0, 0.1), (0, 0) are 0.05, 0.067, 0.081 and
     # 0.092 m away: nearest first is not the order of the resource indices
     want = [(corner[0] + dx, corner[1] + dy) for dx, dy in ((0.1, 0.1), (0.1, 0.0), (0.0, 0.1), (0.0, 0.0))]
@@ -184,7 +184,7 @@ def test_detected_resources_are_nearest_first(make_world):
 def test_pick_up_and_drop_at_the_depot(make_world):
     w = make_world(scenario(1))
     obs = w.reset()
-    xy = w.resource_positions()
+    xy = w.task.resource_positions()
     n_ground = len(xy)
     target = xy[np.argmin(np.hypot(xy[:, 0], xy[:, 1]))]
     start = target * (1 - 0.4 / np.hypot(*target))  # 0.4 m short of it, towards the depot
@@ -194,26 +194,26 @@ def test_pick_up_and_drop_at_the_depot(make_world):
     for _ in range(300):
         obs = w.step({"robot_0": go_to(obs["robot_0"], (float(target[0]), float(target[1])))})
         events += w.drain_events()
-        if obs["robot_0"].carrying:
+        if obs["robot_0"].sensed.carrying:
             break
-    assert obs["robot_0"].carrying
+    assert obs["robot_0"].sensed.carrying
     (pick,) = events
     assert isinstance(pick, PickupEvent) and pick.robot == "robot_0" and pick.stamp_ns == w.t_ns
     assert math.hypot(pick.x - obs["robot_0"].pose.x, pick.y - obs["robot_0"].pose.y) <= 0.05 + 1e-9
-    assert len(w.resource_positions()) == n_ground - 1
-    assert w.carried_resource("robot_0") == pick.resource
+    assert len(w.task.resource_positions()) == n_ground - 1
+    assert w.task.carried_resource("robot_0") == pick.resource
     assert w.stats["robot_0"].pickups == 1
 
     for _ in range(1000):
         obs = w.step({"robot_0": go_to(obs["robot_0"], (0.0, 0.0))})
-        if not obs["robot_0"].carrying:
+        if not obs["robot_0"].sensed.carrying:
             break
-    assert not obs["robot_0"].carrying
+    assert not obs["robot_0"].sensed.carrying
     (drop,) = w.drain_events()
     assert isinstance(drop, DropEvent) and drop.zone == "depot" and drop.resource == pick.resource
     assert math.hypot(drop.x, drop.y) <= 0.5
-    assert w.resources_delivered == 1 and w.stats["robot_0"].deliveries == 1
-    assert len(w.resource_positions()) == n_ground - 1  # no respawn by default
+    assert w.task.resources_delivered == 1 and w.stats["robot_0"].deliveries == 1
+    assert len(w.task.resource_positions()) == n_ground - 1  # no respawn by default
     assert w.drain_events() == []
 
 
@@ -221,7 +221,7 @@ def test_an_empty_robot_in_the_depot_drops_nothing(make_world):
     w = make_world(scenario(4))
     for _ in range(20):
         w.step({})
-    assert w.drain_events() == [] and w.resources_delivered == 0
+    assert w.drain_events() == [] and w.task.resources_delivered == 0
 
 
 def test_dwell_time_and_respawn(make_world):
@@ -230,15 +230,15 @@ def test_dwell_time_and_respawn(make_world):
         scenario(1), drop_zones=(dock,), resources=dataclasses.replace(scenario(1).resources, respawn=True)
     )
     w = make_world(s)
-    n_ground = len(w.resource_positions())
-    r = w.resource_positions()[5]
+    n_ground = len(w.task.resource_positions())
+    r = w.task.resource_positions()[5]
     w.teleport({"robot_0": Pose2D(float(r[0]), float(r[1]), 0.0)})
     w.step({})
-    assert w.observe()["robot_0"].carrying
+    assert w.observe()["robot_0"].sensed.carrying
     w.teleport({"robot_0": Pose2D(3.1, 3.0, 0.0)})
     first_inside = w.tick + 1
     ticks = 0
-    while w.observe()["robot_0"].carrying:
+    while w.observe()["robot_0"].sensed.carrying:
         w.step({})
         ticks += 1
         assert ticks < 50
@@ -246,14 +246,14 @@ def test_dwell_time_and_respawn(make_world):
     assert [type(e) for e in events] == [PickupEvent, DropEvent]
     assert events[1].zone == "dock_0"
     assert events[1].stamp_ns == (first_inside + 10) * s.dt_ns  # inside for 1.0 s = 10 ticks
-    assert len(w.resource_positions()) == n_ground  # one new resource replaced the delivered one
-    assert w.resources_delivered == 1
+    assert len(w.task.resource_positions()) == n_ground  # one new resource replaced the delivered one
+    assert w.task.resources_delivered == 1
 
 
 def test_leaving_the_zone_restarts_the_dwell(make_world):
     dock = DropZoneConfig("dock_0", (3.0, 3.0), 0.3, dwell=1.0, kind="dock")
     w = make_world(dataclasses.replace(scenario(1), drop_zones=(dock,)))
-    r = w.resource_positions()[0]
+    r = w.task.resource_positions()[0]
     w.teleport({"robot_0": Pose2D(float(r[0]), float(r[1]), 0.0)})
     w.step({})
     for _ in range(3):
@@ -262,7 +262,7 @@ def test_leaving_the_zone_restarts_the_dwell(make_world):
             w.step({})
         w.teleport({"robot_0": Pose2D(4.0, 4.0, 0.0)})
         w.step({})
-    assert w.observe()["robot_0"].carrying and w.resources_delivered == 0
+    assert w.observe()["robot_0"].sensed.carrying and w.task.resources_delivered == 0
 
 
 # --------------------------------------------------------------------------- contacts
@@ -380,7 +380,7 @@ def test_noisy_odometry_drifts_from_the_truth_deterministically(make_world):
         assert 1e-4 < max(errors) < 1.0
     assert runs[0] == runs[1]
     # noise does not change where the resources are
-    assert np.array_equal(make_world(s).resource_positions(), make_world(scenario(2)).resource_positions())
+    assert np.array_equal(make_world(s).task.resource_positions(), make_world(scenario(2)).task.resource_positions())
 
 
 # --------------------------------------------------------------------------- determinism

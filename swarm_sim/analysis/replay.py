@@ -46,10 +46,6 @@ def load_run(path: Path | str) -> RunTrace:
                 if stamp not in positions:
                     positions[stamp] = np.full((len(index), 2), np.nan)
                 positions[stamp][index[robot]] = (pose.x, pose.y)
-        elif replayers and not m.topic.startswith("/robot_"):
-            for replay in replayers:  # the servers' recorded state (a few messages per tick)
-                for name, t, value in replay(m.topic, m.data):
-                    trace.series.setdefault(name, []).append((t, value))
         elif m.topic == topics.CLOCK:
             last_clock = max(last_clock, clock_codec.decode_clock(m.data))
         elif m.topic == topics.WORLD_EVENTS:
@@ -60,6 +56,10 @@ def load_run(path: Path | str) -> RunTrace:
         elif m.topic.endswith("/" + topics.STATUS):
             status = diagnostics.decode_status(m.data)
             trace.status[status.robot] = status
+        elif replayers and not m.topic.startswith("/robot_"):
+            for replay in replayers:  # the servers' recorded state (a few messages per tick)
+                for name, t, value in replay(m.topic, m.data):
+                    trace.series.setdefault(name, []).append((t, value))
     if not trace.sim_seconds:  # the run was cut off before it could write its totals
         trace.sim_seconds = last_clock / NS_PER_S
     trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)

@@ -29,14 +29,15 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from swarm_controllers.api import server_channels
 from swarm_msgs_py import ack as ack_codec
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py import diagnostics, gripper, markers, odometry, resources, scan, topics, twist
+from swarm_msgs_py import diagnostics, markers, odometry, scan, topics, twist
+from swarm_msgs_py.sensing import Sensing
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.bag import BagWriter
+from swarm_sim import registry
 from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
 from swarm_sim.world import World
@@ -92,10 +93,16 @@ class WorldNode(Node):
         self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
         self._stats_pub = self._publisher(topics.WORLD_ROBOT_STATS, STATE_LATCHED)
         self._markers_pub = self._publisher(topics.WORLD_MARKERS, STATE_LATCHED)
+        algorithm = registry.of(self.scenario)
+        self.sensing: Sensing = registry.resolve(registry.task(algorithm.task).sensing)
+        """The task's sense topics, published next to odometry and scan."""
+        obs_types = {topics.ODOM: topics.ROBOT_TOPIC_TYPES[topics.ODOM],
+                     topics.SCAN: topics.ROBOT_TOPIC_TYPES[topics.SCAN],
+                     **{t.name: t.type_name for t in self.sensing.topics}}
         self._obs_pubs = {
             r: {
-                name: self._publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP)
-                for name in topics.OBSERVATION_TOPICS
+                name: self._publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP, type_name)
+                for name, type_name in obs_types.items()
             }
             for r in self.robots
         }
@@ -104,7 +111,7 @@ class WorldNode(Node):
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self._answered: dict[str, int] = {}
         """Robot or server channel -> the last tick it answered."""
-        self.servers: tuple[str, ...] = server_channels(self.scenario)
+        self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
         """Server channels (center, depot) the barrier waits for besides the robots."""
         self._missed: dict[str, int] = dict.fromkeys((*self.robots, *self.servers), 0)
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
@@ -129,11 +136,12 @@ class WorldNode(Node):
 
     # ------------------------------------------------------------------ plumbing
 
-    def _publisher(self, topic: str, qos):
+    def _publisher(self, topic: str, qos, type_name: str | None = None):
+        type_name = type_name or topics.type_string(topic)
         self._own_topics.add(topic)
         if self.bag is not None:
-            self.bag.add_topic(topic, topics.type_string(topic), "latched" if qos is STATE_LATCHED else "reliable")
-        return self.create_publisher(topics.type_of(topic), topic, qos)
+            self.bag.add_topic(topic, type_name, "latched" if qos is STATE_LATCHED else "reliable")
+        return self.create_publisher(topics.import_type(type_name), topic, qos)
 
     def _open_bag(self, path: str) -> BagWriter:
         meta = {
@@ -212,8 +220,7 @@ class WorldNode(Node):
             encoded = {
                 topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
                 topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
-                topics.RESOURCES: resources.encode_resources(t_ns, o.resources),
-                topics.GRIPPER: gripper.encode_gripper(t_ns, o.carrying),
+                **self.sensing.encode_all(t_ns, o.sensed),
             }
             for name, data in encoded.items():
                 self._publish(pubs[name], data, topics.robot_topic(r, name), send=send)
@@ -231,7 +238,7 @@ class WorldNode(Node):
         markers_every = max(1, round(self.config.markers_period / self.scenario.sim.dt))
         if final or self.world.tick % markers_every == 0:
             data = markers.encode_markers(
-                self.scenario, t_ns, self.world.resource_positions(), self.world.true_poses()
+                self.scenario, t_ns, self.world.task.placed(), self.world.true_poses()
             )
             self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
 
@@ -345,7 +352,7 @@ class WorldNode(Node):
         stale = sum(s.stale_ticks for s in self.world.stats.values())
         print(
             f"[world] t={t:7.1f}/{self.scenario.sim.duration:.0f} s  rtf={t / max(wall, 1e-9):5.2f}x  "
-            f"delivered={self.world.resources_delivered}  stale={stale}",
+            f"{self.world.task.progress()}  stale={stale}",
             flush=True,
         )
 
