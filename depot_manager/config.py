@@ -4,7 +4,7 @@ by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII)."
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
@@ -25,12 +25,20 @@ class QueueConfig:
     queues are met at intersections, FCFS, as sec. IV-D says); `any` counts every robot on its
     cells, which on our shared ring nearly serialises the docks."""
 
+    SECTION: ClassVar[str] = "queue"
+    """Its key under ``controller`` in a scenario."""
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> QueueConfig:
+        """The scenario's ``controller.queue`` section (its defaults if not given)."""
+        return scenario.controller.section(cls.SECTION)
+
 
 def check_queue(scenario: Scenario) -> None:
     """The queue layout must fit the scenario's depot (ValueError naming the parameter)."""
     from depot_manager.geometry import DepotGeometryConfig, make_layout
 
-    q: QueueConfig = scenario.controller.section("queue")
+    q = QueueConfig.of(scenario)
     try:
         geometry = DepotGeometryConfig.from_scenario(scenario)
         geometry.validate()

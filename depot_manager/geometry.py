@@ -33,6 +33,7 @@ from typing import Literal
 import numpy as np
 
 from swarm_sim.sites import Dock, docks
+from depot_manager.config import QueueConfig
 
 ARC_STEP = 0.04
 """Maximum waypoint spacing along discretised arcs [m]; chords cut inside an arc by at most
@@ -67,7 +68,7 @@ class DepotGeometryConfig:
         d = scenario.depot
         return cls(
             depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=d.perimeter_radius,
-            docks=d.docks, lane_spacing=scenario.controller.section("queue").lane_spacing,
+            docks=d.docks, lane_spacing=QueueConfig.of(scenario).lane_spacing,
             robot_diameter=scenario.robots.diameter,
         )
 

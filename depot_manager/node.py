@@ -18,6 +18,7 @@ from swarm_msgs_py.qos import STATE_LATCHED
 from swarm_sim.protocol import DEPOT
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 from swarm_sim.types import NS_PER_S
+from depot_manager.config import QueueConfig
 
 MARKER_PERIOD = 1.0
 """Sim seconds between slot-occupancy marker updates."""
@@ -63,7 +64,7 @@ class DepotManagerNode(ServerNode):
 
     def _markers(self, stamp_ns: int, occupied) -> list:
         layout, adm = self.server.layout, self.server.admission
-        lanes = self.scenario.controller.section("queue").lane_spacing
+        lanes = QueueConfig.of(self.scenario).lane_spacing
         owned = {(line, cell) for line, cell, _ in occupied}
         cells = [(line, i, p) for line in adm.lines() for i, p in enumerate(adm.cells(line))]
         free = np.array([p for line, i, p in cells if (line, i) not in owned]).reshape(-1, 2)

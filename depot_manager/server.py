@@ -17,13 +17,14 @@ from depot_manager.admission import DepotAdmission
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from swarm_sim.protocol import DepotGrant, DepotReport
 from swarm_sim.types import NS_PER_S
+from depot_manager.config import QueueConfig
 
 
 class DepotServer:
     """Depot manager core, stepped once per tick (see `swarm_sim.protocol`)."""
 
     def __init__(self, scenario, *, lookahead: int = 8) -> None:
-        queue = scenario.controller.section("queue")
+        queue = QueueConfig.of(scenario)
         self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
         self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule)
         self.errors: list[str] = []

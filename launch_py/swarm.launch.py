@@ -11,6 +11,8 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 
+from swarm_sim.scenario import DEFAULT_SCENARIO
+
 
 def _nodes(context):
     robots = int(LaunchConfiguration("robots").perform(context))
@@ -33,7 +35,7 @@ def _nodes(context):
 def generate_launch_description():
     return LaunchDescription([
         DeclareLaunchArgument("robots", default_value="16"),
-        DeclareLaunchArgument("scenario", default_value="cpfa"),
+        DeclareLaunchArgument("scenario", default_value=DEFAULT_SCENARIO),
         DeclareLaunchArgument("seed", default_value="0"),
         DeclareLaunchArgument("bag", default_value="bags/launch_run"),
         OpaqueFunction(function=_nodes),

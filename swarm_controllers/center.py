@@ -66,6 +66,7 @@ from swarm_controllers.spiral import (
 from swarm_sim.protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, RobotId, robot_index
+from swarm_controllers.config import SpiralConfig
 
 FORWARD = 1
 """Walk from the spiral's start (region center), outward, clockwise."""
@@ -303,7 +304,7 @@ def region_bounds(scenario: Scenario) -> list[tuple[np.ndarray, np.ndarray]]:
     regions are then one gap apart, like the lines within a spiral (no stripe left between
     regions, none walked twice), and a wall keeps the same margin as in DDSA.
     """
-    sp = scenario.controller.section("spiral")
+    sp = SpiralConfig.of(scenario)
     size, regions = scenario.arena.size, scenario.regions.count
     half_side = region_side(regions, size) / 2.0 - sp.gap / 2.0
     wall = size / 2.0 - sp.arena_margin
@@ -378,7 +379,7 @@ def region_paths(scenario: Scenario) -> list[SpiralPath]:
     (``resources.margin`` = 0.3 m from the walls) is then within detection range of some
     spiral (tested for 4, 16 and 64 regions).
     """
-    sp = scenario.controller.section("spiral")
+    sp = SpiralConfig.of(scenario)
     centers = region_centers(scenario.regions.count, scenario.arena.size)
     redundant = scenario.sensors.resource_detection_radius - sp.gap / 2.0
     return [SpiralPath(region_spiral(c, lo, hi, sp.gap, redundant))
@@ -414,7 +415,7 @@ class CenterServer:
         self.assigner = RegionAssigner(self.paths, scenario.robot_names)
         cx, cy = scenario.depot.center
         self._center = (float(cx), float(cy))
-        self._range = float(scenario.controller.section("spiral").center_range)
+        self._range = float(SpiralConfig.of(scenario).center_range)
         self._told_stop: dict[RobotId, float] = {}
         self.ignored = 0
         """Reports dropped: sent out of range, from an unknown robot or about an unknown region."""

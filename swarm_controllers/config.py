@@ -8,8 +8,7 @@ key-naming errors as the world's sections, then runs the algorithm's check.
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
@@ -47,6 +46,14 @@ class CpfaConfig:
     controller of the queue paper's lab draws both once every 5 s of its 16 Hz loop. The
     behaviour applies the same hazard per second at every tick of ours."""
 
+    SECTION: ClassVar[str] = "cpfa"
+    """Its key under ``controller`` in a scenario."""
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> CpfaConfig:
+        """The scenario's ``controller.cpfa`` section (its defaults if not given)."""
+        return scenario.controller.section(cls.SECTION)
+
 
 @dataclass(frozen=True)
 class SpiralConfig:
@@ -61,10 +68,18 @@ class SpiralConfig:
     center_range: float = 0.75
     """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
 
+    SECTION: ClassVar[str] = "spiral"
+    """Its key under ``controller`` in a scenario."""
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> SpiralConfig:
+        """The scenario's ``controller.spiral`` section (its defaults if not given)."""
+        return scenario.controller.section(cls.SECTION)
+
 
 def check_spiral(scenario: Scenario) -> None:
     """Refuse spiral settings no planner can use (ValueError naming the key)."""
-    sp: SpiralConfig = scenario.controller.section("spiral")
+    sp = SpiralConfig.of(scenario)
     if not sp.gap > 0:
         raise ValueError("controller.spiral.gap: must be positive")
     if not sp.arena_margin >= 0:

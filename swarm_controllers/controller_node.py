@@ -30,13 +30,14 @@ from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import CENTER, DEPOT
 from swarm_sim import registry
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 from swarm_sim.types import Observation, PheromoneMessage, robot_index
+from depot_manager.config import QueueConfig
 
 
 @dataclass(frozen=True)
 class ControllerConfig:
-    scenario: str = "cpfa"
+    scenario: str = DEFAULT_SCENARIO
     """Scenario name or YAML path (the same one the world loads)."""
     overrides: tuple[str, ...] = ()
     seed: int = 0
@@ -138,7 +139,7 @@ def protocol_topics(scenario: Scenario) -> tuple[tuple[str, ...], tuple[str, ...
     if DEPOT in channels:
         inbound.append(topics.DEPOT_GRANTS)
         outbound.append(topics.DEPOT_REPORTS)
-        if scenario.controller.section("queue").joining == "tail":
+        if QueueConfig.of(scenario).joining == "tail":
             inbound.append(topics.RADIO)
             outbound.append(topics.RADIO)
     return tuple(inbound), tuple(outbound)
@@ -147,7 +148,7 @@ def protocol_topics(scenario: Scenario) -> tuple[tuple[str, ...], tuple[str, ...
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:
     parser = argparse.ArgumentParser(prog="swarm-controllers", description=__doc__.splitlines()[0])
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
-    parser.add_argument("--scenario", default="cpfa")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
     args, ros_args = parser.parse_known_args(argv)

@@ -78,6 +78,7 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.avoidance import AvoidThenEscape
+from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import (
@@ -157,7 +158,7 @@ class CpfaBehaviour:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
         give-up return ends at its edge. None: the depot disc (the plain CPFA)."""
-        cfg = scenario.controller.section("cpfa")
+        cfg = CpfaConfig.of(scenario)
         dt = scenario.sim.dt
         self.robot = robot
         self._rng = rng

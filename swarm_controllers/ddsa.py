@@ -67,6 +67,7 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
+from swarm_controllers.config import SpiralConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
@@ -112,7 +113,7 @@ class LaneAvoidance:
         """A robot this close to a point of its lane [m] drives onto it in lane mode: the general
         avoidance keeps it `AvoidanceConfig.distance` from everything ahead, so it could never
         reach the outer lanes (``arena_margin`` = 0.2 m from the walls) head on."""
-        self.half_width = scenario.controller.section("spiral").gap / 2.0
+        self.half_width = SpiralConfig.of(scenario).gap / 2.0
         self.yield_timeout = float(yield_timeout)
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
         self._rays = [(i, math.cos(a), abs(math.sin(a)))
@@ -191,7 +192,7 @@ class DdsaBehaviour:
         i = robot_index(robot) + 1
         if not 1 <= i <= r:
             raise ValueError(f"{robot} is not one of the scenario's {r} robots")
-        sp = scenario.controller.section("spiral")
+        sp = SpiralConfig.of(scenario)
         half = scenario.arena.size / 2.0 - sp.arena_margin
         center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self.path = SpiralPath(ddsa_path(center, r, i, sp.gap, half))

@@ -69,6 +69,7 @@ from swarm_sim.protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, RobotId
+from swarm_controllers.config import SpiralConfig
 
 ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""
@@ -138,7 +139,7 @@ class MdbsaBehaviour:
         self.distributed = scenario.depot.delivery == "region_centers"
         """MDBSA-D (each region's resources go to its centre) rather than MDBSA-C (all to the
         depot): the world's delivery sites say which."""
-        sp = scenario.controller.section("spiral")
+        sp = SpiralConfig.of(scenario)
         self.paths: list[SpiralPath] = region_paths(scenario)
         """Every region's spiral [m, world frame], as the center has them."""
         zones = {z.name: z for z in drop_zones(scenario)}

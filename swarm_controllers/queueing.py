@@ -62,6 +62,7 @@ from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_sim.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, within_range
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
+from depot_manager.config import QueueConfig
 
 KEEP_OUT_BAND = 0.25
 """Non-carriers keep this far outside the perimeter [m]."""
@@ -107,7 +108,7 @@ class QueueBehaviour:
     """One robot foraging with the CPFA and delivering through the depot's queues."""
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
-        depot, queue = scenario.depot, scenario.controller.section("queue")
+        depot, queue = scenario.depot, QueueConfig.of(scenario)
         self.robot = robot
         self._rng = rng
         self._limits = DriveLimits.from_scenario(scenario)

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from swarm_sim.scenario import DEFAULT_SCENARIO
+
 import argparse
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default="cpfa", help="scenario name or YAML path (default: cpfa)")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO,
+                        help=f"scenario name or YAML path (default: {DEFAULT_SCENARIO})")
     parser.add_argument("--robots", type=int, help="number of robots (robots.count)")
     parser.add_argument("--duration", type=float, help="sim seconds (sim.duration)")
     parser.add_argument("--seed", type=int, help="random seed (default: the scenario's)")

@@ -21,6 +21,8 @@ from typing import Any, Literal, get_args, get_origin
 import yaml
 
 SCENARIO_DIR = Path(__file__).resolve().parent / "scenarios"
+DEFAULT_SCENARIO = "cpfa"
+"""The scenario every command runs unless told otherwise (the CPFA baseline)."""
 
 
 class ScenarioError(ValueError):
@@ -202,7 +204,7 @@ class ControllerConfig:
     `section` hands it out. Sections left out of the file take their defaults.
     """
 
-    behaviour: str = "cpfa"
+    behaviour: str = DEFAULT_SCENARIO
     """The registered algorithm (`swarm_sim.registry.known`)."""
     avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
     arrival_tolerance: float = 0.1
@@ -227,7 +229,7 @@ class ControllerConfig:
 
 @dataclass(frozen=True)
 class Scenario:
-    name: str = "cpfa"
+    name: str = DEFAULT_SCENARIO
     seed: int = 0
     sim: SimConfig = field(default_factory=SimConfig)
     arena: ArenaConfig = field(default_factory=ArenaConfig)
@@ -395,7 +397,7 @@ def resolve_path(name_or_path: str) -> Path:
 
 
 def load_scenario(
-    name_or_path: str = "cpfa",
+    name_or_path: str = DEFAULT_SCENARIO,
     overrides: typing.Iterable[str] = (),
     **fields: Any,
 ) -> Scenario:

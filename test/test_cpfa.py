@@ -28,6 +28,7 @@ from swarm_controllers.cpfa import (
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, PheromoneMessage, Pose2D
+from swarm_controllers.config import CpfaConfig
 
 BASE = load_scenario("cpfa")
 DT_NS = BASE.dt_ns
@@ -37,7 +38,7 @@ MAX_W = BASE.robots.max_angular_speed
 
 
 def scenario(**cpfa: float) -> Scenario:
-    c = dataclasses.replace(BASE.controller.section("cpfa"), **cpfa)
+    c = dataclasses.replace(CpfaConfig.of(BASE), **cpfa)
     return dataclasses.replace(BASE, controller=BASE.controller.with_section("cpfa", c))
 
 
@@ -293,13 +294,13 @@ def test_uninformed_walk_turns_with_sigma_omega_every_search_step():
         cmd = b.step(world.observe())
         travelled += cmd.linear * world.dt
         world.apply(cmd)
-    assert {sigma for _, sigma in spy.sigmas} == {BASE.controller.section("cpfa").uninformed_search_variation}
-    legs = travelled / BASE.controller.section("cpfa").search_step
+    assert {sigma for _, sigma in spy.sigmas} == {CpfaConfig.of(BASE).uninformed_search_variation}
+    legs = travelled / CpfaConfig.of(BASE).search_step
     assert 0.8 * legs < len(spy.sigmas) < 1.3 * legs + 2
 
 
 def test_informed_search_sigma_decays_per_the_formula():
-    cfg = BASE.controller.section("cpfa")
+    cfg = CpfaConfig.of(BASE)
     clock = [0.0]
     s = scenario(rate_of_site_fidelity=0.0, probability_of_returning_to_nest=0.0)  # fidelity always
     spy = SpyRng(np.random.default_rng(5), clock)
@@ -386,7 +387,7 @@ def test_lays_pheromone_with_probability_pois_c_lambda_lp(c):
             (m,) = cmd.messages
             assert m == PheromoneMessage((2 * i + 1) * DT_NS, 3.0, 2.0)
             laid += 1
-    p = poisson_cdf(c, BASE.controller.section("cpfa").rate_of_laying_pheromone)
+    p = poisson_cdf(c, CpfaConfig.of(BASE).rate_of_laying_pheromone)
     assert abs(laid / n - p) < 4.5 * math.sqrt(p * (1 - p) / n) + 2 / n, (laid / n, p)
 
 
@@ -418,7 +419,7 @@ def test_follows_a_received_pheromone_and_searches_informed_there():
 
 def test_pheromone_choice_is_proportional_to_decayed_strength():
     s = scenario(rate_of_site_fidelity=1e3, rate_of_laying_pheromone=1e3)
-    lam = BASE.controller.section("cpfa").rate_of_pheromone_decay
+    lam = CpfaConfig.of(BASE).rate_of_pheromone_decay
     k_now = 1000  # 100 s
     age_old = math.log(4) / lam  # strength 0.25
     old = PheromoneMessage(k_now * DT_NS - round(age_old * NS_PER_S), -4.0, 0.0)
@@ -434,7 +435,7 @@ def test_pheromone_choice_is_proportional_to_decayed_strength():
 
 def test_weak_pheromones_are_forgotten():
     s = scenario(rate_of_site_fidelity=1e3, rate_of_laying_pheromone=1e3)
-    lam, threshold = BASE.controller.section("cpfa").rate_of_pheromone_decay, BASE.controller.section("cpfa").pheromone_threshold
+    lam, threshold = CpfaConfig.of(BASE).rate_of_pheromone_decay, CpfaConfig.of(BASE).pheromone_threshold
     too_old = math.log(1 / threshold) / lam + 1.0  # [s]
     b = behaviour(s)
     k_now = 4000
@@ -567,7 +568,7 @@ def test_after_avoiding_it_drives_one_search_step_straight_before_steering_again
     wall = CLEAR.copy()
     wall[11:14] = 0.2
     assert b.step(obs(0, yaw=away, ranges=wall)).linear == 0.0
-    ticks = math.ceil(BASE.controller.section("cpfa").search_step / (MAX_V * BASE.sim.dt) - 1e-9)
+    ticks = math.ceil(CpfaConfig.of(BASE).search_step / (MAX_V * BASE.sim.dt) - 1e-9)
     for k in range(1, ticks + 1):
         cmd = b.step(obs(k, yaw=away))
         assert (cmd.linear, cmd.angular) == (MAX_V, 0.0)

@@ -68,15 +68,15 @@ def dist_to_polyline(p: np.ndarray, pts: np.ndarray) -> float:
 def test_registered_and_config_defaults():
     assert "ddsa" in known_behaviours()
     assert BASE.controller.behaviour == "ddsa"
-    assert BASE.controller.section("spiral") == SpiralConfig(gap=0.18, arena_margin=0.2)
-    assert load_scenario("cpfa").controller.section("spiral") == SpiralConfig()
+    assert SpiralConfig.of(BASE) == SpiralConfig(gap=0.18, arena_margin=0.2)
+    assert SpiralConfig.of(load_scenario("cpfa")) == SpiralConfig()
     with pytest.raises(ScenarioError, match="controller.spiral.gap"):
         load_scenario("ddsa", ["controller.spiral.gap=0"])
 
 
 def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():
     b = behaviour(robot="robot_2")
-    half = BASE.arena.size / 2 - BASE.controller.section("spiral").arena_margin
+    half = BASE.arena.size / 2 - SpiralConfig.of(BASE).arena_margin
     np.testing.assert_allclose(b.path.waypoints, ddsa_path((0.0, 0.0), 4, 3, 0.18, half))
     assert np.all(np.abs(b.path.waypoints) <= half + 1e-9)
     with pytest.raises(ValueError):
@@ -193,7 +193,7 @@ def lane(**kw) -> LaneAvoidance:
 
 
 @settings(max_examples=200, deadline=None)
-@given(x=st.floats(-0.6, 0.6), y=st.floats(BASE.controller.section("spiral").gap, 0.6), side=st.sampled_from([-1, 1]))
+@given(x=st.floats(-0.6, 0.6), y=st.floats(SpiralConfig.of(BASE).gap, 0.6), side=st.sampled_from([-1, 1]))
 def test_robots_on_the_next_lanes_never_block_the_lane(x, y, side):
     """Any robot whose centre is a gap or more to the side (on an adjacent lane or beyond)."""
     assert not lane().lane_blocked(circle_ranges(x, side * y))

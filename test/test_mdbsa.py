@@ -35,6 +35,7 @@ from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import DropEvent, Observation, PheromoneMessage, Pose2D, robot_name
+from swarm_controllers.config import SpiralConfig
 
 C = load_scenario("mdbsa_c")
 D = load_scenario("mdbsa_d")
@@ -106,11 +107,11 @@ def test_region_paths_stay_in_their_boxes_and_cover_the_resource_area(regions):
     paths = region_paths(s)
     bounds = region_bounds(s)
     side = region_side(regions, s.arena.size)
-    wall = s.arena.size / 2 - s.controller.section("spiral").arena_margin
+    wall = s.arena.size / 2 - SpiralConfig.of(s).arena_margin
     for p, (lo, hi), c in zip(paths, bounds, region_centers(regions, s.arena.size)):
         np.testing.assert_allclose(p.start, c)  # eq. (3): the spiral starts at the region center
         assert np.all(p.waypoints >= lo - 1e-9) and np.all(p.waypoints <= hi + 1e-9)
-        assert np.all(np.abs(p.waypoints - c) <= side / 2 - s.controller.section("spiral").gap / 2 + 1e-9)
+        assert np.all(np.abs(p.waypoints - c) <= side / 2 - SpiralConfig.of(s).gap / 2 + 1e-9)
         assert np.all(np.abs(p.waypoints) <= wall + 1e-9)
     # No line is walked by two regions (neighbouring outer lines are a gap apart).
     for i in range(len(paths)):
@@ -153,7 +154,7 @@ def test_server_hands_out_the_initial_regions_sorted_by_robot():
 
 def test_server_ignores_reports_from_out_of_range_and_other_messages():
     server = CenterServer(C)
-    r = C.controller.section("spiral").center_range
+    r = SpiralConfig.of(C).center_range
     far = report("robot_0", x=r + 0.01)
     unknown = report("robot_99")
     bad_region = report("robot_1", region=16, s=1.0, done=False)
@@ -262,8 +263,8 @@ def test_drives_into_range_before_asking():
             break
     assert b.state is MdbsaState.WAITING
     (m,) = c.messages
-    assert math.hypot(m.x, m.y) <= C.controller.section("spiral").center_range - ASK_MARGIN + 1e-9
-    assert math.hypot(m.x, m.y) > C.controller.section("spiral").center_range - ASK_MARGIN - 0.05
+    assert math.hypot(m.x, m.y) <= SpiralConfig.of(C).center_range - ASK_MARGIN + 1e-9
+    assert math.hypot(m.x, m.y) > SpiralConfig.of(C).center_range - ASK_MARGIN - 0.05
 
 
 def test_idle_robots_wait_and_ask_again_every_idle_retry():
@@ -375,7 +376,7 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
     assert all(r.finished for r in snap) and all(not r.walkers for r in snap)
     assert server.ignored == 0
     assert all(b.state is MdbsaState.IDLE for b in bs.values())
-    assert all(math.hypot(x, y) <= SMALL.controller.section("spiral").center_range for x, y, _ in pose.values())
+    assert all(math.hypot(x, y) <= SpiralConfig.of(SMALL).center_range for x, y, _ in pose.values())
     walks = {(r, region, d) for _, r, state, region, d in log
              if state is MdbsaState.SEARCHING}
     assert {region for _, region, _ in walks} == {0, 1, 2, 3}

@@ -15,6 +15,7 @@ from swarm_sim.analysis.metrics import summarize
 from swarm_sim.scenario import load_scenario
 from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import NS_PER_S
+from depot_manager.config import QueueConfig
 
 ROBOTS = 16
 DURATION = 150.0
@@ -64,7 +65,7 @@ def test_only_carriers_enter_the_perimeter(run):
 
 def test_queue_lengths_are_recorded(run):
     scenario, result = run
-    lines = 1 if scenario.controller.section("queue").wrapping == "single" else scenario.depot.docks
+    lines = 1 if QueueConfig.of(scenario).wrapping == "single" else scenario.depot.docks
     assert result.trace.series["queue_lengths"], "the depot server recorded no queue lengths"
     assert all(len(q) == lines for _, q in result.trace.series["queue_lengths"])
 

@@ -31,12 +31,12 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import Server
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 
 
 @dataclass(frozen=True)
 class ServerNodeConfig:
-    scenario: str = "cpfa"
+    scenario: str = DEFAULT_SCENARIO
     """Scenario name or YAML path (the same one the world loads)."""
     overrides: tuple[str, ...] = ()
     seed: int = 0
@@ -111,7 +111,7 @@ class ServerNode(Node):
 
 def parse_args(prog: str, argv: list[str]) -> tuple[ServerNodeConfig, list[str]]:
     parser = argparse.ArgumentParser(prog=prog)
-    parser.add_argument("--scenario", default="cpfa")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
     args, ros_args = parser.parse_known_args(argv)

@@ -38,7 +38,7 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.bag import BagWriter
 from swarm_sim import registry
-from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
 from swarm_sim.world import World
 
@@ -49,7 +49,7 @@ class Interrupted(Exception):
 
 @dataclass(frozen=True)
 class WorldNodeConfig:
-    scenario: str = "cpfa"
+    scenario: str = DEFAULT_SCENARIO
     """Scenario name or YAML path."""
     overrides: tuple[str, ...] = ()
     """``a.b=VALUE`` scenario overrides."""
@@ -369,7 +369,7 @@ class WorldNode(Node):
 
 def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser = argparse.ArgumentParser(prog="swarm-world", description=__doc__.splitlines()[0])
-    parser.add_argument("--scenario", default="cpfa")
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
