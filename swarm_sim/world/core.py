@@ -340,6 +340,11 @@ class World:
         return self._pos
 
     @property
+    def headings(self) -> np.ndarray:
+        """(n,) true robot yaws [rad, world frame] in robot order (read-only view for tasks)."""
+        return self._yaw
+
+    @property
     def dt_ns(self) -> int:
         """The control tick [ns]."""
         return self._dt_ns

