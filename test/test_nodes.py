@@ -110,7 +110,7 @@ def test_world_node_warns_and_ignores_unknown_robot(context, tmp_path):
         world, _, _ = run_world(context, tmp_path, lambda r, s: (0.0, 0.0))
     finally:
         stranger.destroy_node()
-    assert "/robot_99/cmd_vel" in world._recorded
+    assert "/robot_99/cmd_vel" in world.recorder.known
     assert "robot_99" not in world.world.stats
 
 

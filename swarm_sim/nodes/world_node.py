@@ -26,7 +26,6 @@ from pathlib import Path
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
@@ -35,8 +34,9 @@ from swarm_msgs_py import diagnostics, markers, odometry, scan, topics, twist
 from swarm_msgs_py.sensing import Sensing
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, SENSOR_LOCKSTEP, STATE_LATCHED
-from swarm_sim.bag import BagWriter
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.nodes.lockstep import LockstepBarrier
+from swarm_sim.nodes.recorder import Recorder
 from swarm_sim import registry
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
@@ -86,8 +86,7 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.bag = self._open_bag(cfg.bag) if cfg.bag else None
-        self._own_topics: set[str] = set()
+        self.recorder = self._open_recorder(cfg.bag) if cfg.bag else None
 
         self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
         self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
@@ -109,25 +108,19 @@ class WorldNode(Node):
         self._commands: dict[RobotId, Command] = {}
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
-        self._answered: dict[str, int] = {}
-        """Robot or server channel -> the last tick it answered."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
         """Server channels (center, depot) the barrier waits for besides the robots."""
-        self._missed: dict[str, int] = dict.fromkeys((*self.robots, *self.servers), 0)
+        self.barrier = LockstepBarrier((*self.robots, *self.servers), cfg.dead_after)
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
-            if self.bag is not None:
-                self.bag.add_topic(topic, topics.type_string(topic), "reliable")
+            self._record_topic(topic, topics.type_string(topic))
             self._cmd_subs[robot] = self.create_subscription(
                 topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
-        self._recorded: set[str] = set(self._own_topics) | set(self._cmd_topic)
         if self.servers:
-            self._recorded.add(topics.LOCKSTEP_ACK)
-            if self.bag is not None:
-                self.bag.add_topic(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK), "reliable")
+            self._record_topic(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK))
             self._ack_sub = self.create_subscription(
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
@@ -138,12 +131,18 @@ class WorldNode(Node):
 
     def _publisher(self, topic: str, qos, type_name: str | None = None):
         type_name = type_name or topics.type_string(topic)
-        self._own_topics.add(topic)
-        if self.bag is not None:
-            self.bag.add_topic(topic, type_name, "latched" if qos is STATE_LATCHED else "reliable")
+        self._record_topic(topic, type_name, latched=qos is STATE_LATCHED)
         return self.create_publisher(topics.import_type(type_name), topic, qos)
 
-    def _open_bag(self, path: str) -> BagWriter:
+    def _record_topic(self, topic: str, type_name: str, latched: bool = False) -> None:
+        if self.recorder is not None:
+            self.recorder.add(topic, type_name, latched)
+
+    def _record(self, topic: str, data: bytes) -> None:
+        if self.recorder is not None:
+            self.recorder.write(topic, data)
+
+    def _open_recorder(self, path: str) -> Recorder:
         meta = {
             "scenario_name": self.scenario.name,
             "scenario": json.dumps(scenario_to_dict(self.scenario)),
@@ -151,58 +150,40 @@ class WorldNode(Node):
             "mode": self.config.mode,
             "robots": str(len(self.world.robots)),
         }
-        return BagWriter(Path(path), metadata=meta)
+        return Recorder(self, Path(path), meta, lambda: self.world.t_ns)
 
     def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
         if send:
             pub.publish(data)
-        if self.bag is not None:
-            self.bag.write(topic, self.world.t_ns, data)
+        self._record(topic, data)
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        if self.bag is not None:
-            self.bag.write(topics.robot_topic(robot, topics.CMD_VEL), self.world.t_ns, data)
+        self._record(topics.robot_topic(robot, topics.CMD_VEL), data)
         try:
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
             self.get_logger().warning(f"{robot}: dropping malformed cmd_vel: {exc}")
             return
         self._commands[robot] = Command(linear, angular)
-        self._answered[robot] = stamp_ns
+        self.barrier.answered(robot, stamp_ns)
 
     def _on_ack(self, data: bytes) -> None:
-        if self.bag is not None:
-            self.bag.write(topics.LOCKSTEP_ACK, self.world.t_ns, data)
+        self._record(topics.LOCKSTEP_ACK, data)
         try:
             channel, stamp_ns = ack_codec.decode_ack(data)
         except ValueError as exc:
             self.get_logger().warning(f"dropping malformed lockstep ack: {exc}")
             return
-        if channel in self._missed:
-            self._answered[channel] = stamp_ns
+        self.barrier.answered(channel, stamp_ns)
 
     def _discover(self) -> None:
         """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
-        for topic, types in self.get_topic_names_and_types():
-            if topic in self._recorded or not types:
-                continue
-            self._recorded.add(topic)
-            if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
-                self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
-            msg_type = topics.import_type(types[0])
-            if msg_type is None or self.bag is None:
-                continue
-            # Latched topics (servers' state and markers) are recorded from their last message
-            # on, even one published before we subscribed.
-            latched = any(
-                info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-                for info in self.get_publishers_info_by_topic(topic)
-            )
-            self.bag.add_topic(topic, types[0], "latched" if latched else "reliable")
-            self.create_subscription(
-                msg_type, topic, lambda data, t=topic: self.bag.write(t, self.world.t_ns, data),
-                RECORD_LATCHED if latched else EVENTS, raw=True,
-            )
+        if self.recorder is not None:
+            self.recorder.discover(self._warn_unknown_commands)
+
+    def _warn_unknown_commands(self, topic: str) -> None:
+        if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
+            self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
 
     # ------------------------------------------------------------------ the loop
 
@@ -268,20 +249,20 @@ class WorldNode(Node):
         if self.stop_requested:
             raise Interrupted
         executor.spin_once(timeout_sec=timeout)
-        if self.bag is None:
+        if self.recorder is None:
             return 0.0
         t0 = time.monotonic()
-        self.bag.poll()  # flush/split on time even while the run is stalled
+        self.recorder.poll()
         return time.monotonic() - t0
 
     def _await_commands(self, executor: Executor) -> None:
         """Lockstep barrier: spin until every live controller and server answered this tick."""
         stamp = self.world.t_ns
-        waiting = [r for r in self._missed if self._missed[r] < self.config.dead_after]
+        waiting = self.barrier.live()
         now = time.monotonic()
         deadline, resend = now + self.config.tick_timeout, now + self.config.resend_period
         while True:
-            waiting = [r for r in waiting if self._answered.get(r) != stamp]
+            waiting = self.barrier.waiting(stamp, waiting)
             now = time.monotonic()
             if not waiting:
                 break
@@ -300,23 +281,19 @@ class WorldNode(Node):
             bag_time = self._spin(executor, min(0.05, max(0.0, deadline - now)))
             deadline += bag_time
             resend += bag_time
-        for r in self._missed:
-            if self._answered.get(r) == stamp:
-                self._missed[r] = 0
-            else:
-                self._missed[r] += 1
-                if r in self.world.stats:
-                    self.world.stats[r].stale_ticks += 1
-                if self._missed[r] == self.config.dead_after:
-                    self.get_logger().warning(f"{r}: no answer for {self._missed[r]} ticks, not waiting for it")
+        stale, dead = self.barrier.close_tick(stamp)
+        for r in stale:
+            if r in self.world.stats:
+                self.world.stats[r].stale_ticks += 1
+        for r in dead:
+            self.get_logger().warning(f"{r}: no answer for {self.barrier.dead_after} ticks, not waiting for it")
 
     def _await_wall(self, executor: Executor, until: float) -> None:
         while (remaining := until - time.monotonic()) > 0:
             self._spin(executor, min(0.05, remaining))
         stamp = self.world.t_ns
-        for r in self.robots:
-            if self._answered.get(r) != stamp:
-                self.world.stats[r].stale_ticks += 1
+        for r in self.barrier.waiting(stamp, self.robots):
+            self.world.stats[r].stale_ticks += 1
 
     def run(self, executor: Executor) -> None:
         cfg, sim = self.config, self.scenario.sim
@@ -357,13 +334,11 @@ class WorldNode(Node):
         )
 
     def close(self) -> None:
-        if self.bag is not None:
-            self.bag.set_metadata(
+        if self.recorder is not None:
+            self.recorder.close(
                 wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
                 sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
             )
-            self.bag.close()
-            self.bag = None
         self.world.close()
 
 

@@ -1,0 +1,72 @@
+"""The run's recorder, inside the world node: the world's own bytes plus every other topic.
+
+Like ``ros2 bag record -a``: the world writes what it publishes (and the commands and acks it
+receives) as the very bytes on the wire, and `discover` subscribes to every topic other nodes
+publish, recording each message stamped with the sim time at which it arrives. Latched topics
+(servers' state and markers) are subscribed transient-local, so their last message is recorded
+even if it was published before the recorder subscribed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy
+
+from swarm_msgs_py import topics
+from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED
+from swarm_sim.bag import BagWriter
+
+
+class Recorder:
+    """Records into one bag directory; `now_ns` gives the sim time to stamp messages with."""
+
+    def __init__(self, node: Node, path: Path, metadata: dict[str, str], now_ns: Callable[[], int]) -> None:
+        self._node = node
+        self._now_ns = now_ns
+        self.bag = BagWriter(path, metadata=metadata)
+        self.known: set[str] = set()
+        """Topics recorded already (by the world itself or by discovery)."""
+        self.closed = False
+
+    def add(self, topic: str, type_name: str, latched: bool = False) -> None:
+        """A topic the world writes itself."""
+        self.known.add(topic)
+        self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
+
+    def write(self, topic: str, data: bytes) -> None:
+        self.bag.write(topic, self._now_ns(), data)
+
+    def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
+        """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
+        node = self._node
+        for topic, types in node.get_topic_names_and_types():
+            if topic in self.known or not types:
+                continue
+            self.known.add(topic)
+            on_new(topic)
+            msg_type = topics.import_type(types[0])
+            if msg_type is None:
+                continue
+            latched = any(
+                info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
+                for info in node.get_publishers_info_by_topic(topic)
+            )
+            self.bag.add_topic(topic, types[0], "latched" if latched else "reliable")
+            node.create_subscription(
+                msg_type, topic, lambda data, t=topic: self.write(t, data),
+                RECORD_LATCHED if latched else EVENTS, raw=True,
+            )
+
+    def poll(self) -> None:
+        """Flush and split on time (call it while spinning, even when the run is stalled)."""
+        self.bag.poll()
+
+    def close(self, **metadata: str) -> None:
+        """Write the run's totals into the metadata and finish the bag (idempotent)."""
+        if not self.closed:
+            self.closed = True
+            self.bag.set_metadata(**metadata)
+            self.bag.close()

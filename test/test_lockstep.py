@@ -1,0 +1,27 @@
+"""The lockstep barrier's bookkeeping: stale and dead participants, revival on answering."""
+
+from swarm_sim.nodes.lockstep import LockstepBarrier
+
+
+def test_a_silent_participant_is_stale_every_tick_and_dead_after_n():
+    b = LockstepBarrier(["robot_0", "robot_1", "depot"], dead_after=3)
+    deaths = []
+    for k in range(5):
+        b.answered("robot_0", k)
+        b.answered("depot", k)
+        b.answered("robot_7", k)  # not a participant: ignored
+        assert b.waiting(k, b.live()) == (["robot_1"] if k < 3 else [])
+        stale, dead = b.close_tick(k)
+        assert stale == ["robot_1"]
+        deaths += dead
+    assert deaths == ["robot_1"] and b.live() == ["robot_0", "depot"]
+    for who in ("robot_0", "robot_1", "depot"):  # robot_1 answers again: waited for from now on
+        b.answered(who, 5)
+    assert b.close_tick(5) == ([], []) and b.live() == ["robot_0", "robot_1", "depot"]
+
+
+def test_an_answer_for_another_tick_does_not_count():
+    b = LockstepBarrier(["robot_0"], dead_after=2)
+    b.answered("robot_0", 4)
+    assert b.waiting(5, ["robot_0"]) == ["robot_0"]
+    assert b.close_tick(5) == (["robot_0"], [])
