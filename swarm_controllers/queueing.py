@@ -3,8 +3,8 @@
 A robot forages with the CPFA (`swarm_controllers.cpfa`) and, once it carries a resource to the
 depot's perimeter, queues under the depot manager's grants (`depot_manager.server`): the
 manager owns every queue slot, the robot only drives to the slots it was granted and reports
-each one it reaches. The scenario chooses the wrapping (``depot.queue``: single or multi) and
-the endpoint finding (``depot.joining``: entry or tail), so Q_SE = single + entry, Q_ST =
+each one it reaches. The scenario chooses the wrapping (``controller.queue.wrapping``: single or multi) and
+the endpoint finding (``controller.queue.joining``: entry or tail), so Q_SE = single + entry, Q_ST =
 single + tail, Q_ME = multi + entry, Q_MT = multi + tail.
 
 Phases of a delivery, and the choices the paper leaves open:
