@@ -48,7 +48,7 @@ setup(
             "swarm-controllers = swarm_controllers.controller_node:main",
             "swarm-center = swarm_controllers.center_node:main",
             "swarm-depot-manager = depot_manager.node:main",
-            "swarm-compare = swarm_sim.compare:main",
+            "swarm-compare = swarm_sim.compare.cli:main",
         ],
     },
 )

@@ -11,12 +11,18 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from swarm_sim import compare
-from swarm_sim.compare import (
-    PAPER_TABLE_II, QUEUE_STRATEGIES, RunPlan, main, pairwise_tests, queue_plans, queue_ttests_md,
-    read_results, resource_layout, run_sweep, slim, spiral_mannwhitney_md, spiral_plans, stars,
-    write_queue_report, write_spiral_report,
+from swarm_sim.compare import comparisons
+from swarm_sim.compare.cli import build_parser, main
+from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.queue_paper import (
+    PAPER_TABLE_II, QUEUE_STRATEGIES, queue_plans, queue_ttests_md, write_queue_report,
 )
+from swarm_sim.compare.spiral_paper import (
+    PAPER_SPIRAL_CLAIMS, SPIRAL_EXPERIMENTS, SPIRAL_STRATEGIES, resource_layout, spiral_mannwhitney_md,
+    spiral_plans, write_spiral_report,
+)
+from swarm_sim.compare.stats import pairwise_tests, stars, values_of
+from swarm_sim.compare.sweep import RunPlan, read_results, run_sweep, slim
 from swarm_sim.world.resources import place_resources
 from swarm_sim.scenario import load_scenario
 
@@ -93,7 +99,7 @@ def test_t_test_needs_two_runs_per_group():
 
 def test_runs_without_a_dropoff_time_are_left_out():
     rows = rows_for("a", 48, [1.0, 2.0]) + [{"strategy": "a", "cell": 48, "dropoff_time_mean_s": None}]
-    assert compare.values_of(rows, "a", 48, "dropoff_time_mean_s") == [1.0, 2.0]
+    assert values_of(rows, "a", 48, "dropoff_time_mean_s") == [1.0, 2.0]
 
 
 def test_ttests_md_marks_pairs_and_orders_against_the_paper():
@@ -157,7 +163,7 @@ def test_mann_whitney_marks_separated_groups_and_uses_dash_for_negligible():
     rows = (rows_for("ddsa", 8, np.arange(10.0), SPIRAL_KEYS)
             + rows_for("mdbsa_c", 8, np.arange(10.0), SPIRAL_KEYS)
             + rows_for("mdbsa_d", 8, 100 + np.arange(10.0), SPIRAL_KEYS))
-    text = spiral_mannwhitney_md(rows, 2, [8], compare.SPIRAL_STRATEGIES)
+    text = spiral_mannwhitney_md(rows, 2, [8], SPIRAL_STRATEGIES)
     section = text.split("## resources collected per robot")[1].split("##")[0]
     lines = [ln for ln in section.splitlines() if ln.startswith("| 8 |")]
     assert len(lines) == 3
@@ -166,7 +172,7 @@ def test_mann_whitney_marks_separated_groups_and_uses_dash_for_negligible():
 
 
 def test_claims_cover_the_cells_they_name():
-    by = {(c.experiment, c.metric, c.a, c.b, c.paper): c for c in compare.PAPER_SPIRAL_CLAIMS}
+    by = {(c.experiment, c.metric, c.a, c.b, c.paper): c for c in PAPER_SPIRAL_CLAIMS}
     c64 = by[(1, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −25 %")]
     assert c64.covers(64) and not c64.covers(16)
     c44 = by[(2, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −44 %")]
@@ -188,7 +194,7 @@ def test_queue_plans_pass_the_swarm_size_as_robots_count_field():
 @pytest.mark.parametrize("experiment", [1, 2, 3])
 @pytest.mark.parametrize("layout", ["powerlaw", "clustered"])
 def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
-    exp = compare.SPIRAL_EXPERIMENTS[experiment]
+    exp = SPIRAL_EXPERIMENTS[experiment]
     plans = spiral_plans(experiment, layout=layout)
     for plan in plans:
         # the mdbsa scenarios are written elsewhere; the overrides must hold on the ddsa file
@@ -214,7 +220,7 @@ def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
 
 
 def test_experiment_settings_match_the_papers_tables():
-    e = compare.SPIRAL_EXPERIMENTS
+    e = SPIRAL_EXPERIMENTS
     assert (e[1].robots, e[1].resources, e[1].values, e[1].duration_s) == (8, 160, (4, 16, 64), 720.0)
     assert (e[2].values, e[2].resources, e[2].regions, e[2].duration_s) == ((8, 14, 20, 26, 32), 200, 16, 960.0)
     assert (e[3].robots, e[3].values, e[3].regions, e[3].duration_s) == (16, (100, 150, 200, 250, 300), 16, 720.0)
@@ -336,3 +342,42 @@ def test_a_failing_strategy_is_reported_and_the_sweep_goes_on(tmp_path, capsys):
     with pytest.raises(ModuleNotFoundError):  # the library call without a handler is strict
         run_sweep(queue_plans([48], ["queue_qse"]), range(2), tmp_path / "strict.jsonl", runner=runner,
                   log=lambda _: None)
+
+
+# --------------------------------------------------------------------------- comparisons as records
+
+
+def test_comparisons_are_keyed_by_their_subcommand_names():
+    found = comparisons()
+    assert list(found) == ["queue", "spiral"]
+    assert all(name == c.name for name, c in found.items())
+    assert found["queue"].strategies == QUEUE_STRATEGIES and found["spiral"].strategies == SPIRAL_STRATEGIES
+    sub = next(a for a in build_parser(found)._actions if a.dest == "command")
+    assert list(sub.choices) == ["queue", "spiral"]
+
+
+def test_the_cli_runs_any_comparison_it_is_given(tmp_path):
+    """A comparison the CLI has never heard of: its own option, plans, output directory and report."""
+    seen = {}
+
+    def write_report(rows, out, args, strategies):
+        seen.update(rows=rows, out=out, strategies=strategies)
+        return [out / "report.md"]
+
+    toy = Comparison(
+        name="toy", help="a toy", default_out=str(tmp_path / "toy"), strategies=("a", "b", "c"),
+        add_arguments=lambda p: p.add_argument("--size", type=int, default=3),
+        plans=lambda args, strategies: [RunPlan(s, args.size, (), (("robots__count", args.size),))
+                                        for s in strategies],
+        write_report=write_report,
+        out_dir=lambda args: args.out / f"size{args.size}",
+    )
+    runner = FakeRunner()
+    assert main(["toy", "--size", "5", "--seeds", "2", "--strategies", "c", "a"], runner=runner,
+                comparisons={"toy": toy}) == 0
+    assert [(c[0], c[3]) for c in runner.calls] == [("a", (0, 1)), ("c", (0, 1))]  # the declared order
+    assert seen["out"] == tmp_path / "toy" / "size5" and seen["strategies"] == ["a", "c"]
+    assert [(r["strategy"], r["cell"]) for r in seen["rows"]] == [("a", 5), ("a", 5), ("c", 5), ("c", 5)]
+    assert len(read_results(tmp_path / "toy" / "size5" / "results.jsonl")) == 4
+    with pytest.raises(SystemExit):
+        main(["queue"], runner=FakeRunner(), comparisons={"toy": toy})

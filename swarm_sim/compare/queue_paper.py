@@ -1,0 +1,181 @@
+"""The queue paper's comparison (Zaman et al., queue_depot_traffic.md): Table II, Figs 8-10 and
+independent two-sample t-tests, our runs next to the paper's numbers."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+from swarm_sim.cli import scenario_fields
+from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, label, md_table
+from swarm_sim.compare.stats import all_pairs, cells_of, describe, ordering, pairwise_tests, stars, values_of
+from swarm_sim.compare.sweep import RunPlan, frozen_fields
+
+QUEUE_STRATEGIES: tuple[str, ...] = ("queue_cpfa", "queue_qse", "queue_qst", "queue_qme", "queue_qmt")
+"""Scenario names of the queue paper's five strategies, in the paper's Table II row order."""
+QUEUE_LABELS: dict[str, str] = {
+    "queue_cpfa": "CPFA", "queue_qse": "Q_SE", "queue_qst": "Q_ST", "queue_qme": "Q_ME", "queue_qmt": "Q_MT",
+}
+QUEUE_SIZES: tuple[int, ...] = (48, 64, 80, 96, 112)
+"""The paper's swarm sizes (Table I)."""
+
+PAPER_TABLE_II: dict[str, dict[int, float]] = {
+    "queue_cpfa": {48: 15.17, 64: 13.33, 80: 12.17, 96: 11.47, 112: 11.39},
+    "queue_qse": {48: 17.39, 64: 18.09, 80: 17.36, 96: 16.63, 112: 18.06},
+    "queue_qst": {48: 37.98, 64: 38.88, 80: 42.45, 96: 37.44, 112: 34.60},
+    "queue_qme": {48: 46.61, 64: 54.29, 80: 59.19, 96: 61.42, 112: 64.22},
+    "queue_qmt": {48: 62.94, 64: 71.93, 80: 76.39, 96: 82.31, 112: 82.39},
+}
+"""THE PAPER'S numbers, not ours: queue paper Table II, "Resource Collection (%)", mean over 50
+ARGoS runs of 18 min, 12 x 12 m arena, 320 resources in five 8 x 8 clusters."""
+PAPER_QUEUE_QUOTES = (
+    "Given a total of 320 available resources, the average number of collected resources "
+    "decreases from 49 with 48 robots to 37 with 112 robots. [CPFA]",
+    "Among all strategies, Q_MT achieves the best performance, collecting 202 resources with 48 "
+    "robots and 264 resources with 112 robots.",
+    "As expected, CPFA exhibits the highest collision time (see Fig. 9). [...] Q_SE shows a "
+    "notably faster increase in collision time as the number of robots grows.",
+    "Among all strategies, Q_SE exhibits the highest resource drop-off time [...] its drop-off "
+    "time is even higher than that of CPFA. In contrast, Q_MT consistently achieves the lowest "
+    "drop-off time across all experiments (see Fig. 10).",
+)
+
+QUEUE_METRICS: dict[str, str] = {
+    "resources_collected_pct": "resources collected [%]",
+    "collision_time_per_robot_s": "collision time per robot [s]",
+    "dropoff_time_mean_s": "drop-off time (per-run mean over deliveries) [s]",
+}
+
+
+def queue_plans(
+    sizes: Sequence[int],
+    strategies: Sequence[str] = QUEUE_STRATEGIES,
+    *,
+    duration: float | None = None,
+    overrides: Sequence[str] = (),
+) -> list[RunPlan]:
+    """Every strategy at every swarm size (sizes outer, so a cut sweep has whole columns)."""
+    plans = []
+    for n in sizes:
+        fields = scenario_fields(argparse.Namespace(robots=n, duration=duration))
+        plans.extend(RunPlan(s, n, tuple(overrides), frozen_fields(fields)) for s in strategies)
+    return plans
+
+
+def queue_table_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> str:
+    """table.md: Table II layout (ours next to the paper's), then collision and drop-off times."""
+    lines = ["# Queue paper comparison (Zaman et al.): tables", ""]
+    n_runs = sorted({describe(values_of(rows, s, c, "resources_collected_pct")).n for s in strategies for c in sizes})
+    lines += [f"Runs per cell: {', '.join(map(str, n_runs))} (the paper: 50). Cells: mean ± sample std (n).", ""]
+    lines += ["## Resource collection [%] (Table II layout)", "",
+              "`ours` = this simulator; `paper` = **the paper's Table II** (ARGoS, 50 runs), hard-coded "
+              "reference data.", ""]
+    header = ["Algorithm"] + [f"{c} {w}" for c in sizes for w in ("ours", "paper")]
+    body = []
+    for s in strategies:
+        row = [label(s, QUEUE_LABELS)]
+        for c in sizes:
+            row.append(cell_text(describe(values_of(rows, s, c, "resources_collected_pct"))))
+            row.append(fmt(PAPER_TABLE_II.get(s, {}).get(c)))
+        body.append(row)
+    lines += md_table(header, body) + [""]
+    lines += ["### The paper's Table II (reference, not our data)", ""]
+    lines += md_table(["Algorithm"] + [str(c) for c in QUEUE_SIZES],
+                      [[label(s, QUEUE_LABELS)] + [fmt(PAPER_TABLE_II[s][c]) for c in QUEUE_SIZES]
+                       for s in QUEUE_STRATEGIES]) + [""]
+    lines += ["The paper's text (quoted):", ""] + [f"> {q}" for q in PAPER_QUEUE_QUOTES] + [""]
+    for metric, title in (("collision_time_per_robot_s", "Collision time per robot [s] (Fig. 9)"),
+                          ("dropoff_time_mean_s", "Resource drop-off time [s] (Fig. 10)")):
+        lines += [f"## {title}", ""]
+        if metric == "dropoff_time_mean_s":
+            lines += ["Per run: the mean over its deliveries of the time from entering the perimeter "
+                      "to the drop; runs without a delivery are left out of n.", ""]
+        else:
+            lines += ["The paper plots this in minutes without a table; ours in seconds.", ""]
+        lines += md_table(["Algorithm"] + [str(c) for c in sizes],
+                          [[label(s, QUEUE_LABELS)] + [cell_text(describe(values_of(rows, s, c, metric)))
+                                                       for c in sizes] for s in strategies]) + [""]
+    return "\n".join(lines)
+
+
+def queue_ttests_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> str:
+    """ttests.md: scipy ttest_ind (equal variances, as its default) for every pair and size, and
+    the ordering of the strategies by mean collection against the paper's."""
+    from scipy.stats import kendalltau
+
+    lines = ["# Queue paper comparison: independent two-sample t-tests", "",
+             "scipy.stats.ttest_ind (default: equal variances, two-sided), as the paper. "
+             "Stars: *** p<0.001, ** p<0.01, * p<0.05, ns otherwise; n/a: fewer than two runs "
+             "or no variance.", ""]
+    pairs = all_pairs(strategies)
+    for metric, title in QUEUE_METRICS.items():
+        lines += [f"## {title}", ""]
+        for cell in sizes:
+            lines += [f"### {cell} robots", ""]
+            body = [[label(t.a, QUEUE_LABELS), label(t.b, QUEUE_LABELS), cell_text(t.stats_a),
+                     cell_text(t.stats_b), fmt(t.statistic, 3), fmt_p(t.p), stars(t.p)]
+                    for t in pairwise_tests(rows, metric, [cell], pairs, "t")]
+            lines += md_table(["A", "B", "A mean ± std", "B mean ± std", "t", "p", "sig"], body) + [""]
+    lines += ["## ordering", "",
+              "Strategies ascending by mean resources collected [%]: ours vs the paper's Table II. "
+              "Kendall's tau over the strategies both have.", ""]
+    body = []
+    for cell in sizes:
+        ours = ordering(rows, cell, strategies, "resources_collected_pct")
+        paper = sorted((s for s in strategies if cell in PAPER_TABLE_II.get(s, {})),
+                       key=lambda s: PAPER_TABLE_II[s][cell])
+        common = [s for s in ours if s in paper]
+        if len(common) >= 2:
+            tau = kendalltau([ours.index(s) for s in common], [paper.index(s) for s in common]).statistic
+            same = "yes" if [s for s in ours if s in paper] == [s for s in paper if s in ours] else "no"
+        else:
+            tau, same = math.nan, "—"
+        body.append([str(cell), " < ".join(label(s, QUEUE_LABELS) for s in ours) or "—",
+                     " < ".join(label(s, QUEUE_LABELS) for s in paper) or "— (size not in the paper)",
+                     same, fmt(tau)])
+    lines += md_table(["robots", "ours", "paper", "same order", "Kendall tau"], body) + [""]
+    return "\n".join(lines)
+
+
+def write_queue_report(rows: Sequence[dict], out: Path, sizes: Sequence[int] | None = None,
+                       strategies: Sequence[str] = QUEUE_STRATEGIES) -> list[Path]:
+    """table.md, ttests.md and the Fig. 8-10 box plots from result rows."""
+    sizes = list(sizes or cells_of(rows))
+    out.mkdir(parents=True, exist_ok=True)
+    written = [out / "table.md", out / "ttests.md"]
+    written[0].write_text(queue_table_md(rows, sizes, strategies))
+    written[1].write_text(queue_ttests_md(rows, sizes, strategies))
+    for name, metric, fig in (("collected.png", "resources_collected_pct", "Fig. 8"),
+                              ("collision_time.png", "collision_time_per_robot_s", "Fig. 9"),
+                              ("dropoff_time.png", "dropoff_time_mean_s", "Fig. 10")):
+        written.append(boxplot_figure([(metric, QUEUE_METRICS[metric])], rows, sizes, strategies,
+                                      QUEUE_LABELS, "number of robots",
+                                      f"{QUEUE_METRICS[metric]} (cf. queue paper {fig})", out / name))
+    return written
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--robots", type=int, nargs="+", default=list(QUEUE_SIZES),
+                        help=f"swarm sizes (default: the paper's {' '.join(map(str, QUEUE_SIZES))})")
+
+
+def _plans(args: argparse.Namespace, strategies: list[str]) -> list[RunPlan]:
+    return queue_plans(args.robots, strategies, duration=args.duration, overrides=args.overrides)
+
+
+def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, strategies: list[str]) -> list[Path]:
+    return write_queue_report(rows, out, args.robots, strategies)
+
+
+QUEUE_COMPARISON = Comparison(
+    name="queue",
+    help="queue paper: Table II, Figs 8-10, t-tests",
+    default_out="results/queue",
+    strategies=QUEUE_STRATEGIES,
+    add_arguments=_add_arguments,
+    plans=_plans,
+    write_report=_write_report,
+)

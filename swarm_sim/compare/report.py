@@ -1,0 +1,116 @@
+"""Report building blocks shared by the paper comparisons: number formatting, markdown tables and
+grouped box plots."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from swarm_sim.compare.stats import Stats, values_of
+
+
+def fmt(x: Any, digits: int = 2) -> str:
+    """`x` with `digits` decimals; ``—`` for missing or non-finite values."""
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "—"
+    return f"{x:.{digits}f}"
+
+
+def fmt_p(p: float) -> str:
+    """A p-value: scientific below 0.001, else four decimals; ``n/a`` when the test could not run."""
+    if not math.isfinite(p):
+        return "n/a"
+    return f"{p:.2e}" if p < 0.001 else f"{p:.4f}"
+
+
+def fmt_pct(x: float) -> str:
+    """A signed percentage change (``+12.3 %``)."""
+    return "—" if not math.isfinite(x) else f"{x:+.1f} %"
+
+
+def cell_text(s: Stats, digits: int = 2, median: bool = False) -> str:
+    """``mean ± std (n=…)``, with the median when asked; ``—`` without data."""
+    if s.n == 0:
+        return "—"
+    text = f"{fmt(s.mean, digits)} ± {fmt(s.std, digits)}"
+    return f"{text} (median {fmt(s.median, digits)}, n={s.n})" if median else f"{text} (n={s.n})"
+
+
+def md_table(header: Sequence[str], body: Iterable[Sequence[str]]) -> list[str]:
+    """Lines of a markdown table."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(row) + " |" for row in body]
+    return lines
+
+
+def label(strategy: str, labels: dict[str, str]) -> str:
+    """The paper's name for a strategy, or its scenario name when the paper has none."""
+    return labels.get(strategy, strategy)
+
+
+def grouped_boxplot(
+    ax: Any,
+    rows: Sequence[dict],
+    metric: str,
+    cells: Sequence[int],
+    strategies: Sequence[str],
+    labels: dict[str, str],
+    *,
+    notch: bool = False,
+) -> None:
+    """Boxes grouped by cell (x axis), one colour per strategy, as in both papers' figures."""
+    from matplotlib.patches import Patch
+
+    colours = [f"C{i}" for i in range(len(strategies))]
+    width = 0.8 / max(len(strategies), 1)
+    for j, (s, colour) in enumerate(zip(strategies, colours)):
+        data, pos = [], []
+        for i, cell in enumerate(cells):
+            v = values_of(rows, s, cell, metric)
+            if v:
+                data.append(v)
+                pos.append(i - 0.4 + width * (j + 0.5))
+        if data:
+            box = ax.boxplot(data, positions=pos, widths=width * 0.85, notch=notch, patch_artist=True,
+                             manage_ticks=False, flierprops={"markersize": 3},
+                             medianprops={"color": "black"})
+            for patch in box["boxes"]:
+                patch.set(facecolor=colour, alpha=0.6)
+    ax.set_xticks(range(len(cells)), [str(c) for c in cells])
+    ax.set_xlim(-0.6, len(cells) - 0.4)
+    ax.legend(handles=[Patch(facecolor=c, alpha=0.6, label=label(s, labels)) for s, c in zip(strategies, colours)],
+              fontsize="small")
+    ax.grid(axis="y", alpha=0.3)
+
+
+def boxplot_figure(
+    panels: Sequence[tuple[str, str]],
+    rows: Sequence[dict],
+    cells: Sequence[int],
+    strategies: Sequence[str],
+    labels: dict[str, str],
+    xlabel: str,
+    title: str,
+    path: Path,
+    notch: bool = False,
+) -> Path:
+    """A PNG at `path` with one `grouped_boxplot` per (metric, y label) panel, side by side."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4.5), squeeze=False)
+    for ax, (metric, ylabel) in zip(axes[0], panels):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # notches wider than the box with few runs
+            grouped_boxplot(ax, rows, metric, cells, strategies, labels, notch=notch)
+        ax.set(xlabel=xlabel, ylabel=ylabel)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
