@@ -48,9 +48,9 @@ Rules (the paper's) and the choices it leaves open
 - **join** (sec. V): accepted iff the line is an entry line, the robot is not inside, the cell
   and its conflicts are free, the cell is behind the tail (its index is below every owned cell
   of that line: robots queue towards higher indices), and it is not an intersection cell.
-  Refusals, checked in this order: ``"unknown line"``, ``"already inside"``, ``"unknown cell"``
-  (index out of range; our addition), ``"occupied"``, ``"not behind the tail"``, ``"keep clear"``
-  (an intersection cell: a robot waiting there could close a gridlock; our addition).
+  Refusals (`depot_manager.protocol.Refusal`), checked in this order: UNKNOWN_LINE,
+  ALREADY_INSIDE, UNKNOWN_CELL (index out of range; our addition), OCCUPIED, NOT_BEHIND_TAIL,
+  KEEP_CLEAR (an intersection cell: a robot waiting there could close a gridlock; our addition).
 - **arrived**: the robot reached a cell of its route (either name of an alias); it releases
   every cell before it. A cell behind its current one, beyond its grant or not on its route, or
   an unknown robot, is a ValueError. Reporting its current cell again is a no-op (it keeps its
@@ -116,6 +116,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from depot_manager.geometry import ARC_STEP, Polyline, QueueLayout
+from depot_manager.protocol import Refusal
 
 SAME_POINT = 1e-6
 """Two cells closer than this [m] are the same point (aliases at line junctions)."""
@@ -540,24 +541,24 @@ class DepotAdmission:
 
     # ------------------------------------------------------------------ reports
 
-    def join(self, robot: str, line: str, cell: int, t: float) -> str:
-        """Ask to join entry line `line` at `cell`; "" if accepted, else the refusal reason."""
+    def join(self, robot: str, line: str, cell: int, t: float) -> Refusal:
+        """Ask to join entry line `line` at `cell`; Refusal.NONE if accepted, else why not."""
         m = self._m
         if line not in m.entry_names:
-            return "unknown line"
+            return Refusal.UNKNOWN_LINE
         if robot in self._robots:
-            return "already inside"
+            return Refusal.ALREADY_INSIDE
         ids = m.line_ids[line]
         if not 0 <= cell < len(ids):
-            return "unknown cell"
+            return Refusal.UNKNOWN_CELL
         c = int(ids[cell])
         if not self._free(c, robot):
-            return "occupied"
+            return Refusal.OCCUPIED
         owned = [i for i, cid in enumerate(ids) if self._owner[cid] is not None]
         if owned and cell >= min(owned):
-            return "not behind the tail"
+            return Refusal.NOT_BEHIND_TAIL
         if m.intersection[c]:
-            return "keep clear"
+            return Refusal.KEEP_CLEAR
         r = _Robot(robot, m.entry_names.index(line), t)
         if m.kind == "multi":
             self._set_route(r, r.entry)
@@ -566,7 +567,7 @@ class DepotAdmission:
         r.pos = r.end = cell
         self._owner[c] = robot
         self._robots[robot] = r
-        return ""
+        return Refusal.NONE
 
     def arrived(self, robot: str, line: str, cell: int, t: float) -> None:
         """The robot reached (line, cell) of its route: release the cells behind it."""

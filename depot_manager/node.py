@@ -12,10 +12,9 @@ import sys
 
 import numpy as np
 
-from depot_manager.server import DepotServer
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
-from swarm_sim.protocol import DEPOT
+from depot_manager.protocol import DEPOT
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 from swarm_sim.types import NS_PER_S
 from depot_manager.config import QueueConfig
@@ -33,8 +32,6 @@ _OWNED = (0.9, 0.1, 0.1, 0.9)
 
 class DepotManagerNode(ServerNode):
     CHANNEL = DEPOT
-    INBOUND = topics.DEPOT_REPORTS
-    OUTBOUND = (topics.DEPOT_GRANTS,)
 
     def __init__(self, config: ServerNodeConfig | None = None, **kwargs) -> None:
         super().__init__("depot_manager", config, **kwargs)
@@ -44,9 +41,6 @@ class DepotManagerNode(ServerNode):
         )
         self._last_state = None
         self._markers_at = -1
-
-    def make_server(self, scenario) -> DepotServer:
-        return DepotServer(scenario)
 
     def publish_state(self, stamp_ns: int) -> None:
         s = self.server.admission.snapshot()

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 from depot_manager.admission import DepotAdmission
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
-from swarm_sim.protocol import DepotGrant, DepotReport
+from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
 from swarm_sim.types import NS_PER_S
 from depot_manager.config import QueueConfig
 
@@ -45,18 +45,20 @@ class DepotServer:
             if not isinstance(m, DepotReport):
                 continue
             try:
-                if m.kind == "join":
-                    reason = adm.join(m.robot, m.line, m.cell, t)
-                    if reason:
-                        out.append(DepotGrant(stamp_ns, m.robot, m.line, -1, False, reason))
-                elif m.kind == "at":
-                    adm.arrived(m.robot, m.line, m.cell, t)
-                elif m.kind == "unloaded":
-                    adm.unloaded(m.robot, t)
-                else:
-                    raise ValueError(f"unknown report kind {m.kind!r}")
+                match m.kind:
+                    case ReportKind.JOIN:
+                        reason = adm.join(m.robot, m.line, m.cell, t)
+                        if reason is not Refusal.NONE:
+                            out.append(DepotGrant(stamp_ns, m.robot, m.line, -1, False, reason))
+                    case ReportKind.AT:
+                        adm.arrived(m.robot, m.line, m.cell, t)
+                    case ReportKind.UNLOADED:
+                        adm.unloaded(m.robot, t)
+                    case _:
+                        raise ValueError(f"unknown report kind {m.kind!r}")
             except (ValueError, TypeError) as e:
-                self.errors.append(f"t={t:.3f} {m.robot} {m.kind} {m.line}/{m.cell}: {e}")
+                kind = getattr(m.kind, "value", m.kind)
+                self.errors.append(f"t={t:.3f} {m.robot} {kind} {m.line}/{m.cell}: {e}")
         changed = adm.step(t)
         inside = adm.robots_inside
         last = {r: adm.is_last(r) for r in inside}

@@ -63,7 +63,7 @@ from swarm_controllers.spiral import (
     region_side,
     segments_overlap_collinear,
 )
-from swarm_sim.protocol import ProgressReport, RegionAssignment
+from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, RobotId, robot_index
 from swarm_controllers.config import SpiralConfig

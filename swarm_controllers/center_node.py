@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import sys
 
-from swarm_controllers.center import CenterServer, region_paths
+from swarm_controllers.center import region_paths
 from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
-from swarm_sim.protocol import CENTER
+from swarm_controllers.center_protocol import CENTER
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 
 _REGION = (0.6, 0.6, 0.6, 1.0)
@@ -23,8 +23,6 @@ _PATH = (0.2, 0.6, 1.0, 0.8)
 
 class CenterNode(ServerNode):
     CHANNEL = CENTER
-    INBOUND = topics.CENTER_REPORTS
-    OUTBOUND = (topics.CENTER_ASSIGNMENTS,)
 
     def __init__(self, config: ServerNodeConfig | None = None, **kwargs) -> None:
         super().__init__("center", config, **kwargs)
@@ -43,9 +41,6 @@ class CenterNode(ServerNode):
             "planned_paths", [p.waypoints for p in region_paths(self.scenario)], _PATH, 0.01
         )
         self._markers_pub.publish(markers.serialize_markers(drawn))
-
-    def make_server(self, scenario) -> CenterServer:
-        return CenterServer(scenario)
 
     def publish_state(self, stamp_ns: int) -> None:
         state = self.server.snapshot()

@@ -23,16 +23,15 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from swarm_controllers.api import Behaviour, behaviour_rng
-from swarm_msgs_py import diagnostics, odometry, pheromone, protocol, scan, topics, twist
+from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
+from swarm_msgs_py.records import post_all
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.messaging import Mailbox
-from swarm_sim.protocol import CENTER, DEPOT
 from swarm_sim import registry
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
-from swarm_sim.types import Observation, PheromoneMessage, robot_index
-from depot_manager.config import QueueConfig
+from swarm_sim.scenario import DEFAULT_SCENARIO, load_scenario
+from swarm_sim.types import Observation, robot_index
 
 
 @dataclass(frozen=True)
@@ -69,14 +68,17 @@ class ControllerNode(Node):
         self._expected = len(decoders)
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
-        self.create_subscription(
-            topics.type_of(topics.PHEROMONES), topics.PHEROMONES,
-            lambda data: self.mailbox.post(pheromone.decode_pheromone(data)), EVENTS, raw=True,
-        )
-        inbound, outbound = protocol_topics(self.scenario)
-        for topic in inbound:
-            self.create_subscription(topics.type_of(topic), topic, self._on_protocol, EVENTS, raw=True)
-        self._protocol_pubs = {t: self.create_publisher(topics.type_of(t), t, EVENTS) for t in outbound}
+        inbound, outbound = registry.robot_topics(algorithm)
+        for topic, family in inbound.items():
+            self.create_subscription(
+                topics.import_type(family.type_name), topic,
+                lambda data, f=family: post_all(f, data, self.mailbox.post, self.get_logger().warning),
+                EVENTS, raw=True,
+            )
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+                          for t, f in outbound.items()}
+        self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
+        """Message class -> the topic this robot sends it on."""
         for name, (type_name, decode) in decoders.items():
             self.create_subscription(
                 topics.import_type(type_name), name,
@@ -84,12 +86,6 @@ class ControllerNode(Node):
             )
         self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
-        self._pheromone_pub = self.create_publisher(
-            topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS
-        )
-
-    def _on_protocol(self, data: bytes) -> None:
-        protocol.post_all(data, self.mailbox.post, self.get_logger().warning)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         stamp = decoded[0]
@@ -110,14 +106,14 @@ class ControllerNode(Node):
         command = self.behaviour.step(obs)
         by_topic: dict[str, list] = defaultdict(list)
         for message in command.messages:
-            if isinstance(message, PheromoneMessage):
-                self._pheromone_pub.publish(pheromone.encode_pheromone(message))
-            else:
-                by_topic[protocol.topic_of(message)].append(message)
+            topic = self._topic_of.get(type(message))
+            if topic is None:
+                raise TypeError(f"{self.robot}: this algorithm sends no {type(message).__name__}")
+            by_topic[topic].append(message)
         for topic, messages in by_topic.items():
-            if topic not in self._protocol_pubs:
-                raise TypeError(f"{self.robot}: this scenario has no receiver on {topic}")
-            self._protocol_pubs[topic].publish(protocol.encode_messages(stamp_ns, messages))
+            family, pub = self._outbound[topic]
+            for data in family.encode(stamp_ns, messages):
+                pub.publish(data)
         status = self.behaviour.status(stamp_ns)
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
         if key != self._last_status:
@@ -126,23 +122,6 @@ class ControllerNode(Node):
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
-
-
-def protocol_topics(scenario: Scenario) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """(topics a controller listens to, topics it sends on) besides its own and the
-    pheromones: the servers' topics when the scenario runs them, the radio for tail joining."""
-    inbound, outbound = [], []
-    channels = [spec.channel for spec in registry.of(scenario).servers]
-    if CENTER in channels:
-        inbound.append(topics.CENTER_ASSIGNMENTS)
-        outbound.append(topics.CENTER_REPORTS)
-    if DEPOT in channels:
-        inbound.append(topics.DEPOT_GRANTS)
-        outbound.append(topics.DEPOT_REPORTS)
-        if QueueConfig.of(scenario).joining == "tail":
-            inbound.append(topics.RADIO)
-            outbound.append(topics.RADIO)
-    return tuple(inbound), tuple(outbound)
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:

@@ -65,7 +65,7 @@ from swarm_controllers.center import region_paths
 from swarm_controllers.ddsa import LaneAvoidance
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath
-from swarm_sim.protocol import ProgressReport, RegionAssignment
+from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, RobotId

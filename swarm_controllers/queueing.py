@@ -59,7 +59,7 @@ from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
-from swarm_sim.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, within_range
+from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind, within_range
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
 from depot_manager.config import QueueConfig
@@ -187,7 +187,7 @@ class QueueBehaviour:
             else:
                 return self._forage(obs, r, out)
         if dropped and self._phase is Phase.QUEUED:
-            out.append(DepotReport(obs.stamp_ns, self.robot, "unloaded", self._line, self._cell))
+            out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, self._line, self._cell))
         phase = self._phase
         if phase is Phase.TO_ENTRY:
             linear, angular = self._to_entry(obs, r, out)
@@ -241,7 +241,7 @@ class QueueBehaviour:
                     self._phase = Phase.TO_ENTRY  # wait at the entry point, ask again
                     return
                 self._phase = Phase.SEEKING
-                if grant.reason == "not behind the tail":
+                if grant.reason is Refusal.NOT_BEHIND_TAIL:
                     self._back_along(line, cell)
             return
         if self._phase is Phase.JOINING and self._join is not None:
@@ -384,7 +384,7 @@ class QueueBehaviour:
         tx, ty = self._cells[line][cell]
         if math.hypot(tx - x, ty - y) <= SLOT_TOLERANCE:
             self._line, self._cell = line, cell
-            out.append(DepotReport(obs.stamp_ns, self.robot, "at", line, cell))
+            out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.AT, line, cell))
             if line in self._exit_lines and cell == len(self._cells[line]) - 1:
                 cx, cy = self._center
                 r = math.hypot(x - cx, y - cy)
@@ -421,7 +421,7 @@ class QueueBehaviour:
     def _request_join(self, line: str, cell: int, obs: Observation, out: list[object]) -> None:
         self._join = (line, cell)
         self._phase = Phase.JOINING
-        out.append(DepotReport(obs.stamp_ns, self.robot, "join", line, cell))
+        out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.JOIN, line, cell))
 
     def _back_along(self, line: str, cell: int) -> None:
         """Look for the tail about gamma behind `cell` of `line` (against the queue's flow)."""

@@ -16,6 +16,7 @@ from swarm_msgs_py.cdr import (
     skip_header,
     split_stamp,
 )
+from swarm_msgs_py.topics import PHEROMONES as PHEROMONES_TOPIC
 from swarm_sim.types import PheromoneMessage
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
@@ -37,3 +38,21 @@ def decode_pheromone(data: bytes) -> PheromoneMessage:
     stamp_ns, pos = skip_header(data)
     x, y, _ = _POINT.unpack_from(data, align(pos, 8))
     return PheromoneMessage(stamp_ns, x, y)
+
+
+class PheromoneFamily:
+    """The CPFA's pheromones as a message family (`swarm_msgs_py.records.MessageFamily`): one
+    PointStamped per waypoint on ``/nest/pheromones``."""
+
+    name = "pheromones"
+    type_name = TYPE_NAME
+    topics = {PheromoneMessage: PHEROMONES_TOPIC}
+
+    def encode(self, stamp_ns: int, messages) -> list[bytes]:
+        return [encode_pheromone(m) for m in messages]
+
+    def decode(self, data: bytes) -> tuple[PheromoneMessage, ...]:
+        return (decode_pheromone(data),)
+
+
+PHEROMONES = PheromoneFamily()

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from swarm_sim.protocol import CHANNELS, channel_of
+from swarm_sim.protocol import channel_of
 
 
 def _order(message: Any) -> tuple[int, str, str]:
@@ -36,14 +36,18 @@ class Mailbox:
 
 
 class Router:
-    """One `Mailbox` per channel (`swarm_sim.protocol.CHANNELS`): what the batch runner uses
-    in place of the graph's topics."""
+    """One `Mailbox` per channel, made when first used: what the batch runner uses in place of
+    the graph's topics."""
 
     def __init__(self) -> None:
-        self._boxes = {channel: Mailbox() for channel in CHANNELS}
+        self._boxes: dict[str, Mailbox] = {}
 
     def post(self, message: Any) -> None:
-        self._boxes[channel_of(message)].post(message)
+        channel = channel_of(message)
+        if channel not in self._boxes:
+            self._boxes[channel] = Mailbox()
+        self._boxes[channel].post(message)
 
     def take_before(self, channel: str, stamp_ns: int) -> tuple[Any, ...]:
-        return self._boxes[channel].take_before(stamp_ns)
+        box = self._boxes.get(channel)
+        return box.take_before(stamp_ns) if box is not None else ()

@@ -240,3 +240,39 @@ def make_servers(scenario: Scenario) -> dict[str, Server]:
 def task_factory(scenario: Scenario) -> Callable[..., Any]:
     """The world task class of the scenario's algorithm."""
     return resolve(task(of(scenario).task).core)
+
+
+# --------------------------------------------------------------------------- wiring on the graph
+
+
+def _channel(cls: type) -> str:
+    """The channel a message class travels on (`swarm_sim.protocol.channel_of`)."""
+    from swarm_sim.protocol import ROBOTS
+
+    return getattr(cls, "CHANNEL", ROBOTS)
+
+
+def robot_topics(algorithm: Algorithm) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(inbound, outbound) topic -> message family of a robot's controller: with each server it
+    sends the family's messages on the server's channel and hears the rest; its peer families
+    it both sends and hears."""
+    inbound: dict[str, Any] = {}
+    outbound: dict[str, Any] = {}
+    for spec in algorithm.servers:
+        family = resolve(spec.family)
+        for cls, topic in family.topics.items():
+            (outbound if _channel(cls) == spec.channel else inbound)[topic] = family
+    for path in algorithm.peers:
+        family = resolve(path)
+        for topic in family.topics.values():
+            inbound[topic] = outbound[topic] = family
+    return inbound, outbound
+
+
+def server_topics(spec: ServerSpec) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(inbound, outbound) topic -> message family of a server: it hears its channel's
+    messages and sends the others."""
+    family = resolve(spec.family)
+    inbound = {t: family for cls, t in family.topics.items() if _channel(cls) == spec.channel}
+    outbound = {t: family for cls, t in family.topics.items() if _channel(cls) != spec.channel}
+    return inbound, outbound

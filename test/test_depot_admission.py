@@ -32,7 +32,8 @@ from depot_manager.geometry import (
     make_layout,
 )
 from depot_manager.server import DepotServer
-from swarm_sim.protocol import DepotGrant, DepotReport, ProgressReport
+from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
+from swarm_controllers.center_protocol import ProgressReport
 from depot_manager.config import QueueConfig
 from swarm_sim.scenario import ControllerConfig, DepotConfig, Scenario
 
@@ -170,8 +171,8 @@ def simulate(
                     continue
                 cell = int(rng.integers(0, tail))
             reason = adm.join(b.name, line, cell, t)
-            assert reason in ("", "occupied", "not behind the tail", "keep clear"), reason
-            if reason == "":
+            assert reason in (Refusal.NONE, Refusal.OCCUPIED, Refusal.NOT_BEHIND_TAIL, Refusal.KEEP_CLEAR), reason
+            if reason is Refusal.NONE:
                 b.pos, b.key, b.joined, b.join_at = (line, cell), t, tick, (line, cell)
                 assert adm.grant(b.name) == (line, cell)
         # moves: at most one cell towards the grant, with probability p
@@ -434,18 +435,18 @@ def test_conflicts_cover_crossings_but_not_adjacent_lanes(size):
 def test_join_refusals_and_is_last():
     adm = DepotAdmission(layout("multi", "small"))
     n = len(adm.cells("entry_line_0"))
-    assert adm.join("a", "exit_line_0", 0, 0.0) == "unknown line"
-    assert adm.join("a", "nowhere", 0, 0.0) == "unknown line"
-    assert adm.join("a", "entry_line_0", n, 0.0) == "unknown cell"
-    assert adm.join("a", "entry_line_0", 5, 0.0) == ""
-    assert adm.join("a", "entry_line_1", 0, 0.0) == "already inside"
-    assert adm.join("b", "entry_line_0", 5, 0.0) == "occupied"
-    assert adm.join("b", "entry_line_0", 7, 0.0) == "not behind the tail"
-    assert adm.join("b", "entry_line_0", 4, 0.0) == ""  # right behind the tail
+    assert adm.join("a", "exit_line_0", 0, 0.0) is Refusal.UNKNOWN_LINE
+    assert adm.join("a", "nowhere", 0, 0.0) is Refusal.UNKNOWN_LINE
+    assert adm.join("a", "entry_line_0", n, 0.0) is Refusal.UNKNOWN_CELL
+    assert adm.join("a", "entry_line_0", 5, 0.0) is Refusal.NONE
+    assert adm.join("a", "entry_line_1", 0, 0.0) is Refusal.ALREADY_INSIDE
+    assert adm.join("b", "entry_line_0", 5, 0.0) is Refusal.OCCUPIED
+    assert adm.join("b", "entry_line_0", 7, 0.0) is Refusal.NOT_BEHIND_TAIL
+    assert adm.join("b", "entry_line_0", 4, 0.0) is Refusal.NONE  # right behind the tail
     assert adm.is_last("b") and not adm.is_last("a") and not adm.is_last("nobody")
-    assert adm.join("c", "entry_line_0", 0, 1.0) == ""
+    assert adm.join("c", "entry_line_0", 0, 1.0) is Refusal.NONE
     assert adm.is_last("c") and not adm.is_last("b")
-    assert adm.join("d", "entry_line_1", 0, 1.0) == ""  # other lines are independent
+    assert adm.join("d", "entry_line_1", 0, 1.0) is Refusal.NONE  # other lines are independent
     assert adm.robots_inside == ("a", "b", "c", "d")
     snap = adm.snapshot()
     assert snap.entry_queue_lengths == (3, 1, 0, 0)
@@ -463,8 +464,8 @@ def test_single_queue_join_refuses_keep_clear_cells():
     adm = DepotAdmission(layout("single", "default"))
     kc = [lab for lab in g.labels if lab[0] == "entry_line" and g.keep_clear[g.index[lab]]]
     assert kc
-    assert adm.join("a", *kc[-1], 0.0) == "keep clear"
-    assert adm.join("a", "entry_line", 0, 0.0) == ""
+    assert adm.join("a", *kc[-1], 0.0) is Refusal.KEEP_CLEAR
+    assert adm.join("a", "entry_line", 0, 0.0) is Refusal.NONE
 
 
 def test_arrived_and_unloaded_errors():
@@ -472,7 +473,7 @@ def test_arrived_and_unloaded_errors():
     n = len(adm.cells("entry_line_0"))
     with pytest.raises(ValueError, match="unknown robot"):
         adm.arrived("ghost", "entry_line_0", 1, 0.0)
-    assert adm.join("a", "entry_line_0", n - 3, 0.0) == ""
+    assert adm.join("a", "entry_line_0", n - 3, 0.0) is Refusal.NONE
     adm.step(0.0)
     with pytest.raises(ValueError, match="not on its route"):
         adm.arrived("a", "entry_line_1", n - 2, 0.1)
@@ -496,7 +497,7 @@ def test_arrived_and_unloaded_errors():
         adm.arrived("a", "exit_line_0", c, 0.5)
     assert adm.robots_inside == () and adm.snapshot().left == 1 and adm.grant("a") is None
     assert adm.step(0.6) == {}  # a robot that has left is not reported
-    assert adm.join("a", "entry_line_0", 0, 1.0) == ""  # and may come back
+    assert adm.join("a", "entry_line_0", 0, 1.0) is Refusal.NONE  # and may come back
 
 
 # ------------------------------------------------------------------ right of way
@@ -527,7 +528,7 @@ def _both_at_docks(rotation: float, t0: float, t1: float) -> DepotAdmission:
     adm = DepotAdmission(crossing_layout(rotation))
     for k, t in ((0, t0), (1, t1)):
         line = f"entry_line_{k}"
-        assert adm.join(f"r{k}", line, len(adm.cells(line)) - 1, t) == ""  # at the dock
+        assert adm.join(f"r{k}", line, len(adm.cells(line)) - 1, t) is Refusal.NONE  # at the dock
         adm.unloaded(f"r{k}", t)
     return adm
 
@@ -578,7 +579,7 @@ def test_single_queue_dispatch_goes_to_first_free_dock_ccw():
     got = []
     for r in range(len(lay.docks)):
         name = f"r{r}"
-        assert adm.join(name, "entry_line", e_end, float(r)) == ""
+        assert adm.join(name, "entry_line", e_end, float(r)) is Refusal.NONE
         adm.step(float(r))
         line, _ = adm.grant(name)
         got.append(int(line.rsplit("_", 1)[1]))
@@ -590,7 +591,7 @@ def test_single_queue_dispatch_goes_to_first_free_dock_ccw():
         assert adm.snapshot().dock_occupants[got[-1]] == name
     assert got == ccw
     # every dock taken: the next robot waits at the inner entry point
-    assert adm.join("late", "entry_line", e_end, 9.0) == ""
+    assert adm.join("late", "entry_line", e_end, 9.0) is Refusal.NONE
     adm.step(9.0)
     assert adm.grant("late") == ("entry_line", e_end)
     assert adm.snapshot().inner_queue_counts == (1,) * len(lay.docks)
@@ -622,19 +623,19 @@ def test_waiting_robot_claims_its_cells_against_later_upstream_robots():
     runs = [i for i in range(1, len(kc)) if kc[i] and not kc[i - 1]]  # spiral crossings
     assert len(runs) >= 3
     # E goes to its dock and unloads
-    assert adm.join("E", "entry_line", len(entry) - 1, 0.0) == ""
+    assert adm.join("E", "entry_line", len(entry) - 1, 0.0) is Refusal.NONE
     dock = drive(adm, "E", 0.5)
     assert dock in g.dock
     adm.unloaded("E", 1.0)
     # S is granted across the second crossing
-    assert adm.join("S", "entry_line", runs[1] - 1, 2.0) == ""
+    assert adm.join("S", "entry_line", runs[1] - 1, 2.0) is Refusal.NONE
     adm.step(2.0)
     assert adm.grant("S")[1] > runs[1]
     # E drives to the end of the ring and waits there: the exit corridor crosses S's cells
     ring_end = (dock[0], len(adm.cells(dock[0])) - 2)
     assert drive(adm, "E", 3.0, ring_end) == ring_end and adm.grant("E") == ring_end
     # S2 arrives later before the first crossing: free, but E waited first and claims it
-    assert adm.join("S2", "entry_line", runs[0] - 1, 4.0) == ""
+    assert adm.join("S2", "entry_line", runs[0] - 1, 4.0) is Refusal.NONE
     adm.step(4.0)
     assert adm.grant("S2") == ("entry_line", runs[0] - 1)
     owned = [((ln, c), r) for ln, c, r in adm.snapshot().occupied if r != "S2"]
@@ -717,36 +718,36 @@ def test_server_refusals_grants_history_errors():
     n = len(srv.admission.cells("entry_line_0"))
     s = 1_000_000_000
     out = srv.step(1 * s, [
-        DepotReport(0, "robot_2", "join", "entry_line_0", 5),
-        DepotReport(0, "robot_1", "join", "entry_line_0", 5),
-        DepotReport(0, "robot_10", "join", "nowhere", 0),
-        DepotReport(0, "robot_3", "join", "entry_line_0", 9),
-        DepotReport(0, "robot_4", "join", "entry_line_1", 0),
+        DepotReport(0, "robot_2", ReportKind.JOIN, "entry_line_0", 5),
+        DepotReport(0, "robot_1", ReportKind.JOIN, "entry_line_0", 5),
+        DepotReport(0, "robot_10", ReportKind.JOIN, "nowhere", 0),
+        DepotReport(0, "robot_3", ReportKind.JOIN, "entry_line_0", 9),
+        DepotReport(0, "robot_4", ReportKind.JOIN, "entry_line_1", 0),
         ProgressReport(0, "robot_9", 0.0, 0.0, -1, 0.0, False),  # not for the depot: ignored
     ])
     assert [g.robot for g in out] == sorted(g.robot for g in out)
     by = {g.robot: g for g in out}
-    assert by["robot_1"] == DepotGrant(s, "robot_1", "entry_line_0", -1, False, "occupied")
-    assert by["robot_10"].cell == -1 and by["robot_10"].reason == "unknown line"
-    assert by["robot_3"].reason == "not behind the tail"
+    assert by["robot_1"] == DepotGrant(s, "robot_1", "entry_line_0", -1, False, Refusal.OCCUPIED)
+    assert by["robot_10"].cell == -1 and by["robot_10"].reason is Refusal.UNKNOWN_LINE
+    assert by["robot_3"].reason is Refusal.NOT_BEHIND_TAIL
     assert by["robot_2"] == DepotGrant(s, "robot_2", "entry_line_0", 5 + LOOKAHEAD, True)
     assert by["robot_4"] == DepotGrant(s, "robot_4", "entry_line_1", LOOKAHEAD, True)
     assert srv.history == [(1.0, (1, 1, 0, 0))]
     # already inside
-    out = srv.step(2 * s, [DepotReport(s, "robot_2", "join", "entry_line_2", 0)])
-    assert out == (DepotGrant(2 * s, "robot_2", "entry_line_2", -1, False, "already inside"),)
+    out = srv.step(2 * s, [DepotReport(s, "robot_2", ReportKind.JOIN, "entry_line_2", 0)])
+    assert out == (DepotGrant(2 * s, "robot_2", "entry_line_2", -1, False, Refusal.ALREADY_INSIDE),)
     # a robot joining behind robot_2 takes `last` from it: both are told
-    out = srv.step(3 * s, [DepotReport(2 * s, "robot_5", "join", "entry_line_0", 0)])
+    out = srv.step(3 * s, [DepotReport(2 * s, "robot_5", ReportKind.JOIN, "entry_line_0", 0)])
     assert [(g.robot, g.last) for g in out] == [("robot_2", False), ("robot_5", True)]
     assert out[0].cell == 5 + LOOKAHEAD  # unchanged grant, re-sent for the flag
     assert srv.history[-1] == (3.0, (2, 1, 0, 0))
     # bad reports are recorded, not raised
     out = srv.step(4 * s, [
-        DepotReport(3 * s, "ghost", "at", "entry_line_0", 1),
-        DepotReport(3 * s, "robot_2", "at", "entry_line_0", 99),
+        DepotReport(3 * s, "ghost", ReportKind.AT, "entry_line_0", 1),
+        DepotReport(3 * s, "robot_2", ReportKind.AT, "entry_line_0", 99),
         DepotReport(3 * s, "robot_2", "teleport"),
-        DepotReport(3 * s, "robot_2", "unloaded"),
-        DepotReport(3 * s, "robot_2", "at", "entry_line_0", 6),
+        DepotReport(3 * s, "robot_2", ReportKind.UNLOADED),
+        DepotReport(3 * s, "robot_2", ReportKind.AT, "entry_line_0", 6),
     ])
     assert len(srv.errors) == 4 and "ghost" in srv.errors[0] and "teleport" in srv.errors[2]
     assert [(g.robot, g.cell) for g in out] == [("robot_2", 6 + LOOKAHEAD), ("robot_5", 5)]
@@ -758,10 +759,10 @@ def test_server_refusals_grants_history_errors():
         route, pos = adm.route("robot_2"), adm.position("robot_2")
         i = route.index(pos)
         if pos[0] == "entry_line_0" and pos[1] == n - 1 and adm.grant("robot_2") == pos:
-            msg = DepotReport(0, "robot_2", "unloaded")
+            msg = DepotReport(0, "robot_2", ReportKind.UNLOADED)
         else:
             assert route.index(adm.grant("robot_2")) > i
-            msg = DepotReport(0, "robot_2", "at", *route[i + 1])
+            msg = DepotReport(0, "robot_2", ReportKind.AT, *route[i + 1])
         out = srv.step(tick * s, [msg])
         tick += 1
         assert tick < 100

@@ -30,7 +30,9 @@ from swarm_controllers.spiral import (
     segments_overlap_collinear,
 )
 from swarm_sim.messaging import Router
-from swarm_sim.protocol import CENTER, ROBOTS, DepotReport, ProgressReport, RegionAssignment
+from depot_manager.protocol import DepotReport, ReportKind
+from swarm_controllers.center_protocol import CENTER, ProgressReport, RegionAssignment
+from swarm_sim.protocol import ROBOTS
 from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.world.tasks.foraging import ForagingSense
@@ -158,7 +160,7 @@ def test_server_ignores_reports_from_out_of_range_and_other_messages():
     far = report("robot_0", x=r + 0.01)
     unknown = report("robot_99")
     bad_region = report("robot_1", region=16, s=1.0, done=False)
-    others = [PheromoneMessage(0, 1.0, 1.0), DepotReport(0, "robot_2", "join")]
+    others = [PheromoneMessage(0, 1.0, 1.0), DepotReport(0, "robot_2", ReportKind.JOIN)]
     assert server.step(DT_NS, [far, unknown, bad_region, *others]) == ()
     assert server.ignored == 3
     edge = report("robot_0", x=r * math.cos(1.0), y=r * math.sin(1.0) - 1e-9)

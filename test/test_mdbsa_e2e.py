@@ -9,12 +9,13 @@ import numpy as np
 
 from graph_helpers import run_graph
 from swarm_controllers.spiral import region_centers, region_side
-from swarm_msgs_py import protocol, topics
+from swarm_msgs_py import topics
+from swarm_msgs_py.center_protocol import CENTER
 from swarm_sim.analysis.replay import load_odometry, load_run
 from swarm_sim.bag import bag_info, read_bag
 from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
-from swarm_sim.protocol import RegionAssignment
+from swarm_controllers.center_protocol import RegionAssignment
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S
 
@@ -39,7 +40,7 @@ def test_mdbsa_d_graph_run_stays_in_assigned_regions(tmp_path):
     assignments: dict[str, list[tuple[float, int]]] = {}
     for m in read_bag(bag):
         if m.topic == topics.CENTER_ASSIGNMENTS:
-            for a in protocol.decode_messages(m.data):
+            for a in CENTER.decode(m.data):
                 assert isinstance(a, RegionAssignment)
                 assignments.setdefault(a.robot, []).append((a.stamp_ns / NS_PER_S, a.region))
     assert set(assignments) == set(scenario.robot_names)  # every robot got a region

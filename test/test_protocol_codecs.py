@@ -10,62 +10,99 @@ from hypothesis import strategies as st
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Header
 
+from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind
 from swarm_controllers.center import RegionState
-from swarm_msgs_py import ack, protocol, server_state
+from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
+from swarm_msgs_py import ack, server_state
 from swarm_msgs_py.cdr import CodecError
-from swarm_sim.protocol import (
-    DepotGrant,
-    DepotReport,
-    ProgressReport,
-    RadioQuery,
-    RadioReply,
-    RegionAssignment,
-)
+from swarm_msgs_py.center_protocol import CENTER
+from swarm_msgs_py.depot_protocol import DEPOT, RADIO
+from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+from swarm_msgs_py.records import post_all, topic_of
 
 names = st.sampled_from(["robot_0", "robot_7", "robot_111"])
 floats = st.floats(allow_nan=False, allow_infinity=False, width=64)
 ints = st.integers(-(2**31), 2**31)
 text = st.text(st.characters(codec="utf-8", exclude_characters="\x00"), max_size=20)
 stamps = st.integers(0, 2**31 * 10**9 - 1)  # what builtin_interfaces/Time holds
-messages = st.one_of(
-    st.builds(ProgressReport, stamps, names, floats, floats, ints, floats, st.booleans()),
-    st.builds(RegionAssignment, stamps, names, ints, st.sampled_from([1, -1]), floats, floats, st.booleans()),
-    st.builds(DepotReport, stamps, names, st.sampled_from(["join", "at", "unloaded"]), text, ints),
-    st.builds(DepotGrant, stamps, names, text, ints, st.booleans(), text),
-    st.builds(RadioQuery, stamps, names, floats, floats),
-    st.builds(RadioReply, stamps, names, names, floats, floats, text, ints, st.booleans()),
-)
+families = {
+    CENTER: st.one_of(
+        st.builds(ProgressReport, stamps, names, floats, floats, ints, floats, st.booleans()),
+        st.builds(RegionAssignment, stamps, names, ints, st.sampled_from([1, -1]), floats, floats, st.booleans()),
+    ),
+    DEPOT: st.one_of(
+        st.builds(DepotReport, stamps, names, st.sampled_from(ReportKind), text, ints),
+        st.builds(DepotGrant, stamps, names, text, ints, st.booleans(), st.sampled_from(Refusal)),
+    ),
+    RADIO: st.one_of(
+        st.builds(RadioQuery, stamps, names, floats, floats),
+        st.builds(RadioReply, stamps, names, names, floats, floats, text, ints, st.booleans()),
+    ),
+}
 
 
-@given(st.lists(messages, max_size=6), stamps)
-def test_protocol_messages_round_trip_exactly(batch, stamp):
-    data = protocol.encode_messages(stamp, batch)
-    assert protocol.decode_messages(data) == tuple(batch)
+@given(st.sampled_from(list(families)).flatmap(lambda f: st.tuples(st.just(f), st.lists(families[f], max_size=6))), stamps)
+def test_protocol_messages_round_trip_exactly(family_and_batch, stamp):
+    family, batch = family_and_batch
+    (data,) = family.encode(stamp, batch)
+    assert family.decode(data) == tuple(batch)
     msg = deserialize_message(data, DiagnosticArray)
     assert [s.name for s in msg.status] == [type(m).__name__ for m in batch]
 
 
+def test_enums_travel_as_their_values():
+    (data,) = DEPOT.encode(0, [DepotGrant(1, "robot_0", "entry_line_0", -1, False, Refusal.NOT_BEHIND_TAIL)])
+    values = dict((v.key, v.value) for v in deserialize_message(data, DiagnosticArray).status[0].values)
+    assert values["reason"] == "not behind the tail"
+    (data,) = DEPOT.encode(0, [DepotReport(1, "robot_0", ReportKind.UNLOADED)])
+    assert DEPOT.decode(data)[0].kind is ReportKind.UNLOADED
+
+
 def test_every_protocol_message_has_a_topic():
-    for cls, topic in protocol.MESSAGE_TOPICS.items():
-        assert topic.startswith("/"), cls
+    for family in (CENTER, DEPOT, RADIO):
+        for cls, topic in family.topics.items():
+            assert topic.startswith("/") and topic_of(family, cls.__new__(cls)) == topic
     with pytest.raises(TypeError, match="no topic"):
-        protocol.topic_of(object())
+        topic_of(DEPOT, object())
 
 
-def test_malformed_protocol_messages_are_named():
-    from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+def _grant_with(**changes) -> bytes:
+    values = {"stamp_ns": "1", "robot": "robot_0", "line": "l", "cell": "2", "last": "true", "reason": ""}
+    values.update(changes)
+    pairs = tuple((k, v) for k, v in values.items() if v is not None)
+    return encode_diagnostics(0, [(OK, "DepotGrant", "", "robot_0", pairs)])
 
-    unknown = encode_diagnostics(0, [(OK, "Teleport", "", "robot_0", ())])
-    with pytest.raises(CodecError, match="Teleport"):
-        protocol.decode_messages(unknown)
-    missing = encode_diagnostics(0, [(OK, "RadioQuery", "", "robot_0", (("stamp_ns", "1"),))])
-    with pytest.raises(CodecError, match="RadioQuery"):
-        protocol.decode_messages(missing)
-    bad_bool = protocol.encode_messages(0, [DepotGrant(1, "robot_0", "l", 2, True, "")]).replace(b"true", b"yes!")
+
+@pytest.mark.parametrize("data, named", [
+    (encode_diagnostics(0, [(OK, "Teleport", "", "robot_0", ())]), "Teleport"),
+    (_grant_with(cell=None), "DepotGrant.cell: missing"),
+    (_grant_with(colour="red"), "DepotGrant.colour: unknown field"),
+    (_grant_with(cell="abc"), "DepotGrant.cell: expected an integer"),
+    (_grant_with(cell="1e3"), "DepotGrant.cell: expected an integer"),
+    (_grant_with(last="yes"), "DepotGrant.last: expected true/false"),
+    (_grant_with(reason="too tired"), "DepotGrant.reason: 'too tired' is not one of"),
+    (_grant_with(stamp_ns="9" * 60), "DepotGrant.stamp_ns: expected an integer"),
+])
+def test_malformed_protocol_messages_are_refused_naming_the_field(data, named):
+    with pytest.raises(ValueError, match=named):
+        DEPOT.decode(data)
+
+
+def test_malformed_floats_and_bytes_are_refused():
+    bad = encode_diagnostics(0, [(OK, "RadioQuery", "", "robot_0",
+                                  (("stamp_ns", "1"), ("sender", "robot_0"), ("x", "nan"), ("y", "0.0")))])
+    with pytest.raises(ValueError, match="RadioQuery.x: expected a finite number"):
+        RADIO.decode(bad)
     with pytest.raises(CodecError):
-        protocol.decode_messages(bad_bool)
-    with pytest.raises(CodecError):
-        protocol.decode_messages(b"\x00\x01\x00\x00\x01")
+        DEPOT.decode(b"\x00\x01\x00\x00\x01")
+
+
+def test_post_all_drops_a_malformed_message_with_a_warning():
+    posted, warnings = [], []
+    assert post_all(DEPOT, _grant_with(cell="x"), posted.append, warnings.append) == 0
+    assert posted == [] and "DepotGrant.cell" in warnings[0]
+    assert post_all(DEPOT, _grant_with(), posted.append, warnings.append) == 1
+    assert posted[0].reason is Refusal.NONE and posted[0].last is True
 
 
 @given(st.sampled_from(["center", "depot"]), stamps)

@@ -5,12 +5,13 @@ bag gives the same metrics as the in-process batch run of the same seed."""
 from __future__ import annotations
 
 from graph_helpers import run_graph
-from swarm_msgs_py import protocol, server_state, topics
+from swarm_msgs_py import server_state, topics
+from swarm_msgs_py.depot_protocol import DEPOT
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.bag import bag_info, read_bag
 from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
-from swarm_sim.protocol import DepotGrant, DepotReport
+from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
 from swarm_sim.scenario import load_scenario
 
 ROBOTS = 16
@@ -35,13 +36,13 @@ def test_qmt_graph_run_delivers_at_docks_only(tmp_path):
     grants, reports, lengths = [], [], []
     for m in read_bag(bag):
         if m.topic == topics.DEPOT_GRANTS:
-            grants += protocol.decode_messages(m.data)
+            grants += DEPOT.decode(m.data)
         elif m.topic == topics.DEPOT_REPORTS:
-            reports += protocol.decode_messages(m.data)
+            reports += DEPOT.decode(m.data)
         elif m.topic == topics.DEPOT_STATE:
             lengths.append(server_state.queue_lengths(server_state.decode_state(m.data)[1]))
     assert all(isinstance(g, DepotGrant) for g in grants) and all(isinstance(r, DepotReport) for r in reports)
-    unloaded = {r.robot for r in reports if r.kind == "unloaded"}
+    unloaded = {r.robot for r in reports if r.kind is ReportKind.UNLOADED}
     assert unloaded == {d.robot for d in trace.drops}
     assert all(len(q) == 4 for q in lengths)
 

@@ -71,7 +71,7 @@ def test_queue_lengths_are_recorded(run):
 
 
 def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
-    from swarm_sim.protocol import RadioQuery
+    from depot_manager.protocol import RadioQuery
 
     for name, expect in (("queue_qmt", True), ("queue_qme", False)):
         scenario = load_scenario(name, [f"robots.count={ROBOTS}", "sim.duration=120"])

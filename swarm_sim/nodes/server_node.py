@@ -24,7 +24,9 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, protocol, topics
+from swarm_msgs_py import ack, topics
+from swarm_msgs_py.records import post_all
+from swarm_sim import registry
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
@@ -45,11 +47,11 @@ class ServerNodeConfig:
 
 
 class ServerNode(Node):
+    """A registered server (`swarm_sim.registry.ServerSpec`) on the graph; subclasses name
+    their `CHANNEL` and may publish state and markers."""
+
     CHANNEL = ""
-    INBOUND = ""
-    """The topic robots send this server's messages on."""
-    OUTBOUND: tuple[str, ...] = ()
-    """The topics the server's answers go out on."""
+    """The server's channel, as its registry record names it."""
 
     def __init__(self, name: str, config: ServerNodeConfig | None = None, **kwargs) -> None:
         super().__init__(
@@ -58,19 +60,25 @@ class ServerNode(Node):
         )
         self.config = cfg = declare_config(self, ServerNodeConfig, config)
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
-        self.server: Server = self.make_server(self.scenario)
+        specs = [s for s in registry.of(self.scenario).servers if s.channel == self.CHANNEL]
+        if not specs:
+            raise ValueError(f"{self.scenario.controller.behaviour} registers no {self.CHANNEL!r} server")
+        self.server: Server = registry.resolve(specs[0].core)(self.scenario)
         self.mailbox = Mailbox()
         self._done = -1
-        self._inbound = self.create_subscription(
-            topics.type_of(self.INBOUND), self.INBOUND, self._on_message, EVENTS, raw=True
-        )
-        self._outbound = {t: self.create_publisher(topics.type_of(t), t, EVENTS) for t in self.OUTBOUND}
+        inbound, outbound = registry.server_topics(specs[0])
+        self._inbound = [
+            self.create_subscription(
+                topics.import_type(f.type_name), t, lambda data, f=f: self._on_message(f, data), EVENTS, raw=True
+            )
+            for t, f in inbound.items()
+        ]
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+                          for t, f in outbound.items()}
+        self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,
                                  SENSOR_LOCKSTEP, raw=True)
         self._ack_pub = None
-
-    def make_server(self, scenario: Scenario) -> Server:
-        raise NotImplementedError
 
     def publish_state(self, stamp_ns: int) -> None:
         """Subclasses publish the core's state and markers after each tick."""
@@ -81,16 +89,16 @@ class ServerNode(Node):
         robots = self.scenario.robots.count
         deadline = time.monotonic() + self.config.startup_timeout
         while time.monotonic() < deadline and (
-            self._inbound.get_publisher_count() < robots
-            or any(p.get_subscription_count() < robots for p in self._outbound.values())
+            any(sub.get_publisher_count() < robots for sub in self._inbound)
+            or any(pub.get_subscription_count() < robots for _, pub in self._outbound.values())
         ):
             executor.spin_once(timeout_sec=0.1)
         self._ack_pub = self.create_publisher(
             topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP
         )
 
-    def _on_message(self, data: bytes) -> None:
-        protocol.post_all(data, self.mailbox.post, self.get_logger().warning)
+    def _on_message(self, family, data: bytes) -> None:
+        post_all(family, data, self.mailbox.post, self.get_logger().warning)
 
     def _on_clock(self, data: bytes) -> None:
         if self._ack_pub is None:
@@ -100,9 +108,11 @@ class ServerNode(Node):
             out = self.server.step(stamp, self.mailbox.take_before(stamp))
             by_topic: dict[str, list] = defaultdict(list)
             for m in out:
-                by_topic[protocol.topic_of(m)].append(m)
+                by_topic[self._topic_of[type(m)]].append(m)
             for topic, messages in by_topic.items():
-                self._outbound[topic].publish(protocol.encode_messages(stamp, messages))
+                family, pub = self._outbound[topic]
+                for data in family.encode(stamp, messages):
+                    pub.publish(data)
             self.publish_state(stamp)
             self._done = stamp
         if stamp == self._done:

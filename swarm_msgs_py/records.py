@@ -1,0 +1,173 @@
+"""Message families: protocol dataclasses <-> standard ROS messages, strictly typed.
+
+A `MessageFamily` is what a paper's protocol looks like on the graph: which topic each message
+class travels on, and how a batch of messages of one tick becomes the bytes of one message and
+back. The registry names families (`swarm_sim.registry`); the nodes derive their publishers and
+subscriptions from them, and nothing else lists protocol topics.
+
+`RecordFamily` maps dataclass records to diagnostic_msgs/msg/DiagnosticArray: one array per
+topic per tick, header.stamp = the tick the messages were sent in; one DiagnosticStatus per
+message: level OK, name = the message's class (``DepotGrant``), hardware_id = its sender or
+addressee robot, message empty, values = every field in declaration order as (name, text):
+ints with ``str``, floats with ``repr`` (exact round trip), bools as ``true``/``false``, enums
+as their value. ``ros2 topic echo /depot/grants`` therefore reads as the dataclass.
+
+Decoding is strict: an unknown message name, an unknown or missing field, or a value that is not
+of the field's declared type (int, float, bool, str, an Enum, or ``X | None``) is refused with a
+ValueError naming ``Class.field`` and the text.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+import types
+import typing
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any, Protocol
+
+from swarm_msgs_py.diagnostics import OK, TYPE_NAME, decode_diagnostics, encode_diagnostics
+
+
+class MessageFamily(Protocol):
+    """A protocol's messages on the graph."""
+
+    name: str
+    topics: Mapping[type, str]
+    """Message class -> the topic it travels on."""
+    type_name: str
+    """The ROS type of every topic of the family."""
+
+    def encode(self, stamp_ns: int, messages: Iterable[Any]) -> list[bytes]:
+        """Messages of one tick, all for the same topic -> the wire messages to publish."""
+        ...
+
+    def decode(self, data: bytes) -> tuple[Any, ...]:
+        """One wire message -> its messages, in order; ValueError naming what is malformed."""
+        ...
+
+
+def topic_of(family: MessageFamily, message: Any) -> str:
+    try:
+        return family.topics[type(message)]
+    except KeyError:
+        raise TypeError(f"{family.name}: no topic for message type {type(message).__name__}") from None
+
+
+def post_all(family: MessageFamily, data: bytes, post: Callable[[Any], None], warn: Callable[[str], None]) -> int:
+    """A node's raw subscription callback body: decode `data` and `post` every message; a
+    malformed message is dropped with a warning naming the problem (nothing else is lost).
+    Returns the number of messages posted."""
+    try:
+        messages = family.decode(data)
+    except ValueError as exc:
+        warn(f"dropping a malformed {family.name} message: {exc}")
+        return 0
+    for m in messages:
+        post(m)
+    return len(messages)
+
+
+def _text(value: Any) -> str:
+    if isinstance(value, enum.Enum):
+        return str(value.value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def _parser(tp: Any, key: str) -> Callable[[str], Any]:
+    """The strict text -> value function for a field of type `tp`."""
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(tp) if a is not type(None)]
+        if len(args) != 1:
+            raise TypeError(f"{key}: only X | None unions are supported")
+        inner = _parser(args[0], key)
+        return lambda text: None if text == "None" else inner(text)
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        by_value = {str(m.value): m for m in tp}
+
+        def parse_enum(text: str) -> Any:
+            if text not in by_value:
+                raise ValueError(f"{key}: {text!r} is not one of {sorted(by_value)}")
+            return by_value[text]
+
+        return parse_enum
+    if tp is bool:
+        def parse_bool(text: str) -> bool:
+            if text not in ("true", "false"):
+                raise ValueError(f"{key}: expected true/false, got {text!r}")
+            return text == "true"
+
+        return parse_bool
+    if tp is int:
+        def parse_int(text: str) -> int:
+            if not text.lstrip("-").isdigit() or len(text) > 40:
+                raise ValueError(f"{key}: expected an integer, got {text!r}")
+            return int(text)
+
+        return parse_int
+    if tp is float:
+        def parse_float(text: str) -> float:
+            try:
+                value = float(text)
+            except ValueError:
+                raise ValueError(f"{key}: expected a number, got {text!r}") from None
+            if not math.isfinite(value):
+                raise ValueError(f"{key}: expected a finite number, got {text!r}")
+            return value
+
+        return parse_float
+    if tp is str:
+        return str
+    raise TypeError(f"{key}: unsupported field type {tp}")
+
+
+class RecordFamily:
+    """Dataclass messages as DiagnosticArray records (see the module docstring)."""
+
+    type_name = TYPE_NAME
+
+    def __init__(self, name: str, topics: Mapping[type, str]) -> None:
+        self.name = name
+        self.topics = dict(topics)
+        self._classes = {cls.__name__: cls for cls in self.topics}
+        self._fields: dict[type, tuple[str, ...]] = {}
+        self._parsers: dict[type, tuple[Callable[[str], Any], ...]] = {}
+        for cls in self.topics:
+            hints = typing.get_type_hints(cls)
+            names = tuple(f.name for f in dataclasses.fields(cls))
+            self._fields[cls] = names
+            self._parsers[cls] = tuple(_parser(hints[n], f"{cls.__name__}.{n}") for n in names)
+
+    def encode(self, stamp_ns: int, messages: Iterable[Any]) -> list[bytes]:
+        statuses = []
+        for m in messages:
+            cls = type(m)
+            if cls not in self._fields:
+                raise TypeError(f"not a {self.name} message: {cls.__name__}")
+            values = tuple((name, _text(getattr(m, name))) for name in self._fields[cls])
+            addressee = getattr(m, "robot", None) or getattr(m, "sender", "")
+            statuses.append((OK, cls.__name__, "", addressee, values))
+        return [encode_diagnostics(stamp_ns, statuses)]
+
+    def decode(self, data: bytes) -> tuple[Any, ...]:
+        _, statuses = decode_diagnostics(data)
+        out = []
+        for status in statuses:
+            cls = self._classes.get(status.name)
+            if cls is None:
+                raise ValueError(f"unknown {self.name} message {status.name!r} (known: {', '.join(self._classes)})")
+            values = dict(status.values)
+            names = self._fields[cls]
+            unknown = sorted(set(values) - set(names))
+            if unknown:
+                raise ValueError(f"{status.name}.{unknown[0]}: unknown field")
+            missing = [n for n in names if n not in values]
+            if missing or len(values) != len(status.values):
+                raise ValueError(f"{status.name}.{(missing or ['?'])[0]}: missing or repeated field")
+            out.append(cls(*(parse(values[n]) for n, parse in zip(names, self._parsers[cls]))))
+        return tuple(out)
