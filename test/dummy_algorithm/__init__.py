@@ -14,6 +14,6 @@ register(Algorithm(
     task="beacon",
     servers=(ServerSpec(channel="counter", core="dummy_algorithm.server:CounterServer",
                         node="dummy_algorithm.node", script="dummy-counter",
-                        family="dummy_algorithm.codec:PINGS"),),
+                        family="dummy_algorithm.codec:PINGS", replay="dummy_algorithm.server:replay_pings"),),
     metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard", None),),
 ))

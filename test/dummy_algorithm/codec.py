@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import struct
 
+from dummy_algorithm.messages import Ping
 from dummy_algorithm.task import BeaconSense
 from swarm_msgs_py.cdr import ENCAPSULATION, align, codec, frames_fragment, skip_header, split_stamp
+from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.sensing import Sensing, SenseTopic
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
@@ -28,3 +30,6 @@ def decode_beacon(data: bytes) -> tuple[int, tuple[float, float]]:
 
 
 SENSING = Sensing(BeaconSense, (SenseTopic("beacon", TYPE_NAME, "beacon", encode_beacon, decode_beacon),))
+
+PINGS = RecordFamily("pings", {Ping: "/dummy/pings"})
+"""The dummy's message family: robots' pings to the counter server."""

@@ -1,0 +1,84 @@
+"""The algorithm registry: one record per algorithm, read everywhere; a plug-in algorithm (the
+dummy in test/dummy_algorithm: its own behaviour, world task and sense topic, server, message
+family and metric) runs in batch and on the graph by registering itself."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from swarm_sim import registry
+from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_msgs_py import topics
+
+TEST_DIR = Path(__file__).resolve().parent
+DUMMY = str(TEST_DIR / "dummy_algorithm" / "dummy.yaml")
+
+
+def _plugin_env() -> dict[str, str]:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(TEST_DIR), os.environ.get("PYTHONPATH", "")]),
+            registry.PLUGINS_ENV: "dummy_algorithm"}
+
+
+def test_shipped_records_and_their_wiring():
+    assert registry.known() == ("cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue")
+    queue = registry.algorithm("queue")
+    inbound, outbound = registry.robot_topics(queue)
+    assert set(inbound) == {topics.DEPOT_GRANTS, topics.RADIO, topics.PHEROMONES}
+    assert set(outbound) == {topics.DEPOT_REPORTS, topics.RADIO, topics.PHEROMONES}
+    server_in, server_out = registry.server_topics(queue.servers[0])
+    assert set(server_in) == {topics.DEPOT_REPORTS} and set(server_out) == {topics.DEPOT_GRANTS}
+    assert registry.robot_topics(registry.algorithm("ddsa")) == ({}, {})
+
+
+def test_records_are_refused_twice_and_unknown_names_are_named():
+    with pytest.raises(ValueError, match="already registered"):
+        registry.register(registry.algorithm("cpfa"))
+    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour 'nope' \\(known: cpfa"):
+        load_scenario("cpfa", ["controller.behaviour=nope"])
+    with pytest.raises(ScenarioError, match="unknown key controller.colour"):
+        load_scenario("cpfa", ["controller.colour=red"])
+    with pytest.raises(ScenarioError, match="depot.delivery: queue delivers to docks"):
+        load_scenario("queue_qmt", ["depot.delivery=depot"])
+
+
+def test_sections_belong_to_the_algorithms_and_round_trip():
+    from swarm_sim.scenario import scenario_from_dict, scenario_to_dict
+
+    s = load_scenario("queue_qst", ["controller.queue.lane_spacing=0.25", "controller.cpfa.search_step=0.1"])
+    again = scenario_from_dict(scenario_to_dict(s))
+    assert again == s
+    assert scenario_to_dict(s)["controller"]["queue"]["lane_spacing"] == 0.25
+    with pytest.raises(ScenarioError, match="controller.queue.wrapping: expected one of"):
+        load_scenario("queue_qst", ["controller.queue.wrapping=triple"])
+
+
+def test_the_scenario_module_imports_no_algorithm():
+    code = ("import sys, swarm_sim.scenario, swarm_sim.sites, swarm_sim.registry; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('swarm_controllers', 'depot_manager')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "[]", out.stderr
+
+
+def test_plugin_algorithm_runs_in_batch_and_on_the_graph_and_conforms(tmp_path):
+    """The dummy touches no file of the tree: its package plus its one register() call."""
+    code = (
+        "from swarm_sim.conformance import check_algorithm; import json, sys; "
+        f"print(json.dumps(check_algorithm({DUMMY!r}, robots=4, duration=20.0, "
+        f"graph_bag=__import__('pathlib').Path({str(tmp_path / 'bag')!r}), "
+        f"domain_id={int(os.environ['ROS_DOMAIN_ID'])})))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=_plugin_env())
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == ["ros_free", "determinism", "codecs", "graph_equals_batch"]
+    # the run's own metric, from the bag the graph check recorded
+    summary = subprocess.run([sys.executable, "-m", "swarm_sim.analysis.cli", str(tmp_path / "bag"), "--json", "--no-plot"],
+                             capture_output=True, text=True, timeout=120, env=_plugin_env())
+    result = json.loads(summary.stdout.strip().splitlines()[-1])
+    assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
+    assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults
