@@ -1,4 +1,4 @@
-"""swarm_sim.bag: rosbag2-compatible recording without ROS, crash recovery, clear errors.
+"""swarm_sim.recording: rosbag2-compatible recording without ROS, crash recovery, clear errors.
 
 Bags are written from real CDR bytes (rclpy.serialization of common_interfaces messages) and read
 back with three independent readers: our own, rosbags, and mcap + mcap_ros2.
@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 from nav_msgs.msg import Odometry
 from rclpy.serialization import deserialize_message, serialize_message
 
-from swarm_sim.bag import (
+from swarm_sim.recording import (
     BagError,
     BagTruncatedWarning,
     BagWriter,
@@ -290,7 +290,7 @@ KILLED_WRITER = textwrap.dedent(
     import sys, time
     from rclpy.serialization import serialize_message
     from geometry_msgs.msg import TwistStamped
-    from swarm_sim.bag import BagWriter
+    from swarm_sim.recording import BagWriter
 
     bag = BagWriter(sys.argv[1], split_seconds=1.0, flush_seconds=0.2, metadata={"seed": 3})
     bag.add_topic("/robot_0/cmd_vel", "geometry_msgs/msg/TwistStamped")

@@ -15,7 +15,7 @@ import pytest
 
 from graph_helpers import SMALL_ARENA, overrides, run_graph
 from swarm_msgs_py import topics
-from swarm_sim.bag import bag_info, read_bag
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.analysis.replay import load_run
 
 ROBOTS = 8

@@ -12,7 +12,7 @@ from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import topics
 from swarm_msgs_py.center_protocol import CENTER
 from swarm_sim.analysis.replay import load_odometry, load_run
-from swarm_sim.bag import bag_info, read_bag
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
 from swarm_controllers.center_protocol import RegionAssignment

@@ -8,7 +8,7 @@ from graph_helpers import run_graph
 from swarm_msgs_py import server_state, topics
 from swarm_msgs_py.depot_protocol import DEPOT
 from swarm_sim.analysis.replay import load_run
-from swarm_sim.bag import bag_info, read_bag
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
 from depot_manager.protocol import DepotGrant, DepotReport, ReportKind

@@ -10,7 +10,7 @@ from pathlib import Path
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
-from swarm_sim.bag import BagError
+from swarm_sim.recording import BagError
 
 
 def main(argv: list[str] | None = None) -> int:

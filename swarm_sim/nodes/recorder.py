@@ -17,7 +17,7 @@ from rclpy.qos import DurabilityPolicy
 
 from swarm_msgs_py import topics
 from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED
-from swarm_sim.bag import BagWriter
+from swarm_sim.recording import BagWriter
 
 
 class Recorder:
