@@ -22,8 +22,8 @@ WALL_FIELDS = ("wall_seconds", "real_time_factor")
 
 
 def fingerprint(name: str, duration: float) -> dict:
-    from swarm_sim.batch import run_batch
     from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.batch import run_batch
     from swarm_sim.scenario import load_scenario
 
     scenario = load_scenario(name, (f"sim.duration={duration}",))

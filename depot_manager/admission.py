@@ -117,6 +117,7 @@ from depot_manager.cells import _bearing, _model
 from depot_manager.geometry import QueueLayout
 from depot_manager.protocol import Refusal
 
+
 @dataclass(frozen=True)
 class DepotState:
     """What the depot manager knows at one instant (for `/depot/state` and metrics)."""

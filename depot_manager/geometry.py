@@ -32,8 +32,8 @@ from typing import Literal
 
 import numpy as np
 
-from swarm_sim.sites import Dock, docks
 from depot_manager.config import QueueConfig
+from swarm_sim.sites import Dock, docks
 
 ARC_STEP = 0.04
 """Maximum waypoint spacing along discretised arcs [m]; chords cut inside an arc by at most

@@ -12,12 +12,12 @@ import sys
 
 import numpy as np
 
+from depot_manager.config import QueueConfig
+from depot_manager.protocol import DEPOT
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
-from depot_manager.protocol import DEPOT
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 from swarm_sim.types import NS_PER_S
-from depot_manager.config import QueueConfig
 
 MARKER_PERIOD = 1.0
 """Sim seconds between slot-occupancy marker updates."""

@@ -14,10 +14,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from depot_manager.admission import DepotAdmission
+from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
 from swarm_sim.types import NS_PER_S
-from depot_manager.config import QueueConfig
 
 
 class DepotServer:

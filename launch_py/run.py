@@ -21,8 +21,8 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import loopback_env, private_domain_id
-from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim import registry
+from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 
@@ -130,8 +130,8 @@ def main(argv: list[str] | None = None) -> int:
         _stop(controllers, grace=10.0)
         _stop([world], grace=60.0)
 
-    from swarm_sim.analysis.replay import load_run
     from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.analysis.replay import load_run
 
     try:
         summary = summarize(load_run(bag))

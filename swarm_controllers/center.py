@@ -56,6 +56,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
+from swarm_controllers.config import SpiralConfig
 from swarm_controllers.spiral import (
     SpiralPath,
     mdbsa_leg_steps,
@@ -63,10 +65,8 @@ from swarm_controllers.spiral import (
     region_side,
     segments_overlap_collinear,
 )
-from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, RobotId, robot_index
-from swarm_controllers.config import SpiralConfig
 
 FORWARD = 1
 """Walk from the spiral's start (region center), outward, clockwise."""

@@ -11,10 +11,10 @@ from __future__ import annotations
 import sys
 
 from swarm_controllers.center import region_paths
+from swarm_controllers.center_protocol import CENTER
 from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
-from swarm_controllers.center_protocol import CENTER
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
 
 _REGION = (0.6, 0.6, 0.6, 1.0)

@@ -24,12 +24,12 @@ from rclpy.parameter import Parameter
 
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
-from swarm_msgs_py.records import post_all
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
-from swarm_sim.messaging import Mailbox
+from swarm_msgs_py.records import post_all
 from swarm_sim import registry
+from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import DEFAULT_SCENARIO, load_scenario
 from swarm_sim.types import Observation, robot_index
 

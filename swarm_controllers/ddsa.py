@@ -81,7 +81,6 @@ from swarm_sim.types import (
     robot_index,
 )
 
-
 LANE_YIELD_TIMEOUT = 3.0
 """A searcher whose lane stays blocked this long [s, sim time] swerves after all."""
 

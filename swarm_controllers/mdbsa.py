@@ -62,14 +62,14 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.center import region_paths
+from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
+from swarm_controllers.config import SpiralConfig
 from swarm_controllers.ddsa import LaneAvoidance
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath
-from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, RobotId
-from swarm_controllers.config import SpiralConfig
 
 ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""

@@ -55,14 +55,14 @@ from functools import lru_cache
 import numpy as np
 
 from depot_manager.admission import DepotAdmission
+from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
+from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind, within_range
 from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
-from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind, within_range
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
-from depot_manager.config import QueueConfig
 
 KEEP_OUT_BAND = 0.25
 """Non-carriers keep this far outside the perimeter [m]."""

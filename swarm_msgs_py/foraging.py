@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 from swarm_msgs_py import gripper, resources, topics
-from swarm_msgs_py.sensing import Sensing, SenseTopic
+from swarm_msgs_py.sensing import SenseTopic, Sensing
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 SENSING = Sensing(ForagingSense, (

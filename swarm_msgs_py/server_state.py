@@ -19,8 +19,8 @@ from typing import Any
 
 from swarm_msgs_py import topics
 from swarm_msgs_py.cdr import codec
-from swarm_sim.types import NS_PER_S
 from swarm_msgs_py.diagnostics import OK, TYPE_NAME, decode_diagnostics, encode_diagnostics
+from swarm_sim.types import NS_PER_S
 
 
 @codec(f"{TYPE_NAME} (center state)")

@@ -20,11 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_controllers.api import behaviour_rng
+from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, scenario_fields
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers
-from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World

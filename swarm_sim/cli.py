@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from swarm_sim.scenario import DEFAULT_SCENARIO
-
 import argparse
+
+from swarm_sim.scenario import DEFAULT_SCENARIO
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:

@@ -15,16 +15,25 @@ from swarm_sim.compare import comparisons
 from swarm_sim.compare.cli import build_parser, main
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.queue_paper import (
-    PAPER_TABLE_II, QUEUE_STRATEGIES, queue_plans, queue_ttests_md, write_queue_report,
+    PAPER_TABLE_II,
+    QUEUE_STRATEGIES,
+    queue_plans,
+    queue_ttests_md,
+    write_queue_report,
 )
 from swarm_sim.compare.spiral_paper import (
-    PAPER_SPIRAL_CLAIMS, SPIRAL_EXPERIMENTS, SPIRAL_STRATEGIES, resource_layout, spiral_mannwhitney_md,
-    spiral_plans, write_spiral_report,
+    PAPER_SPIRAL_CLAIMS,
+    SPIRAL_EXPERIMENTS,
+    SPIRAL_STRATEGIES,
+    resource_layout,
+    spiral_mannwhitney_md,
+    spiral_plans,
+    write_spiral_report,
 )
 from swarm_sim.compare.stats import pairwise_tests, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, read_results, run_sweep, slim
-from swarm_sim.world.resources import place_resources
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.resources import place_resources
 
 QUEUE_KEYS = ("resources_collected_pct", "collision_time_per_robot_s", "dropoff_time_mean_s")
 SPIRAL_KEYS = ("resources_per_robot", "collision_time_per_robot_s", "foraging_rate_per_min",

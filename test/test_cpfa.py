@@ -15,8 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from swarm_controllers.api import Behaviour, behaviour_rng
-from swarm_sim.registry import known as known_behaviours
-from swarm_sim.registry import make_behaviour
+from swarm_controllers.config import CpfaConfig
 from swarm_controllers.cpfa import (
     CpfaBehaviour,
     CpfaState,
@@ -25,10 +24,11 @@ from swarm_controllers.cpfa import (
     per_tick_probability,
     poisson_cdf,
 )
+from swarm_sim.registry import known as known_behaviours
+from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, PheromoneMessage, Pose2D
-from swarm_controllers.config import CpfaConfig
+from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = load_scenario("cpfa")
 DT_NS = BASE.dt_ns

@@ -12,16 +12,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_controllers.api import behaviour_rng
-from swarm_sim.registry import known as known_behaviours
-from swarm_sim.registry import make_behaviour
 from swarm_controllers.avoidance import ray_angles
+from swarm_controllers.config import SpiralConfig
 from swarm_controllers.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral import ddsa_path
 from swarm_sim.analysis.metrics import resources_delivered
-from swarm_controllers.config import SpiralConfig
+from swarm_sim.registry import known as known_behaviours
+from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
-from swarm_sim.world.tasks.foraging import ForagingSense
 from swarm_sim.types import Command, Observation, Pose2D
+from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = load_scenario("ddsa", robots__count=4)
 DT = BASE.sim.dt

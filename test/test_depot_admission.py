@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from depot_manager.admission import DepotAdmission
+from depot_manager.config import QueueConfig
 from depot_manager.geometry import (
     DepotGeometryConfig,
     Dock,
@@ -31,10 +32,9 @@ from depot_manager.geometry import (
     QueueLayout,
     make_layout,
 )
-from depot_manager.server import DepotServer
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
+from depot_manager.server import DepotServer
 from swarm_controllers.center_protocol import ProgressReport
-from depot_manager.config import QueueConfig
 from swarm_sim.scenario import ControllerConfig, DepotConfig, Scenario
 
 P_MIN = 0.3

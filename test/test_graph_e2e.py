@@ -15,8 +15,8 @@ import pytest
 
 from graph_helpers import SMALL_ARENA, overrides, run_graph
 from swarm_msgs_py import topics
-from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.analysis.replay import load_run
+from swarm_sim.recording import bag_info, read_bag
 
 ROBOTS = 8
 DURATION = 40.0

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.registry import make_behaviour
+from depot_manager.protocol import DepotReport, ReportKind
 from swarm_controllers.center import (
     FORWARD,
     REVERSE,
@@ -22,6 +22,8 @@ from swarm_controllers.center import (
     region_paths,
     region_spiral,
 )
+from swarm_controllers.center_protocol import CENTER, ProgressReport, RegionAssignment
+from swarm_controllers.config import SpiralConfig
 from swarm_controllers.mdbsa import ASK_MARGIN, ASK_RETRY, IDLE_RETRY, MdbsaBehaviour, MdbsaState
 from swarm_controllers.spiral import (
     mdbsa_path,
@@ -30,14 +32,12 @@ from swarm_controllers.spiral import (
     segments_overlap_collinear,
 )
 from swarm_sim.messaging import Router
-from depot_manager.protocol import DepotReport, ReportKind
-from swarm_controllers.center_protocol import CENTER, ProgressReport, RegionAssignment
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.sites import drop_zones
+from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
-from swarm_sim.world.tasks.foraging import ForagingSense
+from swarm_sim.sites import drop_zones
 from swarm_sim.types import DropEvent, Observation, PheromoneMessage, Pose2D, robot_name
-from swarm_controllers.config import SpiralConfig
+from swarm_sim.world.tasks.foraging import ForagingSense
 
 C = load_scenario("mdbsa_c")
 D = load_scenario("mdbsa_d")

@@ -8,14 +8,14 @@ from __future__ import annotations
 import numpy as np
 
 from graph_helpers import run_graph
+from swarm_controllers.center_protocol import RegionAssignment
 from swarm_controllers.spiral import region_centers, region_side
 from swarm_msgs_py import topics
 from swarm_msgs_py.center_protocol import CENTER
-from swarm_sim.analysis.replay import load_odometry, load_run
-from swarm_sim.recording import bag_info, read_bag
-from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
-from swarm_controllers.center_protocol import RegionAssignment
+from swarm_sim.analysis.replay import load_odometry, load_run
+from swarm_sim.batch import run_batch
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S
 

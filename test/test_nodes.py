@@ -15,10 +15,10 @@ from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_run
+from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import PheromoneMessage, Pose2D
-from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")

@@ -4,14 +4,14 @@ bag gives the same metrics as the in-process batch run of the same seed."""
 
 from __future__ import annotations
 
+from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
 from graph_helpers import run_graph
 from swarm_msgs_py import server_state, topics
 from swarm_msgs_py.depot_protocol import DEPOT
-from swarm_sim.analysis.replay import load_run
-from swarm_sim.recording import bag_info, read_bag
-from swarm_sim.batch import run_batch
 from swarm_sim.analysis.metrics import summarize
-from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
+from swarm_sim.analysis.replay import load_run
+from swarm_sim.batch import run_batch
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.scenario import load_scenario
 
 ROBOTS = 16

@@ -9,13 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
-from swarm_sim.batch import run_batch
-from swarm_sim.analysis.metrics import summarize
-from swarm_sim.scenario import load_scenario
-from swarm_sim.world.tasks.foraging import ForagingSense
-from swarm_sim.types import NS_PER_S
 from depot_manager.config import QueueConfig
+from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
+from swarm_sim.analysis.metrics import summarize
+from swarm_sim.batch import run_batch
+from swarm_sim.scenario import load_scenario
+from swarm_sim.types import NS_PER_S
+from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROBOTS = 16
 DURATION = 150.0

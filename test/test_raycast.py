@@ -10,10 +10,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, scan_angles
 from swarm_sim.scenario import ObstacleConfig, ScanConfig, load_scenario
 from swarm_sim.types import Pose2D
 from swarm_sim.world import World
+from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, scan_angles
 
 R = 0.085  # robot radius [m]
 OPEN = StaticScene(6.0, np.zeros((0, 3)), np.zeros((0, 5)))

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from swarm_msgs_py import topics
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
-from swarm_msgs_py import topics
 
 TEST_DIR = Path(__file__).resolve().parent
 DUMMY = str(TEST_DIR / "dummy_algorithm" / "dummy.yaml")

@@ -9,9 +9,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes
-from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
+from swarm_sim.sites import drop_zones
+from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes
 
 ARENA = ArenaConfig(size=12.0)
 DEPOT = DepotConfig(center=(0.0, 0.0), radius=0.5)

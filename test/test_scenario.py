@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import pytest
 
-from swarm_sim.sites import drop_zones
 from swarm_sim.scenario import (
     SCENARIO_DIR,
     Scenario,
@@ -14,6 +13,7 @@ from swarm_sim.scenario import (
     scenario_from_dict,
     scenario_to_dict,
 )
+from swarm_sim.sites import drop_zones
 
 
 @pytest.mark.parametrize("path", sorted(SCENARIO_DIR.glob("*.yaml")), ids=lambda p: p.stem)

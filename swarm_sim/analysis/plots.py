@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace, delivered_over_time, summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.recording import bag_info
-from swarm_sim import registry
 from swarm_sim.scenario import scenario_from_dict
 from swarm_sim.sites import drop_zones
 

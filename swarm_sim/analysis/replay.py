@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, topics
 from swarm_sim import registry
-from swarm_msgs_py import clock as clock_codec
-from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
+from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
 from swarm_sim.types import NS_PER_S, DropEvent, robot_index
 

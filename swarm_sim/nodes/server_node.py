@@ -25,12 +25,12 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from swarm_msgs_py import ack, topics
-from swarm_msgs_py.records import post_all
-from swarm_sim import registry
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.records import post_all
+from swarm_sim import registry
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import Server
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario

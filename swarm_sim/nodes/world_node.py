@@ -31,13 +31,13 @@ from rclpy.signals import SignalHandlerOptions
 from swarm_msgs_py import ack as ack_codec
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, markers, odometry, scan, topics, twist
-from swarm_msgs_py.sensing import Sensing
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.sensing import Sensing
+from swarm_sim import registry
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.recorder import Recorder
-from swarm_sim import registry
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
 from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
 from swarm_sim.world import World

@@ -45,9 +45,9 @@ import numpy as np
 import pybullet as p
 
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
-from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.world.tasks import TaskFactory, WorldTask
 
 ROBOT_MASS = 1.0

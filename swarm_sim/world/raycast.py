@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm_sim.scenario import Scenario, ScanConfig
+from swarm_sim.scenario import ScanConfig, Scenario
 
 TWO_PI = 2 * math.pi
 _WINDOW_EPS = 1e-9

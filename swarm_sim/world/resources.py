@@ -22,10 +22,9 @@ Distributions:
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
-
-from collections.abc import Sequence
 
 from swarm_sim.scenario import ArenaConfig, DepotConfig, DropZoneConfig, ResourceConfig, ScenarioError
 
