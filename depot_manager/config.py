@@ -6,12 +6,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
 
+from swarm_sim.scenario import Section
+
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
 
 
 @dataclass(frozen=True)
-class QueueConfig:
+class QueueConfig(Section):
     wrapping: Literal["single", "multi"] = "multi"
     """Queue wrapping inside the perimeter (sec. IV): single-queue or multi-queue wrapping."""
     joining: Literal["entry", "tail"] = "entry"
@@ -26,12 +28,6 @@ class QueueConfig:
     cells, which on our shared ring nearly serialises the docks."""
 
     SECTION: ClassVar[str] = "queue"
-    """Its key under ``controller`` in a scenario."""
-
-    @classmethod
-    def of(cls, scenario: Scenario) -> QueueConfig:
-        """The scenario's ``controller.queue`` section (its defaults if not given)."""
-        return scenario.controller.section(cls.SECTION)
 
 
 def check_queue(scenario: Scenario) -> None:

@@ -10,12 +10,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
+from swarm_sim.scenario import Section
+
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
 
 
 @dataclass(frozen=True)
-class CpfaConfig:
+class CpfaConfig(Section):
     """Central-place foraging algorithm parameters (Hecker & Moses 2015, Table 1/3).
 
     Defaults are the values BCLab's CPFA implementation labels "according to Beyond
@@ -47,16 +49,10 @@ class CpfaConfig:
     behaviour applies the same hazard per second at every tick of ours."""
 
     SECTION: ClassVar[str] = "cpfa"
-    """Its key under ``controller`` in a scenario."""
-
-    @classmethod
-    def of(cls, scenario: Scenario) -> CpfaConfig:
-        """The scenario's ``controller.cpfa`` section (its defaults if not given)."""
-        return scenario.controller.section(cls.SECTION)
 
 
 @dataclass(frozen=True)
-class SpiralConfig:
+class SpiralConfig(Section):
     """Square-spiral search (DDSA / MDBSA, Lu & Luna 2023). The regions themselves are world
     facts (the scenario's ``regions`` section)."""
 
@@ -69,12 +65,6 @@ class SpiralConfig:
     """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
 
     SECTION: ClassVar[str] = "spiral"
-    """Its key under ``controller`` in a scenario."""
-
-    @classmethod
-    def of(cls, scenario: Scenario) -> SpiralConfig:
-        """The scenario's ``controller.spiral`` section (its defaults if not given)."""
-        return scenario.controller.section(cls.SECTION)
 
 
 def check_spiral(scenario: Scenario) -> None:

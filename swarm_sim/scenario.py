@@ -16,9 +16,12 @@ import types
 import typing
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, get_args, get_origin
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, get_args, get_origin
 
 import yaml
+
+if TYPE_CHECKING:
+    from typing import Self  # Python >= 3.11; annotations only
 
 SCENARIO_DIR = Path(__file__).resolve().parent / "scenarios"
 DEFAULT_SCENARIO = "cpfa"
@@ -192,6 +195,17 @@ class AvoidanceConfig:
     """Width of the front sector watched for obstacles [rad]."""
     turn_speed: float = 1.5
     """[rad/s] while turning away."""
+
+
+class Section:
+    """Base of an algorithm's scenario section (a frozen dataclass): `SECTION` is its key under
+    ``controller``, `of` reads it from a scenario (its defaults if the scenario does not give it)."""
+
+    SECTION: ClassVar[str] = ""
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> Self:
+        return scenario.controller.section(cls.SECTION)
 
 
 @dataclass(frozen=True)
