@@ -36,21 +36,21 @@ topic                 type                                 from -> to        cor
 /world/markers        visualization_msgs/msg/MarkerArray   world -> RViz     scenario + state
                                                                              (`markers`)
 /center/reports       diagnostic_msgs/msg/DiagnosticArray  robot -> center   ProgressReport
-                                                                             (`protocol`)
+                                                                             (`center_protocol`)
 /center/assignments   diagnostic_msgs/msg/DiagnosticArray  center -> robots  RegionAssignment
-                                                                             (`protocol`)
+                                                                             (`center_protocol`)
 /center/state         diagnostic_msgs/msg/DiagnosticArray  center -> all     regions' walkers and
                                                                              progress (`server_state`)
 /center/markers       visualization_msgs/msg/MarkerArray   center -> RViz    regions, paths
 /depot/reports        diagnostic_msgs/msg/DiagnosticArray  robot -> depot    DepotReport
-                                                                             (`protocol`)
-/depot/grants         diagnostic_msgs/msg/DiagnosticArray  depot -> robots   DepotGrant (`protocol`)
+                                                                             (`depot_protocol`)
+/depot/grants         diagnostic_msgs/msg/DiagnosticArray  depot -> robots   DepotGrant (`depot_protocol`)
 /depot/state          diagnostic_msgs/msg/DiagnosticArray  depot -> all      queues and docks
                                                                              (`server_state`)
 /depot/markers        visualization_msgs/msg/MarkerArray   depot -> RViz     lines, docks, slots
 /radio                diagnostic_msgs/msg/DiagnosticArray  robot -> robots   RadioQuery/RadioReply,
                                                                              kept within range
-                                                                             (`protocol`)
+                                                                             (`depot_protocol`)
 /lockstep/ack         std_msgs/msg/Header                  server -> world   tick done (`ack`)
 ====================  ===================================  ================  ======================
 
