@@ -22,7 +22,7 @@ from pathlib import Path
 
 from launch_py.dds import loopback_env, private_domain_id
 from swarm_sim import registry
-from swarm_sim.cli import add_scenario_arguments, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 
@@ -72,11 +72,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("bags"), help="directory for bags (default: bags)")
     parser.add_argument("--bag", type=Path, help="exact bag directory (default: OUT/<scenario>_<N>r_s<seed>_<time>)")
     parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-    parser.add_argument("--controller-processes", type=int, default=1, metavar="K",
+    parser.add_argument("--controller-processes", type=number(int, 0), default=1, metavar="K",
                         help="processes for the controllers (default 1; 0 = one per robot)")
-    parser.add_argument("--real-time-factor", type=float, default=1.0, help="realtime mode's target")
-    parser.add_argument("--tick-timeout", type=float, default=2.0, help="lockstep: wall s to wait per tick")
-    parser.add_argument("--domain-id", type=int, help="ROS_DOMAIN_ID (default: a private one)")
+    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0,
+                        help="realtime mode's target")
+    parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
+                        help="lockstep: wall s to wait per tick")
+    parser.add_argument("--domain-id", type=number(int, 0, 232), help="ROS_DOMAIN_ID 0-232 (default: a private one)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored

@@ -21,7 +21,7 @@ import numpy as np
 
 from swarm_controllers.api import behaviour_rng
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
-from swarm_sim.cli import add_scenario_arguments, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers
@@ -115,8 +115,8 @@ def run_many(name: str, overrides: Iterable[str], fields: dict, seeds: list[int]
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="swarm-batch", description=__doc__.splitlines()[0])
     add_scenario_arguments(parser)
-    parser.add_argument("--runs", type=int, default=1, help="runs with seeds seed, seed+1, ...")
-    parser.add_argument("--jobs", type=int, default=1, help="runs in parallel (processes)")
+    parser.add_argument("--runs", type=number(int, 1, 10**6), default=1, help="runs with seeds seed, seed+1, ...")
+    parser.add_argument("--jobs", type=number(int, 1, 1024), default=1, help="runs in parallel (processes)")
     parser.add_argument("--json", action="store_true", help="print one JSON object per run")
     args = parser.parse_args(argv)
     try:

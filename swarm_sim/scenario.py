@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import types
 import typing
 from dataclasses import dataclass, field
@@ -278,6 +279,9 @@ def _type_name(tp: Any) -> str:
     return getattr(tp, "__name__", None) or str(tp).replace("typing.", "")
 
 
+_FLOAT_TEXT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
 def _convert(value: Any, tp: Any, key: str) -> Any:
     """Convert a YAML value to the annotated type, or raise naming `key`."""
     origin = get_origin(tp)
@@ -314,6 +318,8 @@ def _convert(value: Any, tp: Any, key: str) -> Any:
             raise ScenarioError(f"{key}: expected {len(args)} values, got {len(value)}")
         return tuple(_convert(v, a, f"{key}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
     if tp is float:
+        if isinstance(value, str) and _FLOAT_TEXT.fullmatch(value.strip()):
+            value = float(value)  # YAML 1.1 reads 1e30 (no dot) as a string
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ScenarioError(f"{key}: expected a number, got {value!r}")
         if not math.isfinite(value):
@@ -421,12 +427,7 @@ def load_scenario(
     with ``__`` for dots, e.g. ``robots__count=8`` (the CLI's ``--robots``).
     """
     path = resolve_path(name_or_path)
-    try:
-        data = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as exc:
-        raise ScenarioError(f"{path}: not valid YAML: {exc}") from None
-    if not isinstance(data, dict):
-        raise ScenarioError(f"{path}: the top level must be a mapping")
+    data = read_yaml(path)
     for text in overrides:
         _set_path(data, *parse_override(text))
     for key, value in fields.items():
@@ -435,6 +436,53 @@ def load_scenario(
     scenario = _build(Scenario, data, "")
     validate(scenario)
     return scenario
+
+
+MAX_DURATION = 1e7
+"""[s] of sim time (about 116 days): a longer run is a typo, not an experiment."""
+MAX_FILE_BYTES = 1 << 20
+"""A scenario file larger than this is refused (ours are ~1 KB)."""
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """safe_load that refuses duplicate keys (YAML says they are an error; PyYAML keeps the last)."""
+
+    def construct_mapping(self, node, deep=False):  # noqa: ANN001 - PyYAML's signature
+        seen = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=True)
+            if isinstance(key, str) and key in seen:
+                raise ScenarioError(f"duplicate key {key!r} (line {key_node.start_mark.line + 1})")
+            seen.add(key)
+        return super().construct_mapping(node, deep)
+
+
+def read_yaml(path: Path) -> dict[str, Any]:
+    """A scenario file's mapping; ScenarioError naming the file and the problem for anything
+    that is not a non-empty, UTF-8, YAML mapping without duplicate keys."""
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read: {exc.strerror}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ScenarioError(f"{path}: {len(raw)} bytes is larger than a scenario file can be ({MAX_FILE_BYTES})")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    try:
+        data = yaml.load(text, Loader=_StrictLoader)  # noqa: S506 - a SafeLoader subclass
+    except ScenarioError as exc:
+        raise ScenarioError(f"{path}: {exc}") from None
+    except yaml.YAMLError as exc:
+        raise ScenarioError(f"{path}: not valid YAML: {' '.join(str(exc).split())}") from None
+    except RecursionError:
+        raise ScenarioError(f"{path}: nested too deeply") from None
+    if data is None:
+        raise ScenarioError(f"{path}: the file is empty")
+    if not isinstance(data, dict):
+        raise ScenarioError(f"{path}: the top level must be a mapping")
+    return data
 
 
 def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
@@ -477,6 +525,8 @@ def validate(s: Scenario) -> None:
     _require(s.sim.dt > 0, "sim.dt: must be positive")
     _require(s.sim.physics_substeps >= 1, "sim.physics_substeps: must be at least 1")
     _require(s.sim.duration >= s.sim.dt, "sim.duration: must be at least one tick (sim.dt)")
+    _require(s.sim.duration <= MAX_DURATION, f"sim.duration: at most {MAX_DURATION:g} s of sim time")
+    _require(s.seed >= 0, "seed: must not be negative")
     _require(s.arena.size > 0, "arena.size: must be positive")
     half = s.arena.size / 2
     _require(

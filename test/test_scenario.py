@@ -79,3 +79,44 @@ def test_defaults_are_valid():
     from swarm_sim.scenario import validate
 
     validate(Scenario())
+
+
+@pytest.mark.parametrize("content, named", [
+    (b"name: a\nname: b\n", "duplicate key 'name' \\(line 2\\)"),
+    (b"\xff\xfe", "not UTF-8 text"),
+    (b"", "the file is empty"),
+    (b"a: " + b"[" * 5000 + b"]" * 5000, "nested too deeply"),
+    (b"- 1\n", "top level must be a mapping"),
+    (b"sim: {duration: [1, 2}", "not valid YAML"),
+])
+def test_broken_scenario_files_are_refused_in_one_line(tmp_path, content, named):
+    path = tmp_path / "broken.yaml"
+    path.write_bytes(content)
+    with pytest.raises(ScenarioError, match=named) as info:
+        load_scenario(str(path))
+    assert "\n" not in str(info.value)
+
+
+def test_floats_in_exponent_form_and_bounds():
+    assert load_scenario("cpfa", ["sim.duration=1e3"]).sim.duration == 1000.0  # YAML 1.1 reads 1e3 as a string
+    with pytest.raises(ScenarioError, match="sim.duration: at most"):
+        load_scenario("cpfa", ["sim.duration=1e30"])
+    with pytest.raises(ScenarioError, match="seed: must not be negative"):
+        load_scenario("cpfa", seed=-1)
+
+
+@pytest.mark.parametrize("module, args, named", [
+    ("swarm_sim.batch", ["--runs", "0"], "--runs: 0 is outside"),
+    ("swarm_sim.batch", ["--jobs", "0"], "--jobs: 0 is outside"),
+    ("swarm_sim.batch", ["--seed", "-1"], "--seed: -1 is outside"),
+    ("swarm_sim.batch", ["--duration", "inf"], "--duration: inf is outside"),
+    ("launch_py.run", ["--real-time-factor", "0"], "--real-time-factor: 0 is outside"),
+    ("launch_py.run", ["--tick-timeout", "nan"], "--tick-timeout: nan is outside"),
+    ("launch_py.run", ["--domain-id", "500"], "--domain-id: 500 is outside"),
+])
+def test_bad_flags_are_refused_in_one_line_without_a_traceback(module, args, named):
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2 and named in out.stderr and "Traceback" not in out.stderr, out.stderr

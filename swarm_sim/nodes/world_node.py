@@ -36,6 +36,7 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
+from swarm_sim.cli import number
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.recorder import Recorder
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
@@ -346,10 +347,10 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser = argparse.ArgumentParser(prog="swarm-world", description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=number(int, 0, 2**63 - 1), default=0)
     parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-    parser.add_argument("--tick-timeout", type=float, default=WorldNodeConfig.tick_timeout)
-    parser.add_argument("--real-time-factor", type=float, default=1.0)
+    parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout)
+    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0)
     parser.add_argument("--bag", default="")
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
