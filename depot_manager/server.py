@@ -27,6 +27,7 @@ class DepotServer:
         queue = QueueConfig.of(scenario)
         self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
         self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule)
+        self.robots = frozenset(scenario.robot_names)
         self.errors: list[str] = []
         """One line per report that could not be applied."""
         self.history: list[tuple[float, tuple[int, ...]]] = []
@@ -43,6 +44,9 @@ class DepotServer:
         out: list[DepotGrant] = []
         for m in messages:
             if not isinstance(m, DepotReport):
+                continue
+            if m.robot not in self.robots:  # a report from the bus names a robot of no run
+                self.errors.append(f"t={t:.3f} report from unknown robot {m.robot!r} ignored")
                 continue
             try:
                 match m.kind:

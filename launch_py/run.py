@@ -92,6 +92,10 @@ def main(argv: list[str] | None = None) -> int:
         return 2
 
     bag = args.bag or default_bag_dir(args.out, scenario)
+    if bag.exists() and (not bag.is_dir() or any(bag.iterdir())):
+        print(f"swarm-run: --bag {bag}: already exists and is not an empty directory (a run never "
+              "overwrites a recording)", file=sys.stderr)
+        return 2
     bag.parent.mkdir(parents=True, exist_ok=True)
     groups = split_robots(scenario.robot_names, args.controller_processes)
     domain = args.domain_id if args.domain_id is not None else private_domain_id()

@@ -111,6 +111,8 @@ class QueueBehaviour:
         depot, queue = scenario.depot, QueueConfig.of(scenario)
         self.robot = robot
         self._rng = rng
+        self.ignored_messages = 0
+        """Grants and radio replies naming a line or slot our layout does not have (dropped)."""
         self._limits = DriveLimits.from_scenario(scenario)
         self._center = (float(depot.center[0]), float(depot.center[1]))
         self._R = depot.perimeter_radius
@@ -231,7 +233,17 @@ class QueueBehaviour:
                 if m.to == self.robot and self._phase is Phase.SEEKING and within_range(m, x, y, self._gamma):
                     self._on_reply(m, obs, out)
 
+    def _valid_slot(self, line: str, cell: int) -> bool:
+        """Whether (line, cell) names a slot of our layout: messages from the bus are untrusted."""
+        cells = self._cells.get(line)
+        if cells is None or not 0 <= cell < len(cells):
+            self.ignored_messages += 1
+            return False
+        return True
+
     def _on_grant(self, grant: DepotGrant, obs: Observation) -> None:
+        if grant.cell >= 0 and not self._valid_slot(grant.line, grant.cell):
+            return
         if grant.cell < 0:  # a refused join
             if self._phase is Phase.JOINING and self._join is not None and grant.line == self._join[0]:
                 line, cell = self._join
@@ -265,7 +277,7 @@ class QueueBehaviour:
             if self._rng.random() < 0.5:
                 self._yield_until = obs.t + YIELD_TIME
             return
-        if reply.line not in self._entry_lines:
+        if not self._valid_slot(reply.line, reply.cell) or reply.line not in self._entry_lines:
             return
         if self._join is not None:
             return

@@ -486,3 +486,27 @@ def test_write_is_cheap_enough_for_the_simulation_loop(tmp_path: Path) -> None:
         rate = 20_000 / (time.perf_counter() - start)
     assert rate > 10_000, f"{rate:.0f} messages/s"
 
+
+
+def test_analysis_skips_and_counts_malformed_messages_and_keeps_the_rest(tmp_path: Path) -> None:
+    import json
+
+    from swarm_msgs_py import clock, diagnostics
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.analysis.replay import MalformedMessageWarning, load_run
+    from swarm_sim.scenario import load_scenario, scenario_to_dict
+    from swarm_sim.types import DropEvent
+
+    scenario = load_scenario("cpfa", ["robots.count=2", "sim.duration=1"])
+    bag = tmp_path / "hostile"
+    meta = {"scenario": json.dumps(scenario_to_dict(scenario)), "sim_seconds": "1.0"}
+    with BagWriter(bag, metadata=meta) as w:
+        for topic in ("/clock", "/world/events", "/robot_0/status"):
+            w.add_topic(topic, "rosgraph_msgs/msg/Clock" if topic == "/clock" else "diagnostic_msgs/msg/DiagnosticArray")
+        w.write("/clock", 0, clock.encode_clock(10**9))
+        w.write("/robot_0/status", 1, diagnostics.encode_diagnostics(0, [(0, "garbage", "", "", ())]))
+        w.write("/world/events", 2, diagnostics.encode_events(10**9, [DropEvent("robot_1", 10**9, 3, "depot", 0.1, 0.0)]))
+    with pytest.warns(MalformedMessageWarning, match="/robot_0/status"):
+        trace = load_run(bag)
+    summary = summarize(trace)
+    assert summary["malformed_messages"] == 1 and summary["resources_delivered"] == 1

@@ -14,7 +14,7 @@ from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _se
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NS_PER_S
+from swarm_sim.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROBOTS = 16
@@ -119,3 +119,31 @@ def test_perimeter_delay_covers_the_drop_off(run):
     if summary["perimeter_delay_mean_s"] is not None:
         assert summary["perimeter_delay_mean_s"] > 0
         assert summary["dropoff_time_mean_s"] is not None
+
+
+def test_replies_and_grants_naming_slots_that_do_not_exist_are_dropped():
+    from depot_manager.protocol import DepotGrant, RadioReply
+    from swarm_sim.scenario import load_scenario
+    from swarm_sim.registry import make_behaviour
+
+    s = load_scenario("queue_qmt", ["robots.count=2"])
+    b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+    b._phase = Phase.SEEKING
+    ranges = np.full(24, np.inf, dtype=np.float32)
+    bad = (RadioReply(0, "robot_1", "robot_0", 1.0, 0.0, "entry_line_0", 10**9, False),
+           RadioReply(0, "robot_1", "robot_0", 1.0, 0.0, "nowhere", 1, False),
+           DepotGrant(0, "robot_0", "entry_line_0", 10**6))
+    obs = Observation("robot_0", 10**8, Pose2D(1.0, 0.0, 0.0), 0.0, 0.0, ranges, ForagingSense((), True), bad)
+    b._handle(obs, [])  # the message handling alone, in the phase that listens to replies
+    assert b.ignored_messages == 3
+    b.step(obs)  # and a whole step with them does not fail
+
+
+def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
+    from depot_manager.protocol import DepotReport, ReportKind
+    from depot_manager.server import DepotServer
+    from swarm_sim.scenario import load_scenario
+
+    server = DepotServer(load_scenario("queue_qmt", ["robots.count=4"]))
+    out = server.step(10**9, [DepotReport(0, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])
+    assert out == () and server.admission.robots_inside == () and len(server.errors) == 4

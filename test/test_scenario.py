@@ -120,3 +120,15 @@ def test_bad_flags_are_refused_in_one_line_without_a_traceback(module, args, nam
 
     out = subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, timeout=60)
     assert out.returncode == 2 and named in out.stderr and "Traceback" not in out.stderr, out.stderr
+
+
+def test_swarm_run_never_overwrites_a_recording(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "metadata.yaml").write_text("x")
+    out = subprocess.run([sys.executable, "-m", "launch_py.run", "--bag", str(tmp_path / "old")],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2 and "already exists" in out.stderr and out.stdout == ""
+    assert (tmp_path / "old" / "metadata.yaml").read_text() == "x"

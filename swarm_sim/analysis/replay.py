@@ -8,6 +8,7 @@ status messages with the `swarm_msgs_py` codecs; the metric functions of
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +20,11 @@ from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
 from swarm_sim.types import NS_PER_S, DropEvent, robot_index
+
+
+class MalformedMessageWarning(UserWarning):
+    """A bag holds messages that do not decode (e.g. published by a faulty or hostile node);
+    they are skipped and counted in `RunTrace.malformed`, everything else is analysed."""
 
 
 def load_run(path: Path | str) -> RunTrace:
@@ -39,27 +45,33 @@ def load_run(path: Path | str) -> RunTrace:
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
     last_clock = 0
     for m in read_bag(path):
-        if m.topic.endswith("/" + topics.ODOM):
-            robot = m.topic[1:].partition("/")[0]
-            if robot in index:
-                stamp, pose, _, _ = odometry.decode_odometry(m.data)
-                if stamp not in positions:
-                    positions[stamp] = np.full((len(index), 2), np.nan)
-                positions[stamp][index[robot]] = (pose.x, pose.y)
-        elif m.topic == topics.CLOCK:
-            last_clock = max(last_clock, clock_codec.decode_clock(m.data))
-        elif m.topic == topics.WORLD_EVENTS:
-            for event in diagnostics.decode_events(m.data)[1]:
-                (trace.drops if isinstance(event, DropEvent) else trace.pickups).append(event)
-        elif m.topic == topics.WORLD_ROBOT_STATS:
-            trace.stats = diagnostics.decode_robot_stats(m.data)[1]
-        elif m.topic.endswith("/" + topics.STATUS):
-            status = diagnostics.decode_status(m.data)
-            trace.status[status.robot] = status
-        elif replayers and not m.topic.startswith("/robot_"):
-            for replay in replayers:  # the servers' recorded state (a few messages per tick)
-                for name, t, value in replay(m.topic, m.data):
-                    trace.series.setdefault(name, []).append((t, value))
+        try:
+            if m.topic.endswith("/" + topics.ODOM):
+                robot = m.topic[1:].partition("/")[0]
+                if robot in index:
+                    stamp, pose, _, _ = odometry.decode_odometry(m.data)
+                    if stamp not in positions:
+                        positions[stamp] = np.full((len(index), 2), np.nan)
+                    positions[stamp][index[robot]] = (pose.x, pose.y)
+            elif m.topic == topics.CLOCK:
+                last_clock = max(last_clock, clock_codec.decode_clock(m.data))
+            elif m.topic == topics.WORLD_EVENTS:
+                for event in diagnostics.decode_events(m.data)[1]:
+                    (trace.drops if isinstance(event, DropEvent) else trace.pickups).append(event)
+            elif m.topic == topics.WORLD_ROBOT_STATS:
+                trace.stats = diagnostics.decode_robot_stats(m.data)[1]
+            elif m.topic.endswith("/" + topics.STATUS):
+                status = diagnostics.decode_status(m.data)
+                trace.status[status.robot] = status
+            elif replayers and not m.topic.startswith("/robot_"):
+                for replay in replayers:  # the servers' recorded state (a few messages per tick)
+                    for name, t, value in replay(m.topic, m.data):
+                        trace.series.setdefault(name, []).append((t, value))
+        except ValueError as exc:  # a malformed message on the bus was recorded as sent
+            trace.malformed[m.topic] = trace.malformed.get(m.topic, 0) + 1
+            if trace.malformed[m.topic] == 1:
+                warnings.warn(f"{path}: skipping malformed messages on {m.topic}: {exc}", MalformedMessageWarning,
+                              stacklevel=2)
     if not trace.sim_seconds:  # the run was cut off before it could write its totals
         trace.sim_seconds = last_clock / NS_PER_S
     trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
