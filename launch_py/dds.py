@@ -4,13 +4,12 @@ rmw_fastrtps (Jazzy) reads discovery settings from the environment when a proces
 creates its first rclpy context, so everything here is plain environment variables;
 this module never imports rclpy.
 
-* Up to ``LOCALHOST_MAX_PROCESSES`` processes: ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``.
-  rmw_fastrtps then announces to 127.0.0.1 only, but guesses peers by participant
-  index (32 of 40 peers found in 60 s) and binds its sockets to 0.0.0.0 and the LAN
-  address; set the constant to 0 to use the profile always.
-* More processes (one per robot): the Fast DDS profile ``fastdds_loopback.xml``
-  (UDP bound to 127.0.0.1 only, no multicast, no shared memory, SPDP sent to 256
-  participant ids on 127.0.0.1). The range must then be ``SYSTEM_DEFAULT``: rmw_fastrtps
+* Every process gets the Fast DDS profile ``fastdds_loopback.xml`` (UDP bound to
+  127.0.0.1 only, no multicast, no shared memory, SPDP sent to 256 participant ids on
+  127.0.0.1), so the graph is reachable from loopback only. Plain
+  ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` is not enough: rmw_fastrtps then announces to
+  127.0.0.1 only but binds its sockets to 0.0.0.0 and the LAN address (and guesses peers
+  by participant index: 32 of 40 peers found in 60 s). The range must be ``SYSTEM_DEFAULT``: rmw_fastrtps
   starts from the XML default profile and, for ``LOCALHOST``, adds a 0.0.0.0 unicast
   locator and initial peers on top of it, for ``SUBNET`` it adds ``ROS_STATIC_PEERS``;
   only ``SYSTEM_DEFAULT`` leaves the profile alone.
@@ -23,8 +22,6 @@ from collections.abc import Mapping
 from pathlib import Path
 
 PROFILE_PATH = Path(__file__).with_name("fastdds_loopback.xml")
-LOCALHOST_MAX_PROCESSES = 24
-"""Largest process count for which plain LOCALHOST discovery is trusted."""
 PROFILE_MAX_PROCESSES = 256
 """Participants per domain the profile can discover (its maxInitialPeersRange)."""
 DOMAIN_RANGE = (100, 200)
@@ -65,12 +62,9 @@ def loopback_env(
     env["ROS_DOMAIN_ID"] = str(domain_id)
     # No DEFAULT_FASTRTPS_PROFILES.xml from the working directory on top of ours.
     env["SKIP_DEFAULT_XML_FILE"] = "1"
-    if processes <= LOCALHOST_MAX_PROCESSES:
-        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    else:
-        env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
-        env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 2.x name
-        env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 3.x name
+    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
+    env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 2.x name
+    env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 3.x name
     return env
 
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 import os
 import random
 
-# Before anything imports rclpy: loopback only, and a domain no other run on this machine uses.
-os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+# Before anything imports rclpy: loopback only (sockets bound to 127.0.0.1, launch_py.dds), and
+# a domain no other run on this machine uses.
 os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(101, 199)))
-os.environ.setdefault("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")
+from launch_py.dds import apply_to_current_process, loopback_env  # noqa: E402 - after the domain
+
+apply_to_current_process(loopback_env(int(os.environ["ROS_DOMAIN_ID"]), processes=2))

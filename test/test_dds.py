@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 import select
+import signal
 import socket
 import subprocess
 import sys
@@ -235,20 +236,18 @@ def _igmp_groups() -> set[tuple[str, str]]:
 # --------------------------------------------------------------------------- tests
 
 
-def test_loopback_env_switches_to_profile_above_localhost_limit() -> None:
+def test_loopback_env_always_uses_the_loopback_profile() -> None:
     base = {
         "PATH": "/bin",
         "ROS_LOCALHOST_ONLY": "1",
         "ROS_STATIC_PEERS": "192.0.2.7",
         "ROS_DISCOVERY_SERVER": "192.0.2.7:11811",
     }
-    few = dds.loopback_env(150, dds.LOCALHOST_MAX_PROCESSES, base)
-    many = dds.loopback_env(150, dds.LOCALHOST_MAX_PROCESSES + 1, base)
-    assert few["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
-    assert "FASTRTPS_DEFAULT_PROFILES_FILE" not in few
-    assert many["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "SYSTEM_DEFAULT"
-    assert Path(many["FASTRTPS_DEFAULT_PROFILES_FILE"]).is_file()
+    few = dds.loopback_env(150, 1, base)
+    many = dds.loopback_env(150, 120, base)
     for env in (few, many):
+        assert env["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "SYSTEM_DEFAULT"
+        assert Path(env["FASTRTPS_DEFAULT_PROFILES_FILE"]).is_file()
         assert env["RMW_IMPLEMENTATION"] == "rmw_fastrtps_cpp"
         assert env["ROS_DOMAIN_ID"] == "150"
         assert env["PATH"] == "/bin"
@@ -288,8 +287,10 @@ def _assert_loopback_only(pids: list[int], igmp_before: set[tuple[str, str]]) ->
 def test_profile_carries_messages_between_two_processes_over_loopback_only() -> None:
     igmp_before = _igmp_groups()
     domain = _domain(1)
-    env = dds.loopback_env(domain, dds.LOCALHOST_MAX_PROCESSES + 1)
-    plain = dds.loopback_env(domain, 1)  # LOCALHOST range, no profile: as `ros2` CLIs run
+    env = dds.loopback_env(domain, 2)
+    plain = {**env, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}  # no profile: as `ros2` CLIs run
+    for key in ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE"):
+        plain.pop(key)
     with _children() as procs:
         procs.append(worker := _spawn(env, "worker", 0, 30.0))
         procs.append(control := _spawn(plain, "worker", 1, 30.0))
@@ -335,3 +336,43 @@ def test_profile_discovers_40_processes_over_loopback_only(record_property) -> N
 
 if __name__ == "__main__":
     sys.exit(_child(sys.argv[1], int(sys.argv[2]), float(sys.argv[3])))
+
+
+def test_a_swarm_run_and_the_test_process_bind_loopback_only(tmp_path) -> None:
+    """The whole graph of a default swarm-run (world, controllers, depot manager) and this
+    test process's own DDS participant: every UDP socket on 127.0.0.1, no multicast."""
+    import rclpy
+
+    igmp_before = _igmp_groups()
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    node = rclpy.create_node("binding_probe", context=context)
+    cmd = [sys.executable, "-m", "launch_py.run", "--scenario", "queue_qmt", "--robots", "4", "--duration", "600",
+           "--bag", str(tmp_path / "bag"), "--domain-id", os.environ["ROS_DOMAIN_ID"]]
+    launcher = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        pids: list[int] = []
+        while time.monotonic() < deadline and len(pids) < 3:  # world, controllers, depot manager
+            time.sleep(1.0)
+            pids = [int(p.name) for p in Path("/proc").iterdir() if p.name.isdigit() and _parent(int(p.name)) == launcher.pid]
+        assert len(pids) >= 3, pids
+        time.sleep(3.0)
+        _assert_loopback_only([launcher.pid, *pids, os.getpid()], igmp_before)
+    finally:
+        os.killpg(launcher.pid, signal.SIGINT)
+        try:
+            launcher.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(launcher.pid, signal.SIGKILL)
+            launcher.wait()
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+def _parent(pid: int) -> int:
+    try:
+        return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+    except (OSError, IndexError, ValueError):
+        return -1
