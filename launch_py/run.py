@@ -85,6 +85,7 @@ def main(argv: list[str] | None = None) -> int:
     # (nohup, some CI shells and test runners), so install the handlers explicitly.
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, _raise_interrupt)
+    signal.signal(signal.SIGHUP, _raise_interrupt)  # terminal closed: stop the children too
     try:
         scenario = load_scenario(args.scenario, args.overrides, **scenario_fields(args), seed=args.seed)
     except ScenarioError as exc:
@@ -135,6 +136,11 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         _stop(controllers, grace=10.0)
         _stop([world], grace=60.0)
+
+    if world.returncode != 0:
+        cause = f"killed by signal {-world.returncode}" if world.returncode < 0 else f"exited with {world.returncode}"
+        print(f"[swarm-run] the world node {cause}: the run stopped early and the bag's last file may be "
+              f"cut off (swarm-analyze reads what was written)", file=sys.stderr, flush=True)
 
     from swarm_sim.analysis.metrics import summarize
     from swarm_sim.analysis.replay import load_run

@@ -35,8 +35,10 @@ def context():
 class ScriptedControllers(Node):
     """Answers every robot's observations with a command chosen by `policy(robot, stamp)`."""
 
-    def __init__(self, robots, policy, context, skip=()):
+    def __init__(self, robots, policy, context, skip=(), forge=()):
         super().__init__("scripted", context=context)
+        self.forge = forge
+        """Robots that, besides answering, also send a command stamped for the previous tick."""
         self.pubs = {}
         self.seen = {r: [] for r in robots}
         for r in robots:
@@ -57,12 +59,15 @@ class ScriptedControllers(Node):
         self.seen[robot].append(stamp)
         linear, angular = self.policy(robot, stamp)
         self.pubs[robot].publish(twist.encode_twist(robot, stamp, linear, angular))
+        if robot in self.forge and stamp > 0:  # a late (or forged) answer for the previous tick,
+            # sent last: were it applied, the robot would drive at 0.15 m/s
+            self.pubs[robot].publish(twist.encode_twist(robot, stamp - 10**8, 0.15, 0.0))
 
 
-def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), **config):
+def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), forge=(), **config):
     cfg = WorldNodeConfig(overrides=overrides, bag=str(tmp_path / "bag"), startup_timeout=10.0, **config)
     world = WorldNode(cfg, context=context)
-    peer = ScriptedControllers(world.robots, policy, context, skip=skip)
+    peer = ScriptedControllers(world.robots, policy, context, skip=skip, forge=forge)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(world)
     executor.add_node(peer)
@@ -185,3 +190,13 @@ def test_world_node_survives_malformed_commands(context, tmp_path):
         junk.destroy_node()
     assert world.world.tick == 10 and world.world.stats["robot_0"].stale_ticks == 0
     assert load_run(bag).sim_seconds == pytest.approx(1.0)
+
+
+def test_commands_stamped_for_another_tick_are_ignored_in_lockstep(context, tmp_path):
+    from swarm_sim.analysis.replay import load_odometry
+
+    world, _, bag = run_world(context, tmp_path, lambda r, s: (0.0, 0.0), forge=("robot_0",))
+    assert world.rejected_commands == world.world.tick - 1 == 9
+    assert world.world.stats["robot_0"].stale_ticks == 0
+    rows = load_odometry(bag)["robot_0"]
+    assert (rows[:, 1:3] == rows[0, 1:3]).all()  # it never drove: the forged 0.15 m/s was not applied

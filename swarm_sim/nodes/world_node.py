@@ -111,6 +111,8 @@ class WorldNode(Node):
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
         """Server channels (center, depot) the barrier waits for besides the robots."""
+        self.rejected_commands = 0
+        """Lockstep: commands stamped for a tick other than the current one (ignored)."""
         self.barrier = LockstepBarrier((*self.robots, *self.servers), cfg.dead_after)
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
@@ -164,6 +166,15 @@ class WorldNode(Node):
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
             self.get_logger().warning(f"{robot}: dropping malformed cmd_vel: {exc}")
+            return
+        if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
+            # A command for another tick (late, or forged on the bus) would break lockstep.
+            self.rejected_commands += 1
+            if self.rejected_commands == 1 or self.rejected_commands % 1000 == 0:
+                self.get_logger().warning(
+                    f"{robot}: ignoring a cmd_vel stamped {stamp_ns} ns at tick {self.world.t_ns} ns "
+                    f"({self.rejected_commands} so far)"
+                )
             return
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
