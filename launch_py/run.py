@@ -161,6 +161,10 @@ def main(argv: list[str] | None = None) -> int:
             f"[swarm-run] bag: {bag}  (swarm-analyze {bag})",
             flush=True,
         )
+    if summary["server_stale_ticks"]:
+        print(f"[swarm-run] a server missed {summary['server_stale_ticks']} lockstep ticks (did it die?): "
+              "its answers are missing from those ticks on", file=sys.stderr, flush=True)
+        return world.returncode or 3
     return 0 if world.returncode == 0 else world.returncode
 
 

@@ -66,6 +66,8 @@ class RunTrace:
     """`PerimeterLog.entries`."""
     perimeter_exits: dict[RobotId, list[float]] = field(default_factory=dict)
     """`PerimeterLog.exits`."""
+    server_stale: dict[str, int] = field(default_factory=dict)
+    """Lockstep ticks each server (by channel) did not acknowledge in time (graph runs)."""
     malformed: dict[str, int] = field(default_factory=dict)
     """Recorded messages that did not decode, by topic (skipped by the analysis)."""
     series: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
@@ -168,6 +170,7 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "trips_by_robot": trips,
         "stale_ticks": sum(s.stale_ticks for s in trace.stats.values()),
         "clamped_commands": sum(s.clamped_commands for s in trace.stats.values()),
+        "server_stale_ticks": sum(trace.server_stale.values()),
         "malformed_messages": sum(trace.malformed.values()),
         **_registered_metrics(trace),
     }

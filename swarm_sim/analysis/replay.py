@@ -40,6 +40,7 @@ def load_run(path: Path | str) -> RunTrace:
         sim_seconds=float(meta.get("sim_seconds", 0.0)), wall_seconds=float(meta.get("wall_seconds", 0.0)),
         total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
     )
+    trace.server_stale = _server_stale(path, str(meta.get("server_stale_ticks", "{}")))
     replayers = [registry.resolve(s.replay) for s in registry.of(scenario).servers if s.replay]
     index = {r: i for i, r in enumerate(trace.robots)}
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
@@ -76,6 +77,20 @@ def load_run(path: Path | str) -> RunTrace:
         trace.sim_seconds = last_clock / NS_PER_S
     trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
     return trace
+
+
+def _server_stale(path: Path, text: str) -> dict[str, int]:
+    """The bag's ``server_stale_ticks`` metadata ({channel: ticks}); anything else is reported
+    and ignored (a bag is untrusted input)."""
+    try:
+        value = json.loads(text)
+        if isinstance(value, dict) and all(isinstance(k, str) and type(v) is int for k, v in value.items()):
+            return value
+    except ValueError:
+        pass
+    warnings.warn(f"{path}: ignoring malformed server_stale_ticks metadata {text[:80]!r}", MalformedMessageWarning,
+                  stacklevel=3)
+    return {}
 
 
 def _perimeter_log(trace: RunTrace, positions: dict[int, np.ndarray]) -> tuple[dict, dict]:

@@ -111,6 +111,8 @@ class WorldNode(Node):
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
         """Server channels (center, depot) the barrier waits for besides the robots."""
+        self.server_stale_ticks = dict.fromkeys(self.servers, 0)
+        """Lockstep ticks each server (by channel) did not acknowledge in time."""
         self.rejected_commands = 0
         """Lockstep: commands stamped for a tick other than the current one (ignored)."""
         self.barrier = LockstepBarrier((*self.robots, *self.servers), cfg.dead_after)
@@ -297,6 +299,8 @@ class WorldNode(Node):
         for r in stale:
             if r in self.world.stats:
                 self.world.stats[r].stale_ticks += 1
+            else:
+                self.server_stale_ticks[r] += 1
         for r in dead:
             self.get_logger().warning(f"{r}: no answer for {self.barrier.dead_after} ticks, not waiting for it")
 
@@ -350,6 +354,7 @@ class WorldNode(Node):
             self.recorder.close(
                 wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
                 sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
+                server_stale_ticks=json.dumps(self.server_stale_ticks),
             )
         self.world.close()
 
