@@ -35,8 +35,10 @@ def context():
 class ScriptedControllers(Node):
     """Answers every robot's observations with a command chosen by `policy(robot, stamp)`."""
 
-    def __init__(self, robots, policy, context, skip=(), forge=()):
+    def __init__(self, robots, policy, context, skip=(), forge=(), mute=None):
         super().__init__("scripted", context=context)
+        self.mute = mute or {}
+        """robot -> the stamp [ns] from which it stops answering (its controller died)."""
         self.forge = forge
         """Robots that, besides answering, also send a command stamped for the previous tick."""
         self.pubs = {}
@@ -58,16 +60,18 @@ class ScriptedControllers(Node):
         stamp, pose, _, _ = odometry.decode_odometry(data)
         self.seen[robot].append(stamp)
         linear, angular = self.policy(robot, stamp)
+        if stamp >= self.mute.get(robot, stamp + 1):
+            return
         self.pubs[robot].publish(twist.encode_twist(robot, stamp, linear, angular))
         if robot in self.forge and stamp > 0:  # a late (or forged) answer for the previous tick,
             # sent last: were it applied, the robot would drive at 0.15 m/s
             self.pubs[robot].publish(twist.encode_twist(robot, stamp - 10**8, 0.15, 0.0))
 
 
-def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), forge=(), **config):
+def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), forge=(), mute=None, **config):
     cfg = WorldNodeConfig(overrides=overrides, bag=str(tmp_path / "bag"), startup_timeout=10.0, **config)
     world = WorldNode(cfg, context=context)
-    peer = ScriptedControllers(world.robots, policy, context, skip=skip, forge=forge)
+    peer = ScriptedControllers(world.robots, policy, context, skip=skip, forge=forge, mute=mute)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(world)
     executor.add_node(peer)
@@ -200,3 +204,14 @@ def test_commands_stamped_for_another_tick_are_ignored_in_lockstep(context, tmp_
     assert world.world.stats["robot_0"].stale_ticks == 0
     rows = load_odometry(bag)["robot_0"]
     assert (rows[:, 1:3] == rows[0, 1:3]).all()  # it never drove: the forged 0.15 m/s was not applied
+
+
+def test_a_dead_controllers_robot_stops_instead_of_driving_on_blind(context, tmp_path):
+    from swarm_sim.analysis.replay import load_odometry
+
+    world, _, bag = run_world(context, tmp_path, lambda r, s: (0.15, 0.0), mute={"robot_1": 3 * 10**8},
+                              tick_timeout=0.05)
+    rows = load_odometry(bag)["robot_1"]  # t, x, y, yaw per tick
+    moving, after_death = rows[rows[:, 0] <= 0.3], rows[rows[:, 0] >= 0.6]
+    assert np.ptp(moving[:, 1:3], axis=0).max() > 0.02  # it drove while its controller answered
+    assert np.ptp(after_death[:, 1:3], axis=0).max() < 1e-9  # dead after 3 silent ticks: stopped

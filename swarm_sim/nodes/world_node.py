@@ -302,7 +302,10 @@ class WorldNode(Node):
             else:
                 self.server_stale_ticks[r] += 1
         for r in dead:
-            self.get_logger().warning(f"{r}: no answer for {self.barrier.dead_after} ticks, not waiting for it")
+            self.get_logger().warning(f"{r}: no answer for {self.barrier.dead_after} ticks, not waiting for it; "
+                                      "it stands still until it answers again")
+            if r in self._commands:
+                self._commands[r] = Command()  # a dead controller's robot must not drive on blind
 
     def _await_wall(self, executor: Executor, until: float) -> None:
         while (remaining := until - time.monotonic()) > 0:
