@@ -11,3 +11,10 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(10
 from launch_py.dds import apply_to_current_process, loopback_env  # noqa: E402 - after the domain
 
 apply_to_current_process(loopback_env(int(os.environ["ROS_DOMAIN_ID"]), processes=2))
+
+# Hypothesis times its own input generation; on a loaded 2-core machine (CI, parallel runs) the
+# first draw of a strategy can take seconds, which says nothing about the code under test.
+from hypothesis import HealthCheck, settings  # noqa: E402
+
+settings.register_profile("swarmforage", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("swarmforage")
