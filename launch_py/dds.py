@@ -42,6 +42,7 @@ _DROPPED = (
     "RMW_FASTRTPS_USE_QOS_FROM_XML",
     "FASTDDS_ENVIRONMENT_FILE",
     "SKIP_DEFAULT_XML_FILE",
+    "RMW_FASTRTPS_PUBLICATION_MODE",
 )
 
 
@@ -65,6 +66,10 @@ def loopback_env(
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
     env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 2.x name
     env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 3.x name
+    # Lockstep delivery relies on it: publish() puts the bytes on the socket before it returns,
+    # so a robot's message stamped k reaches its peers before its cmd_vel k lets the world send
+    # tick k+1 (asynchronous publication would let a sender thread reorder them under load).
+    env["RMW_FASTRTPS_PUBLICATION_MODE"] = "SYNCHRONOUS"
     return env
 
 

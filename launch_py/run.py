@@ -16,7 +16,6 @@ its exit code says how the run went (`EXIT_CODES`).
 from __future__ import annotations
 
 import argparse
-import ctypes
 import json
 import os
 import signal
@@ -27,6 +26,7 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import loopback_env, private_domain_id
+from launch_py.lifetime import die_with_parent
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
@@ -42,17 +42,6 @@ EXIT_CODES = {
 }
 """swarm-run's exit codes."""
 
-_PR_SET_PDEATHSIG = 1
-
-
-def _die_with_parent(parent: int) -> None:
-    """In the child, before exec: the kernel sends it SIGTERM when the launcher dies (Linux)."""
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-    except (OSError, AttributeError):  # not Linux: the launcher's own handlers still stop it
-        return
-    if os.getppid() != parent:  # the launcher died before the prctl took effect
-        os._exit(1)
 
 
 def split_robots(robots: list[str], processes: int) -> list[list[str]]:
@@ -131,6 +120,8 @@ def main(argv: list[str] | None = None) -> int:
     domain = args.domain_id if args.domain_id is not None else private_domain_id()
     servers = registry.of(scenario).servers
     env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
+        env.setdefault(var, "1")  # which would also not survive the controllers' fork
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -142,14 +133,19 @@ def main(argv: list[str] | None = None) -> int:
     me = os.getpid()
 
     def start(label: str, cmd: list[str]) -> tuple[str, subprocess.Popen]:
-        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: _die_with_parent(me))
+        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: die_with_parent(me))
         return label, proc
 
-    children = [
-        start(f"controller process of {', '.join(group) if len(group) <= 4 else f'{len(group)} robots'}",
-              [*python, "swarm_controllers.controller_node", "--robots", *group, *common])
-        for group in groups
-    ]
+    if args.controller_processes == 0:  # one process per robot, forked after the imports
+        children = [start("controller processes (one per robot)",
+                          [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names,
+                           *common])]
+    else:
+        children = [
+            start(f"controller process of {', '.join(group) if len(group) <= 4 else f'{len(group)} robots'}",
+                  [*python, "swarm_controllers.controller_node", "--robots", *group, *common])
+            for group in groups
+        ]
     children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]

@@ -45,21 +45,32 @@ class Launch:
         self.pids: dict[int, str] = {}
 
     def children(self) -> dict[int, str]:
-        """The launcher's child processes: pid -> command line (remembered for `alive`)."""
+        """The launcher's descendants: pid -> "<name> <command line>" (remembered for `alive`)."""
+        parents: dict[int, int] = {}
         for p in Path("/proc").iterdir():
             if p.name.isdigit():
                 try:
-                    ppid = int((p / "stat").read_text().rsplit(")", 1)[1].split()[1])
-                    cmdline = (p / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+                    parents[int(p.name)] = int((p / "stat").read_text().rsplit(")", 1)[1].split()[1])
                 except (OSError, ValueError, IndexError):
                     continue
-                if ppid == self.proc.pid:
-                    self.pids[int(p.name)] = cmdline
+        mine, grew = {self.proc.pid}, True
+        while grew:
+            new = {pid for pid, ppid in parents.items() if ppid in mine} - mine
+            mine |= new
+            grew = bool(new)
+        for pid in mine - {self.proc.pid}:
+            try:
+                name = Path(f"/proc/{pid}/comm").read_text().strip()
+                cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+            except OSError:
+                continue
+            self.pids[pid] = f"{name} {cmdline}"
         return dict(self.pids)
 
     def child(self, module: str, robot: str | None = None) -> int:
-        found = [pid for pid, cmd in self.children().items()
-                 if f"-m {module} " in cmd and (robot is None or f"--robots {robot} " in cmd)]
+        """The process running `module`, or with --fork the one named after `robot`."""
+        found = [pid for pid, text in self.children().items()
+                 if f"-m {module} " in text and (robot is None or text.startswith(robot + " "))]
         assert len(found) == 1, (module, robot, self.pids)
         return found[0]
 
@@ -265,7 +276,7 @@ def test_no_node_outlives_the_launcher(launch, how):
     kernel stop every child (PR_SET_PDEATHSIG), the world closing its bag."""
     run = launch("--robots", "4", "--duration", "600", "--controller-processes", "0", *overrides(["arena.size=5.0"]))
     run.wait_until(lambda: run.sim_time() > 3.0, what="3 s of sim time")
-    assert len(run.children()) == 5
+    assert len(run.children()) == 6  # world, the controllers' parent and its 4 forks
     os.kill(run.proc.pid, how)
     run.proc.communicate(timeout=90)
     if how == signal.SIGHUP:

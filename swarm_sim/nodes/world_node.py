@@ -270,7 +270,10 @@ class WorldNode(Node):
             self._diagnostics_pub.publish(diagnostics.encode_rejections(t_ns, self.get_fully_qualified_name(), counts))
 
     def wait_for_controllers(self, executor: Executor) -> None:
-        deadline = time.monotonic() + self.config.startup_timeout
+        """Spin until every controller and server is matched (or `startup_timeout`), saying
+        what it waits for every `progress_period`; prints when the first tick goes out."""
+        start = time.monotonic()
+        deadline, say = start + self.config.startup_timeout, start + self.config.progress_period
         missing = list(self.robots)
         while missing and time.monotonic() < deadline:
             self._spin(executor, 0.1)
@@ -281,10 +284,17 @@ class WorldNode(Node):
             ]
             if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
                 missing.append("servers (" + ", ".join(self.servers) + ")")
+            if missing and time.monotonic() >= say:
+                say += self.config.progress_period
+                print(f"[world] {time.monotonic() - start:5.1f} s: waiting for {len(missing)} of "
+                      f"{len(self.robots) + bool(self.servers)} nodes to connect: {', '.join(missing[:4])}"
+                      f"{' ...' if len(missing) > 4 else ''}", flush=True)
         if missing:
             self.get_logger().warning(
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
+        print(f"[world] first tick after {time.monotonic() - start:.1f} s of start-up: "
+              f"{len(self.robots) - len(missing)} controllers and {len(self.servers)} servers connected", flush=True)
 
     stop_requested = False
     """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
