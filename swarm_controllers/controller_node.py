@@ -27,6 +27,7 @@ import gc
 import os
 import signal
 import sys
+import time
 from collections import defaultdict
 from dataclasses import dataclass
 
@@ -161,8 +162,9 @@ def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str],
     return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args, args.fork
 
 
-def serve(robots: list[str], config: ControllerConfig, ros_args: list[str]) -> int:
-    """The robots' controller nodes in this process, spun until shut down."""
+def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True) -> int:
+    """The robots' controller nodes in this process, spun until shut down; `teardown=False`
+    leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
     nodes: list[ControllerNode] = []
     try:
@@ -176,14 +178,25 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str]) -> i
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        for node in nodes:
-            node.destroy_node()
-        rclpy.try_shutdown()
+        if teardown:
+            for node in nodes:
+                node.destroy_node()
+            rclpy.try_shutdown()
     return 0
 
 
+STOP_GRACE = 5.0
+"""Wall seconds the forked robot processes get to leave after Ctrl-C/SIGTERM before SIGKILL."""
+
+
 def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str]) -> int:
-    """One process per robot, forked from this one (see the module docstring)."""
+    """One process per robot, forked from this one (see the module docstring).
+
+    A robot process leaves without tearing its DDS participant down (`os._exit` once its loop
+    ends): when a hundred participants leave at once, Fast DDS 2.14 can hang in participant
+    deletion, and an exiting process needs no goodbye (its peers see it gone by its lease). It
+    gets SIGKILL if this process dies, and this process SIGKILLs any that has not left
+    `STOP_GRACE` seconds after a stop."""
     load_scenario(config.scenario, config.overrides, seed=config.seed)  # refuse a bad file once, here
     gc.freeze()  # what the children inherit stays shared (no copy-on-write from the collector)
     parent = os.getpid()
@@ -191,35 +204,43 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
     for robot in robots:
         pid = os.fork()
         if pid == 0:
-            die_with_parent(parent)
+            die_with_parent(parent, signal.SIGKILL)
             set_process_name(robot)
             code = 1
             try:
-                code = serve([robot], config, ros_args)
+                code = serve([robot], config, ros_args, teardown=False)
             finally:
                 sys.stdout.flush()
                 sys.stderr.flush()
                 os._exit(code)
         children[pid] = robot
-    stopping = False
+    stopping = 0.0  # when the stop began (monotonic)
+
+    def signal_all(sig: int) -> None:
+        for pid in children:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, sig)
 
     def stop(signum: int, _frame: object) -> None:
         nonlocal stopping
-        stopping = True
-        for pid in children:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal.SIGINT)
+        stopping = stopping or time.monotonic()
+        signal_all(signal.SIGINT)
 
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, stop)
     while children:
         try:
-            pid, status = os.wait()
+            pid, status = os.waitpid(-1, os.WNOHANG)
         except ChildProcessError:
             break
+        if pid == 0:
+            if stopping and time.monotonic() > stopping + STOP_GRACE:
+                signal_all(signal.SIGKILL)
+            time.sleep(0.05)
+            continue
         robot = children.pop(pid, "?")
         code = os.waitstatus_to_exitcode(status)
-        if not stopping or code not in (0, -signal.SIGINT):
+        if not stopping or code not in (0, -signal.SIGINT, -signal.SIGKILL):
             how = f"was killed by signal {-code}" if code < 0 else f"exited with code {code}"
             print(f"[controllers] the process of {robot} (pid {pid}) {how}", file=sys.stderr, flush=True)
     return 0
