@@ -18,14 +18,22 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from datetime import datetime
 from pathlib import Path
 
-from launch_py.dds import loopback_env, private_domain_id
+from launch_py.dds import (
+    discovery_port,
+    discovery_server_env,
+    loopback_env,
+    private_domain_id,
+    server_profile,
+)
 from launch_py.lifetime import die_with_parent
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
@@ -97,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
     parser.add_argument("--domain-id", type=number(int, 0, 232), help="ROS_DOMAIN_ID 0-232 (default: a private one)")
+    parser.add_argument("--discovery", choices=("server", "simple"), default="server",
+                        help="DDS discovery: the world node as discovery server for every other node (default; "
+                             "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
@@ -119,9 +130,15 @@ def main(argv: list[str] | None = None) -> int:
     groups = split_robots(scenario.robot_names, args.controller_processes)
     domain = args.domain_id if args.domain_id is not None else private_domain_id()
     servers = registry.of(scenario).servers
-    env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ)
+    port = discovery_port(domain) if args.discovery == "server" else None
+    env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ, server_port=port)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
+    world_env = env
+    if port is not None:
+        profile = Path(tempfile.mkdtemp(prefix="swarmforage-")) / "discovery_server.xml"
+        profile.write_text(server_profile(port), encoding="utf-8")
+        world_env = discovery_server_env(env, profile)
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -132,28 +149,26 @@ def main(argv: list[str] | None = None) -> int:
     python = [sys.executable, "-m"]
     me = os.getpid()
 
-    def start(label: str, cmd: list[str]) -> tuple[str, subprocess.Popen]:
+    def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
         proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: die_with_parent(me))
         return label, proc
 
-    if args.controller_processes == 0:  # one process per robot, forked after the imports
-        children = [start("controller processes (one per robot)",
-                          [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names,
-                           *common])]
-    else:
-        children = [
-            start(f"controller process of {', '.join(group) if len(group) <= 4 else f'{len(group)} robots'}",
-                  [*python, "swarm_controllers.controller_node", "--robots", *group, *common])
-            for group in groups
-        ]
-    children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
-    _, world = start("world", world_cmd)
-    procs = [p for _, p in children]
+    if args.controller_processes == 0:  # one process per robot, forked after the imports
+        controllers = [("controller processes (one per robot)",
+                        [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names])]
+    else:
+        controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
+                        [*python, "swarm_controllers.controller_node", "--robots", *g]) for g in groups]
+    children: list[tuple[str, subprocess.Popen]] = []
+    world: subprocess.Popen | None = None
     interrupted = False
     reported: set[int] = set()
     try:
+        _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
+        children += [start(label, [*cmd, *common]) for label, cmd in controllers]
+        children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
         while world.poll() is None:
             for label, p in children:
                 if p.poll() is not None and p.pid not in reported:
@@ -164,10 +179,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         interrupted = True
         print("[swarm-run] stopping: the world first (it closes the bag), then the other nodes", flush=True)
-        _stop([world], grace=60.0)
+        _stop([world] if world else [], grace=60.0)
     finally:
-        _stop(procs, grace=10.0)
-        _stop([world], grace=60.0)
+        _stop([p for _, p in children], grace=10.0)
+        _stop([world] if world else [], grace=60.0)
+        if port is not None:
+            shutil.rmtree(profile.parent, ignore_errors=True)
 
     world_died = world.returncode != 0 and not interrupted
     if world_died:
@@ -205,7 +222,7 @@ def _how(returncode: int) -> str:
 
 def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
     """Say what went wrong, if anything; the exit code (`EXIT_CODES`)."""
-    say = lambda text: print(f"[swarm-run] {text}", file=sys.stderr, flush=True)  # noqa: E731
+    say = lambda text: print(f"[swarm-run] {text}", file=sys.stderr, flush=True)
     rejected = summary.get("rejected_messages") or {}
     if rejected:
         total = sum(n for by_reason in rejected.values() for n in by_reason.values())

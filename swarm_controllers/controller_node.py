@@ -45,7 +45,7 @@ from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound, Rejections, merged
 from swarm_sim.messaging import Mailbox
-from swarm_sim.scenario import DEFAULT_SCENARIO, load_scenario
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 from swarm_sim.types import Observation, robot_index
 
 
@@ -55,10 +55,20 @@ class ControllerConfig:
     """Scenario name or YAML path (the same one the world loads)."""
     overrides: tuple[str, ...] = ()
     seed: int = 0
+    startup_timeout: float = 60.0
+    """Wall seconds to wait for every peer and server to be matched before answering anyway."""
 
 
 class ControllerNode(Node):
-    def __init__(self, robot: str, config: ControllerConfig | None = None, **kwargs) -> None:
+    """One robot's controller. It creates its ``cmd_vel`` publisher, which is what the world
+    waits for before the first tick, only once every topic it exchanges with the other robots
+    and the servers is matched (`connect`): a message sent before its receivers are matched
+    would be lost, and the run would no longer be the batch run of the same seed."""
+
+    def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
+                 **kwargs) -> None:
+        """`scenario`: the one `config` names, already loaded (saves each forked process the
+        parse)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, start_parameter_services=False, enable_rosout=False,
@@ -66,7 +76,7 @@ class ControllerNode(Node):
         )
         self.robot = robot
         self.config = cfg = declare_config(self, ControllerConfig, config)
-        self.scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
+        self.scenario = scenario or load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
@@ -88,14 +98,18 @@ class ControllerNode(Node):
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
         inbound, outbound = registry.robot_topics(algorithm)
-        for topic, family in inbound.items():
-            self.create_subscription(
+        self._inbound_subs = {
+            topic: self.create_subscription(
                 topics.import_type(family.type_name), topic,
                 lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
                 EVENTS, raw=True,
             )
+            for topic, family in inbound.items()
+        }
         self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
                           for t, f in outbound.items()}
+        self._peer_topics = set(inbound) & set(outbound)
+        """Topics every robot both sends and hears: matched once all robots are."""
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         """Message class -> the topic this robot sends it on."""
         for name, (type_name, decode) in decoders.items():
@@ -103,12 +117,31 @@ class ControllerNode(Node):
                 topics.import_type(type_name), name,
                 lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
             )
-        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        self._cmd_pub = None
+        self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
         self._diagnostics_pub = self.create_publisher(
             topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
 
+    def connect(self) -> bool:
+        """Create the ``cmd_vel`` publisher once every exchange topic is matched (or the start-up
+        timeout passed); True once it exists."""
+        if self._cmd_pub is not None:
+            return True
+        robots = self.scenario.robots.count
+        need = {t: robots if t in self._peer_topics else 1 for t in (*self._inbound_subs, *self._outbound)}
+        missing = [t for t, sub in self._inbound_subs.items() if sub.get_publisher_count() < need[t]]
+        missing += [t for t, (_, pub) in self._outbound.items() if pub.get_subscription_count() < need[t]]
+        if missing and time.monotonic() < self._connect_by:
+            return False
+        if missing:
+            self.get_logger().warning(f"answering without all peers matched on {', '.join(sorted(missing))}")
+        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        return True
+
     def _on_observation(self, name: str, decoded: tuple) -> None:
+        if self._cmd_pub is None:  # not connected yet: the world cannot have started
+            return
         stamp = decoded[0]
         if stamp == self._answered_stamp:  # the world re-sent a tick: our answer was late or lost
             self._cmd_pub.publish(self._answer)
@@ -162,7 +195,8 @@ def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str],
     return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args, args.fork
 
 
-def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True) -> int:
+def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
+          scenario: Scenario | None = None) -> int:
     """The robots' controller nodes in this process, spun until shut down; `teardown=False`
     leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
@@ -170,11 +204,13 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     try:
         executor = make_executor()
         for robot in robots:
-            nodes.append(ControllerNode(robot, config))
+            nodes.append(ControllerNode(robot, config, scenario=scenario))
             executor.add_node(nodes[-1])
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
+        connecting = list(nodes)
         while rclpy.ok():
-            executor.spin_once(timeout_sec=0.5)
+            executor.spin_once(timeout_sec=0.1 if connecting else 0.5)
+            connecting = [n for n in connecting if not n.connect()]
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -183,6 +219,27 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
                 node.destroy_node()
             rclpy.try_shutdown()
     return 0
+
+
+def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
+    """Do, once before forking, what every robot process would otherwise do first (measured: a
+    forked process's first node took 0.2-0.6 s of CPU, 112 of them on 2 cores most of a
+    minute): import the behaviour, sense and message-family modules and every message type,
+    and the interface packages rclpy's Node pulls in lazily. No DDS entity is made here: Fast
+    DDS leaves threads behind, and a forked copy of a threaded process can deadlock."""
+    from rcl_interfaces.msg import ParameterEvent
+    from rclpy.type_support import check_for_type_support
+    from rosgraph_msgs.msg import Clock
+    from type_description_interfaces.srv import GetTypeDescription
+
+    registry.make_behaviour(scenario, robot, behaviour_rng(config.seed, robot))
+    algorithm = registry.of(scenario)
+    sensing = registry.resolve(registry.task(algorithm.task).sensing)
+    inbound, outbound = registry.robot_topics(algorithm)
+    names = [*topics.ROBOT_TOPIC_TYPES.values(), topics.type_string(topics.DIAGNOSTICS),
+             *(t.type_name for t in sensing.topics), *(f.type_name for f in (*inbound.values(), *outbound.values()))]
+    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, Clock, GetTypeDescription):
+        check_for_type_support(cls)  # loads the type support C modules (and rosidl's parser) now
 
 
 STOP_GRACE = 5.0
@@ -197,7 +254,8 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
     deletion, and an exiting process needs no goodbye (its peers see it gone by its lease). It
     gets SIGKILL if this process dies, and this process SIGKILLs any that has not left
     `STOP_GRACE` seconds after a stop."""
-    load_scenario(config.scenario, config.overrides, seed=config.seed)  # refuse a bad file once, here
+    scenario = load_scenario(config.scenario, config.overrides, seed=config.seed)  # refuse a bad file once, here
+    _warm_up(scenario, robots[0], config)
     gc.freeze()  # what the children inherit stays shared (no copy-on-write from the collector)
     parent = os.getpid()
     children: dict[int, str] = {}
@@ -208,7 +266,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
             set_process_name(robot)
             code = 1
             try:
-                code = serve([robot], config, ros_args, teardown=False)
+                code = serve([robot], config, ros_args, teardown=False, scenario=scenario)
             finally:
                 sys.stdout.flush()
                 sys.stderr.flush()

@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 import rclpy
+from graph_helpers import overrides
+from launch_py.dds import discovery_port
 from rclpy.node import Node
 
 from depot_manager.protocol import DepotReport, RadioReply, ReportKind
-from graph_helpers import overrides
 from swarm_msgs_py import ack, clock, diagnostics, server_state, topics, twist
 from swarm_msgs_py.depot_protocol import DEPOT, RADIO
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
@@ -173,15 +174,22 @@ class Hostile(Node):
 
 def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_path):
     run = launch("--scenario", "queue_qmt", "--robots", "6", "--duration", "150", *overrides(BUSY_DEPOT))
+    # a client of the run's discovery server (the world), as `ros2` on this machine would be
+    os.environ["ROS_DISCOVERY_SERVER"] = f"127.0.0.1:{discovery_port(int(os.environ['ROS_DOMAIN_ID']))}"
     ctx = rclpy.Context()
     rclpy.init(context=ctx)
-    node = Hostile(ctx)
+    try:
+        node = Hostile(ctx)  # the DDS participant is made here
+    finally:
+        del os.environ["ROS_DISCOVERY_SERVER"]
     executor = rclpy.executors.SingleThreadedExecutor(context=ctx)
     executor.add_node(node)
     try:
         deadline = time.monotonic() + 90
         while not node.ready():
-            assert time.monotonic() < deadline and run.proc.poll() is None, "the run's topics never matched"
+            assert time.monotonic() < deadline and run.proc.poll() is None, (
+                f"the run's topics never matched: clock {node.stamp}, "
+                f"{ {t: p.get_subscription_count() for t, p in node.pubs.items()} }")
             executor.spin_once(timeout_sec=0.1)
         for _ in range(3):
             node.attack()

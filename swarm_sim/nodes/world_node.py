@@ -42,7 +42,12 @@ from swarm_sim.cli import number
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.recorder import Recorder
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
+from swarm_sim.scenario import (
+    DEFAULT_SCENARIO,
+    Scenario,
+    load_scenario,
+    scenario_to_dict,
+)
 from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 

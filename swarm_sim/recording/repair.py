@@ -16,8 +16,13 @@ import shutil
 import warnings
 from pathlib import Path
 
-from swarm_sim.recording.metadata import METADATA_FILE, BagError, BagTruncatedWarning, _load_yaml
-from swarm_sim.recording.reader import _open_files, _merge
+from swarm_sim.recording.metadata import (
+    METADATA_FILE,
+    BagError,
+    BagTruncatedWarning,
+    _load_yaml,
+)
+from swarm_sim.recording.reader import _merge, _open_files
 from swarm_sim.recording.writer import BagWriter
 
 
