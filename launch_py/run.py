@@ -4,7 +4,10 @@ depot manager for the queue strategies).
 
 Controllers run all in one process by default; ``--controller-processes K`` spreads them over
 K processes and ``0`` gives every robot its own process, as on real hardware. DDS stays on
-loopback and on a private domain id (`launch_py.dds`). Ctrl-C stops every process and still
+loopback and on a private domain id (`launch_py.dds`). Discovery goes through the world node, a
+Fast DDS discovery server on 127.0.0.1:7000+domain (peer-to-peer SIMPLE discovery took 120 s to
+connect 112 robot processes on 2 cores, the server about a third of that: each process learns
+only of the endpoints of its own topics); ``--discovery simple`` is the peer-to-peer way. Ctrl-C stops every process and still
 leaves a valid bag. Needs no ros2cli or launch: plain subprocesses with the right environment.
 
 The launcher owns its children: Ctrl-C, SIGTERM and SIGHUP stop them all (the world first, so
@@ -28,6 +31,7 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import (
+    PROFILE_PATH,
     discovery_port,
     discovery_server_env,
     loopback_env,
@@ -146,6 +150,10 @@ def main(argv: list[str] | None = None) -> int:
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
+    if port is not None:
+        print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
+              f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
+              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list", flush=True)
     python = [sys.executable, "-m"]
     me = os.getpid()
 
