@@ -30,6 +30,10 @@ setup(
         "rosbags",
         "matplotlib",
         "scipy",
+        "foxglove-sdk",  # swarm-run --foxglove: the official Foxglove WebSocket server
+        "imageio",  # swarm-analyze --video
+        "imageio-ffmpeg",  # its ffmpeg (a binary inside the wheel) for .mp4
+        "tqdm",  # sweep progress bars
     ],
     extras_require={
         "ros": [
@@ -37,7 +41,8 @@ setup(
             "ros-jazzy-common-interfaces",
             "ros-jazzy-rmw-fastrtps-cpp",
         ],
-        "test": ["pytest", "hypothesis"],
+        "dask": ["distributed"],  # sweeps on a Dask cluster (--scheduler, --dask-local)
+        "test": ["pytest", "hypothesis", "websockets", "distributed"],
     },
     entry_points={
         "console_scripts": [
