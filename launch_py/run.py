@@ -23,6 +23,7 @@ from pathlib import Path
 from launch_py.dds import loopback_env, private_domain_id
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 
@@ -79,6 +80,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
     parser.add_argument("--domain-id", type=number(int, 0, 232), help="ROS_DOMAIN_ID 0-232 (default: a private one)")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), nargs="?", const=DEFAULT_PORT, metavar="PORT",
+                        help=f"serve the run live to Foxglove over WebSocket (default port {DEFAULT_PORT}; 0: any free)")
+    parser.add_argument("--foxglove-host", default=LOOPBACK,
+                        help=f"address the live view binds (default {LOOPBACK}: this machine only)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
@@ -119,8 +124,12 @@ def main(argv: list[str] | None = None) -> int:
         subprocess.Popen([*python, spec.node, *common], env=env, start_new_session=True)
         for spec in servers
     ]
+    print(f"[swarm-run] started {len(controllers)} controller/server process(es); the world node reports "
+          "while they start and discover each other", flush=True)
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
+    if args.foxglove is not None:
+        world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     world = subprocess.Popen(world_cmd, env=env, start_new_session=True)
     interrupted = False
     try:

@@ -4,7 +4,8 @@ Like ``ros2 bag record -a``: the world writes what it publishes (and the command
 receives) as the very bytes on the wire, and `discover` subscribes to every topic other nodes
 publish, recording each message stamped with the sim time at which it arrives. Latched topics
 (servers' state and markers) are subscribed transient-local, so their last message is recorded
-even if it was published before the recorder subscribed.
+even if it was published before the recorder subscribed. With a `LiveView` every topic and
+message also goes to the Foxglove clients, as the same bytes.
 """
 
 from __future__ import annotations
@@ -17,16 +18,20 @@ from rclpy.qos import DurabilityPolicy
 
 from swarm_msgs_py import topics
 from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED
+from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.recording import BagWriter
 
 
 class Recorder:
-    """Records into one bag directory; `now_ns` gives the sim time to stamp messages with."""
+    """Records into one bag directory (None: no bag) and feeds `live` (None: no live view);
+    `now_ns` gives the sim time to stamp messages with."""
 
-    def __init__(self, node: Node, path: Path, metadata: dict[str, str], now_ns: Callable[[], int]) -> None:
+    def __init__(self, node: Node, path: Path | None, metadata: dict[str, str], now_ns: Callable[[], int],
+                 live: LiveView | None = None) -> None:
         self._node = node
         self._now_ns = now_ns
-        self.bag = BagWriter(path, metadata=metadata)
+        self.bag = BagWriter(path, metadata=metadata) if path is not None else None
+        self.live = live
         self.known: set[str] = set()
         """Topics recorded already (by the world itself or by discovery)."""
         self.closed = False
@@ -34,10 +39,20 @@ class Recorder:
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
         """A topic the world writes itself."""
         self.known.add(topic)
-        self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
+        self._add(topic, type_name, latched)
+
+    def _add(self, topic: str, type_name: str, latched: bool) -> None:
+        if self.bag is not None:
+            self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
+        if self.live is not None:
+            self.live.add(topic, type_name, latched)
 
     def write(self, topic: str, data: bytes) -> None:
-        self.bag.write(topic, self._now_ns(), data)
+        now = self._now_ns()
+        if self.bag is not None:
+            self.bag.write(topic, now, data)
+        if self.live is not None:
+            self.live.write(topic, now, data)
 
     def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
         """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
@@ -54,7 +69,7 @@ class Recorder:
                 info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
                 for info in node.get_publishers_info_by_topic(topic)
             )
-            self.bag.add_topic(topic, types[0], "latched" if latched else "reliable")
+            self._add(topic, types[0], latched)
             node.create_subscription(
                 msg_type, topic, lambda data, t=topic: self.write(t, data),
                 RECORD_LATCHED if latched else EVENTS, raw=True,
@@ -62,11 +77,15 @@ class Recorder:
 
     def poll(self) -> None:
         """Flush and split on time (call it while spinning, even when the run is stalled)."""
-        self.bag.poll()
+        if self.bag is not None:
+            self.bag.poll()
 
     def close(self, **metadata: str) -> None:
         """Write the run's totals into the metadata and finish the bag (idempotent)."""
         if not self.closed:
             self.closed = True
-            self.bag.set_metadata(**metadata)
-            self.bag.close()
+            if self.live is not None:
+                self.live.close()
+            if self.bag is not None:
+                self.bag.set_metadata(**metadata)
+                self.bag.close()

@@ -76,6 +76,11 @@ class WorldNodeConfig:
     """Sim seconds between ``/world/robot_stats`` messages."""
     markers_period: float = 5.0
     """Sim seconds between ``/world/markers`` messages."""
+    foxglove_port: int = -1
+    """Serve the run live over the Foxglove WebSocket protocol on this port (0: any free port;
+    -1: no live view), `swarm_sim.nodes.live_view`."""
+    foxglove_host: str = "127.0.0.1"
+    """Address the live view binds (loopback unless asked otherwise)."""
 
 
 class WorldNode(Node):
@@ -87,7 +92,7 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recorder = self._open_recorder(cfg.bag) if cfg.bag else None
+        self.recorder = self._open_recorder(cfg.bag) if cfg.bag or cfg.foxglove_port >= 0 else None
 
         self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
         self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
@@ -155,7 +160,13 @@ class WorldNode(Node):
             "mode": self.config.mode,
             "robots": str(len(self.world.robots)),
         }
-        return Recorder(self, Path(path), meta, lambda: self.world.t_ns)
+        live = None
+        if self.config.foxglove_port >= 0:
+            from swarm_sim.nodes.live_view import LiveView
+
+            live = LiveView(self.config.foxglove_port, self.config.foxglove_host)
+            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
+        return Recorder(self, Path(path) if path else None, meta, lambda: self.world.t_ns, live)
 
     def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
         if send:
@@ -238,8 +249,10 @@ class WorldNode(Node):
             self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
 
     def wait_for_controllers(self, executor: Executor) -> None:
-        deadline = time.monotonic() + self.config.startup_timeout
+        start = time.monotonic()
+        deadline = start + self.config.startup_timeout
         missing = list(self.robots)
+        said = start
         while missing and time.monotonic() < deadline:
             self._spin(executor, 0.1)
             missing = [
@@ -249,6 +262,11 @@ class WorldNode(Node):
             ]
             if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
                 missing.append("servers (" + ", ".join(self.servers) + ")")
+            if missing and time.monotonic() - said >= self.config.progress_period:
+                said = time.monotonic()
+                self.print_startup(missing, said - start)
+        print(f"[world] {len(self.robots) - len([m for m in missing if m in self._cmd_subs])}/{len(self.robots)} "
+              f"controllers connected after {time.monotonic() - start:.1f} s: starting", flush=True)
         if missing:
             self.get_logger().warning(
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
@@ -343,6 +361,18 @@ class WorldNode(Node):
         while time.monotonic() < end:
             self._spin(executor, 0.05)
 
+    def print_startup(self, missing: list[str], waited: float) -> None:
+        """What the start-up is waiting for (nodes starting and discovering each other)."""
+        robots = [m for m in missing if m in self._cmd_subs]
+        others = [m for m in missing if m not in self._cmd_subs]
+        text = f"{len(self.robots) - len(robots)}/{len(self.robots)} controllers connected"
+        if robots:
+            text += f", waiting for {', '.join(robots[:3])}{' ...' if len(robots) > 3 else ''}"
+        if others:
+            text += f"; waiting for {', '.join(others)}"
+        print(f"[world] start-up {waited:5.1f} s: {text} (gives up after {self.config.startup_timeout:.0f} s)",
+              flush=True)
+
     def print_progress(self, wall: float) -> None:
         t = self.world.t_ns / NS_PER_S
         stale = sum(s.stale_ticks for s in self.world.stats.values())
@@ -371,10 +401,14 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout)
     parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0)
     parser.add_argument("--bag", default="")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), default=-1, metavar="PORT",
+                        help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
+    parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host)
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
+        foxglove_port=args.foxglove, foxglove_host=args.foxglove_host,
     )
     return config, ros_args
 
