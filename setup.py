@@ -14,7 +14,7 @@ setup(
     python_requires=">=3.10",
     packages=find_packages(include=["swarm_sim*", "swarm_controllers*", "swarm_msgs_py*",
                                     "depot_manager*", "launch_py*"]),
-    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml"]},
+    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml", "*.json"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),

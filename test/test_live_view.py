@@ -97,3 +97,18 @@ def test_a_websocket_client_subscribes_and_decodes_the_live_run(tmp_path):
     # the same bytes went to the bag
     recorded = {m.data for m in read_bag(tmp_path / "bag") if m.topic == "/robot_0/odom"}
     assert all(data in recorded for _, data in got["/robot_0/odom"])
+
+
+def test_the_shipped_layout_is_the_one_the_code_builds():
+    from swarm_sim.nodes.foxglove_layout import LAYOUT_FILE, QUEUES, TOTALS, build_layout
+
+    assert LAYOUT_FILE.read_text() == build_layout() + "\n", "run: python -m swarm_sim.nodes.foxglove_layout"
+    layout = json.loads(LAYOUT_FILE.read_text())
+    scene = layout["content"]["items"][0]["content"]
+    assert scene["panelType"] == "ThreeDee" and scene["config"]["topics"]["/world/markers"]["visible"]
+    plots = [item["content"] for item in layout["content"]["items"][1]["content"]["items"]]
+    paths = {p["value"] for plot in plots for p in plot["config"]["paths"]}
+    assert f"{TOTALS}.deliveries" in paths and f"{QUEUES}.total" in paths
+    scripts = {s["name"]: s["sourceCode"] for s in layout["userScripts"].values()}
+    assert f'export const output = "{TOTALS}"' in scripts["swarm totals"]
+    assert 'inputs = ["/depot/state"]' in scripts["depot queues"]

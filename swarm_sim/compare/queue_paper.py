@@ -169,8 +169,8 @@ def _extreme(rows: Sequence[dict], strategies: Sequence[str], sizes: Sequence[in
     found = []
     for c in sizes:
         means = _means(rows, strategies, c, metric)
-        if who not in means or len(means) < 2:
-            return "—", None
+        if who not in means or len(means) < 2 or len(set(means.values())) == 1:
+            return "—" if who not in means else "no differences", None
         found.append((c, (max if highest else min)(means, key=means.get)))
     text = ", ".join(f"{c}: {label(s, QUEUE_LABELS)}" for c, s in found)
     return text, all(s == who for _, s in found)
@@ -184,7 +184,7 @@ def _trend(rows: Sequence[dict], who: str, sizes: Sequence[int], metric: str, ri
     hi = describe(values_of(rows, who, max(sizes), metric)).mean
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return "—", None
-    return f"{fmt(lo, 1)} -> {fmt(hi, 1)}", (hi > lo) if rising else (hi < lo)
+    return f"{fmt(lo, 1)} -> {fmt(hi, 1)}", None if hi == lo else (hi > lo) if rising else (hi < lo)
 
 
 def queue_headlines(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> list[Headline]:
@@ -199,6 +199,8 @@ def queue_headlines(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
         means = _means(rows, queue_order, c, pct)
         order = sorted(means, key=means.get)
         found.append(f"{c}: {' < '.join(label(s, QUEUE_LABELS) for s in order)}")
+        if len(set(means.values())) < len(means):  # ties: no strict order to compare
+            holds_order = None
         if holds_order and order != queue_order:
             holds_order = False
     out.append(Headline("collection Q_SE < Q_ST < Q_ME < Q_MT", "Table II: every size", "; ".join(found) or "—",
