@@ -24,7 +24,12 @@ from launch_py.dds import loopback_env, private_domain_id
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
+
+
+STARTUP_REPORT_PERIOD = 5.0
+"""Wall seconds between start-up lines while the world node is not up yet."""
 
 
 def split_robots(robots: list[str], processes: int) -> list[list[str]]:
@@ -132,8 +137,16 @@ def main(argv: list[str] | None = None) -> int:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     world = subprocess.Popen(world_cmd, env=env, start_new_session=True)
     interrupted = False
+    launched = time.monotonic()
+    said = launched
     try:
         while world.poll() is None:
+            now = time.monotonic()
+            if now - said >= STARTUP_REPORT_PERIOD and not (bag / METADATA_FILE).exists():
+                said = now  # the world node opens the bag once it is up; it reports from there on
+                running = sum(p.poll() is None for p in controllers)
+                print(f"[swarm-run] {now - launched:5.1f} s: waiting for the world node to come up "
+                      f"({running + 1} processes starting: Python, ROS and pybullet imports)", flush=True)
             if any(c.poll() not in (None, 0) for c in controllers) and not interrupted:
                 print("[swarm-run] a controller or server process exited early; the world counts it stale",
                       flush=True)

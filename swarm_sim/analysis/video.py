@@ -124,7 +124,7 @@ class _Canvas:
 
     _LINE_STYLE = {"entry_lines": ("0.2", 0.8), "exit_lines": ("tab:blue", 0.8), "inner_queues": ("tab:purple", 0.8),
                    "regions": ("0.6", 0.6), "planned_paths": ("0.8", 0.4)}
-    _POINT_STYLE = {"docks": ("tab:green", 30, "s"), "slots_owned": ("tab:red", 8, "o"),
+    _POINT_STYLE = {"docks": ("tab:green", 30, "s"), "slots_owned": ("black", 8, "o"),
                     "entry_points": ("0.2", 10, "o"), "exit_points": ("tab:blue", 10, "o")}
 
     def __init__(self, scenario: Scenario, robots: int) -> None:

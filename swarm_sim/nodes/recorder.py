@@ -17,7 +17,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 
 from swarm_msgs_py import topics
-from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED
+from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_profile
 from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.recording import BagWriter
 
@@ -34,6 +34,7 @@ class Recorder:
         self.live = live
         self.known: set[str] = set()
         """Topics recorded already (by the world itself or by discovery)."""
+        self._latched: set[str] = set()
         self.closed = False
 
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
@@ -42,6 +43,8 @@ class Recorder:
         self._add(topic, type_name, latched)
 
     def _add(self, topic: str, type_name: str, latched: bool) -> None:
+        if latched:
+            self._latched.add(topic)
         if self.bag is not None:
             self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
         if self.live is not None:
@@ -75,6 +78,27 @@ class Recorder:
                 RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
+    def record_offered_qos(self) -> None:
+        """Write each topic's offered QoS (one profile per publisher, as the graph reports it) and
+        type description hash into the bag, as ``ros2 bag record`` does; topics without a
+        publisher left keep the profile they were added with."""
+        if self.bag is None:
+            return
+        for topic in sorted(self.known):
+            try:
+                infos = self._node.get_publishers_info_by_topic(topic)
+            except Exception:  # noqa: BLE001 - the graph is gone (shutdown): keep the defaults
+                return
+            if not infos:
+                continue
+            depth = published_depth(topic, topic in self._latched)
+            profiles = []
+            for info in infos:
+                profile = rosbag2_profile(info.qos_profile, depth)
+                if profile not in profiles:
+                    profiles.append(profile)
+            self.bag.set_offered_qos(topic, profiles, str(infos[0].topic_type_hash))
+
     def poll(self) -> None:
         """Flush and split on time (call it while spinning, even when the run is stalled)."""
         if self.bag is not None:
@@ -87,5 +111,6 @@ class Recorder:
             if self.live is not None:
                 self.live.close()
             if self.bag is not None:
+                self.record_offered_qos()
                 self.bag.set_metadata(**metadata)
                 self.bag.close()

@@ -44,6 +44,10 @@ from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
 from swarm_sim.world import World
 
 
+_IMPORTED = time.monotonic()
+"""When this module's imports were done (start-up lines count from here)."""
+
+
 class Interrupted(Exception):
     """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
@@ -250,6 +254,8 @@ class WorldNode(Node):
 
     def wait_for_controllers(self, executor: Executor) -> None:
         start = time.monotonic()
+        print(f"[world] up ({start - _IMPORTED:.1f} s after its imports to build the world and the topics of "
+              f"{len(self.robots)} robots); waiting for the controllers{' and servers' if self.servers else ''} to connect", flush=True)
         deadline = start + self.config.startup_timeout
         missing = list(self.robots)
         said = start
