@@ -7,10 +7,10 @@ from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviou
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
 
-The node serves the standard parameter services (``ros2 param list/get``) from its first tick on:
-created with the node, their twelve DDS endpoints per robot would be announced to every other
-process while a run with one process per robot is still discovering its lockstep topics (measured:
-start-up of 112 one-robot processes about a fifth slower); once stepping they cost nothing.
+The node serves the standard parameter services (``ros2 param list/get``), created with it. Their
+twelve DDS endpoints per robot make the start-up of 112 one-robot processes about a sixth slower
+(benchmarks/bench_startup.py); creating them at the first tick instead kept the start-up but
+stalled the first ticks far longer (README, Benchmarks).
 
 ``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process.
 """
@@ -26,7 +26,6 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.parameter_service import ParameterService
 
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
@@ -52,7 +51,7 @@ class ControllerNode(Node):
     def __init__(self, robot: str, config: ControllerConfig | None = None, **kwargs) -> None:
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
-            "controller", namespace=robot, start_parameter_services=False, enable_rosout=False,
+            "controller", namespace=robot, enable_rosout=False,
             parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.robot = robot
@@ -66,7 +65,6 @@ class ControllerNode(Node):
         self._last_status: tuple | None = None
         self._answered_stamp = -1
         self._answer = b""
-        self._parameter_service: ParameterService | None = None
         decoders = {
             topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry),
             topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan),
@@ -104,8 +102,6 @@ class ControllerNode(Node):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
-        if self._parameter_service is None:
-            self._parameter_service = ParameterService(self)
         _, pose, v, w = self._latest[topics.ODOM]
         sensed = self.sensing.sense(**{t.field: self._latest[t.name][1] for t in self.sensing.topics})
         obs = Observation(

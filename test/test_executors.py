@@ -68,6 +68,7 @@ def test_dask_local_cluster_matches_the_local_pool_and_resumes_its_sweep(tmp_pat
         assert dask.address.startswith("tcp://127.0.0.1:")
         workers = dask.client.scheduler_info()["workers"]
         assert len(workers) == 2 and all(w.startswith("tcp://127.0.0.1:") for w in workers)
+        assert all(w["nanny"].startswith("tcp://127.0.0.1:") for w in workers.values())
         resumed = run_sweep(PLANS, seeds, path, executor=dask, resume=True, log=lambda _: None)
         # a run that raises on a Dask worker is recorded and the others finish
         bad = run_sweep([RunPlan("no_such_scenario", 2, TINY), PLANS[0]], [0], tmp_path / "bad" / "results.jsonl",

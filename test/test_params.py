@@ -1,5 +1,5 @@
-"""`ros2 param list/get` on every node: the controller (from its first tick on), depot-manager and
-center nodes serve the standard parameter services (as the world does). A client node asks them
+"""`ros2 param list/get` on every node: the controller, depot-manager and center nodes serve the
+standard parameter services (as the world does). A client node asks them
 over DDS what ``ros2 param list`` and ``ros2 param get`` ask: ListParameters and GetParameters."""
 
 from __future__ import annotations
@@ -12,33 +12,14 @@ from rclpy.parameter_client import AsyncParameterClient
 from depot_manager.node import DepotManagerNode
 from swarm_controllers.center_node import CenterNode
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
-from swarm_msgs_py import topics
-from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_sim.nodes.server_node import ServerNodeConfig
-from test_nodes import SMALL, _observation_bytes
+from test_nodes import SMALL
 
 
 def _spin_until(executor, future, timeout=20.0):
     executor.spin_until_future_complete(future, timeout_sec=timeout)
     assert future.done(), "no answer from the parameter service"
     return future.result()
-
-
-def _first_tick(node: ControllerNode, peer: Node, executor) -> None:
-    """Feed the controller one tick's observations (its parameter services start then)."""
-    pubs = {n: peer.create_publisher(topics.type_of(n), f"/{node.robot}/{n}", SENSOR_LOCKSTEP)
-            for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
-    for _ in range(200):
-        executor.spin_once(timeout_sec=0.02)
-        if all(p.get_subscription_count() for p in pubs.values()):
-            break
-    for name, data in _observation_bytes(node.scenario, node.robot, 0).items():
-        pubs[name].publish(data)
-    for _ in range(200):
-        executor.spin_once(timeout_sec=0.02)
-        if node._answered_stamp == 0:
-            return
-    raise AssertionError("the controller did not tick")
 
 
 @pytest.mark.parametrize("make, name, seed", [
@@ -56,9 +37,6 @@ def test_param_list_and_get_answer_on_every_node(context, make, name, seed):
     executor.add_node(client_node)
     try:
         client = AsyncParameterClient(client_node, name)
-        if isinstance(node, ControllerNode):
-            assert not client.wait_for_services(timeout_sec=1.0)  # not while the run starts up
-            _first_tick(node, client_node, executor)
         assert client.wait_for_services(timeout_sec=20.0), f"{name}: no parameter services"
         listed = _spin_until(executor, client.list_parameters()).result.names
         assert {"scenario", "overrides", "seed", "use_sim_time"} <= set(listed), listed

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import nullcontext
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -76,7 +77,7 @@ def main(argv: list[str] | None = None, run: RunFunction | None = None,
     comparison = comparisons[args.command]
     strategies = _strategies(args.strategies, comparison.strategies, parser)
     try:
-        with executor or executor_from_args(args) as ex:
+        with nullcontext(executor) if executor else executor_from_args(args) as ex:
             return run_comparison(comparison, args, strategies, run=run, executor=ex)[0]
     except (RuntimeError, OSError) as exc:  # no Dask, scheduler unreachable
         print(f"swarm-compare: {exc}", file=sys.stderr)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from contextlib import nullcontext
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
@@ -61,7 +62,7 @@ def reproduce_all(args: argparse.Namespace, comparisons: Mapping[str, Comparison
     parser = build_parser(comparisons)
     reports: list[SweepReport] = []
     try:
-        with executor or executor_from_args(args) as ex:
+        with nullcontext(executor) if executor else executor_from_args(args) as ex:
             for name, comparison in comparisons.items():
                 out = args.out / Path(comparison.default_out).name
                 for options in comparison.reproduce:
