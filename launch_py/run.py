@@ -6,11 +6,17 @@ Controllers run all in one process by default; ``--controller-processes K`` spre
 K processes and ``0`` gives every robot its own process, as on real hardware. DDS stays on
 loopback and on a private domain id (`launch_py.dds`). Ctrl-C stops every process and still
 leaves a valid bag. Needs no ros2cli or launch: plain subprocesses with the right environment.
+
+The launcher owns its children: Ctrl-C, SIGTERM and SIGHUP stop them all (the world first, so
+it closes the bag), and each child gets SIGTERM from the kernel if the launcher dies in any
+other way (``PR_SET_PDEATHSIG``), so no node outlives it. It names every node that died, and
+its exit code says how the run went (`EXIT_CODES`).
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
 import json
 import os
 import signal
@@ -26,6 +32,29 @@ from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
 from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
+
+EXIT_CODES = {
+    0: "the run is complete and every node lived to its end",
+    1: "the bag could not be read",
+    2: "bad flags or scenario (nothing was started)",
+    3: "a server (depot manager, center) died: the run ended early",
+    4: "the run is complete, but robots were declared dead on the way (named in the output)",
+    5: "the world node died: the bag was repaired and analysed up to its last flushed data",
+    130: "interrupted (Ctrl-C, SIGTERM or SIGHUP): the bag holds the run up to then",
+}
+"""swarm-run's exit codes."""
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent(parent: int) -> None:
+    """In the child, before exec: the kernel sends it SIGTERM when the launcher dies (Linux)."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except (OSError, AttributeError):  # not Linux: the launcher's own handlers still stop it
+        return
+    if os.getppid() != parent:  # the launcher died before the prctl took effect
+        os._exit(1)
 
 
 STARTUP_REPORT_PERIOD = 5.0
@@ -120,54 +149,63 @@ def main(argv: list[str] | None = None) -> int:
         flush=True,
     )
     python = [sys.executable, "-m"]
-    controllers = [
-        subprocess.Popen([*python, "swarm_controllers.controller_node", "--robots", *group, *common],
-                         env=env, start_new_session=True)
+    me = os.getpid()
+
+    def start(label: str, cmd: list[str]) -> tuple[str, subprocess.Popen]:
+        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: _die_with_parent(me))
+        return label, proc
+
+    children = [
+        start(f"controller process of {', '.join(group) if len(group) <= 4 else f'{len(group)} robots'}",
+              [*python, "swarm_controllers.controller_node", "--robots", *group, *common])
         for group in groups
     ]
-    controllers += [
-        subprocess.Popen([*python, spec.node, *common], env=env, start_new_session=True)
-        for spec in servers
-    ]
-    print(f"[swarm-run] started {len(controllers)} controller/server process(es); the world node reports "
+    children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
+    print(f"[swarm-run] started {len(children)} controller/server process(es); the world node reports "
           "while they start and discover each other", flush=True)
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
-    world = subprocess.Popen(world_cmd, env=env, start_new_session=True)
+    _, world = start("world", world_cmd)
+    procs = [p for _, p in children]
     interrupted = False
-    launched = time.monotonic()
-    said = launched
+    reported: set[int] = set()
+    launched = said = time.monotonic()
     try:
         while world.poll() is None:
             now = time.monotonic()
             if now - said >= STARTUP_REPORT_PERIOD and not (bag / METADATA_FILE).exists():
                 said = now  # the world node opens the bag once it is up; it reports from there on
-                running = sum(p.poll() is None for p in controllers)
+                running = sum(p.poll() is None for p in procs)
                 print(f"[swarm-run] {now - launched:5.1f} s: waiting for the world node to come up "
                       f"({running + 1} processes starting: Python, ROS and pybullet imports)", flush=True)
-            if any(c.poll() not in (None, 0) for c in controllers) and not interrupted:
-                print("[swarm-run] a controller or server process exited early; the world counts it stale",
-                      flush=True)
-                interrupted = True
+            for label, p in children:
+                if p.poll() is not None and p.pid not in reported:
+                    reported.add(p.pid)
+                    print(f"[swarm-run] the {label} (pid {p.pid}) {_how(p.returncode)} while the run went on; "
+                          "the world declares what it ran dead", file=sys.stderr, flush=True)
             time.sleep(0.2)
     except KeyboardInterrupt:
-        print("[swarm-run] Ctrl-C: stopping the world (it closes the bag) and the controllers", flush=True)
+        interrupted = True
+        print("[swarm-run] stopping: the world first (it closes the bag), then the other nodes", flush=True)
         _stop([world], grace=60.0)
     finally:
-        _stop(controllers, grace=10.0)
+        _stop(procs, grace=10.0)
         _stop([world], grace=60.0)
 
-    if world.returncode != 0:
-        cause = f"killed by signal {-world.returncode}" if world.returncode < 0 else f"exited with {world.returncode}"
-        print(f"[swarm-run] the world node {cause}: the run stopped early and the bag's last file may be "
-              f"cut off (swarm-analyze reads what was written)", file=sys.stderr, flush=True)
+    world_died = world.returncode != 0 and not interrupted
+    if world_died:
+        print(f"[swarm-run] the world node (pid {world.pid}) {_how(world.returncode)}: the run stopped early; "
+              f"repairing the bag's cut-off last file", file=sys.stderr, flush=True)
 
     from swarm_sim.analysis.metrics import summarize
     from swarm_sim.analysis.replay import load_run
+    from swarm_sim.recording import repair_bag
 
     try:
+        if world_died:
+            repair_bag(bag)
         summary = summarize(load_run(bag))
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
@@ -183,11 +221,35 @@ def main(argv: list[str] | None = None) -> int:
             f"[swarm-run] bag: {bag}  (swarm-analyze {bag})",
             flush=True,
         )
+    return _verdict(summary, world_died=world_died, interrupted=interrupted)
+
+
+def _how(returncode: int) -> str:
+    return f"was killed by signal {-returncode}" if returncode < 0 else f"exited with code {returncode}"
+
+
+def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
+    """Say what went wrong, if anything; the exit code (`EXIT_CODES`)."""
+    say = lambda text: print(f"[swarm-run] {text}", file=sys.stderr, flush=True)  # noqa: E731
+    rejected = summary.get("rejected_messages") or {}
+    if rejected:
+        total = sum(n for by_reason in rejected.values() for n in by_reason.values())
+        kinds = "; ".join(f"{w}: {', '.join(f'{n} {r}' for r, n in rs.items())}" for w, rs in list(rejected.items())[:6])
+        say(f"{total} messages from the bus were rejected ({kinds})")
+    dead = summary.get("dead_nodes") or []
+    if dead:
+        say(f"declared dead during the run: {', '.join(dead)}")
     if summary["server_stale_ticks"]:
-        print(f"[swarm-run] a server missed {summary['server_stale_ticks']} lockstep ticks (did it die?): "
-              "its answers are missing from those ticks on", file=sys.stderr, flush=True)
-        return world.returncode or 3
-    return 0 if world.returncode == 0 else world.returncode
+        say(f"a server missed {summary['server_stale_ticks']} lockstep ticks")
+    ended = summary.get("run_ended", "complete")
+    if world_died:
+        return 5
+    if interrupted or ended == "interrupted":
+        return 130
+    if ended.startswith("server") or summary["server_stale_ticks"]:
+        say(f"the run ended early: {ended}")
+        return 3
+    return 4 if dead else 0
 
 
 if __name__ == "__main__":

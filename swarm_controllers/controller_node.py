@@ -7,6 +7,10 @@ from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviou
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
 
+Messages from other nodes are untrusted: they are checked before the behaviour sees them
+(`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
+and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
+
 The node serves the standard parameter services (``ros2 param list/get``), created with it. Their
 twelve DDS endpoints per robot make the start-up of 112 one-robot processes about a sixth slower
 (benchmarks/bench_startup.py); creating them at the first tick instead kept the start-up but
@@ -31,9 +35,9 @@ from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
-from swarm_msgs_py.records import post_all
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim import registry
+from swarm_sim.inbound import Inbound, Rejections, merged
 from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import DEFAULT_SCENARIO, load_scenario
 from swarm_sim.types import Observation, robot_index
@@ -61,6 +65,10 @@ class ControllerNode(Node):
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
         self.mailbox = Mailbox()
+        self.rejections = Rejections()
+        self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
+                               self.get_logger().warning)
+        self._published_rejections: dict = {}
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
@@ -77,7 +85,7 @@ class ControllerNode(Node):
         for topic, family in inbound.items():
             self.create_subscription(
                 topics.import_type(family.type_name), topic,
-                lambda data, f=family: post_all(f, data, self.mailbox.post, self.get_logger().warning),
+                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
                 EVENTS, raw=True,
             )
         self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
@@ -91,6 +99,8 @@ class ControllerNode(Node):
             )
         self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
+        self._diagnostics_pub = self.create_publisher(
+            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         stamp = decoded[0]
@@ -102,6 +112,7 @@ class ControllerNode(Node):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
+        self.inbound.now_ns = self.inbound.released_ns = stamp_ns
         _, pose, v, w = self._latest[topics.ODOM]
         sensed = self.sensing.sense(**{t.field: self._latest[t.name][1] for t in self.sensing.topics})
         obs = Observation(
@@ -124,6 +135,11 @@ class ControllerNode(Node):
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
+        counts = merged(self.rejections, getattr(self.behaviour, "rejections", None))
+        if counts != self._published_rejections:
+            self._published_rejections = counts
+            self._diagnostics_pub.publish(
+                diagnostics.encode_rejections(stamp_ns, self.get_fully_qualified_name(), counts))
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)

@@ -16,7 +16,7 @@ from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.analysis.video import render_video
 from swarm_sim.cli import number
-from swarm_sim.recording import BagError
+from swarm_sim.recording import BagError, repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
 
 
@@ -41,6 +41,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-plot", action="store_true")
     parser.add_argument("--trajectories", action="store_true",
                         help="also draw <bag>/trajectories.png: odometry over the planned spirals")
+    parser.add_argument("--repair", action="store_true",
+                        help="first finalise a bag whose recorder was killed, in place, so that rosbags "
+                             "and ros2 bag read it too (every recovered message kept)")
     video = parser.add_argument_group("replay video (one bag)")
     video.add_argument("--video", type=Path, metavar="OUT.mp4|OUT.gif", help="render the run from the bag")
     video.add_argument("--speedup", type=number(float, 0, 1e6, open_low=True), default=10.0,
@@ -56,6 +59,8 @@ def main(argv: list[str] | None = None) -> int:
     for given in args.bags:
         try:
             bag = find_bag(given)
+            if args.repair and repair_bag(bag):
+                print(f"swarm-analyze: {bag}: repaired (its last file was cut off)", file=sys.stderr)
             trace = load_run(bag)
         except (BagError, ValueError) as exc:
             print(f"swarm-analyze: {exc}", file=sys.stderr)
@@ -79,13 +84,14 @@ def main(argv: list[str] | None = None) -> int:
             print(json.dumps(summary))
         else:
             print(f"{bag}:")
-            for key in ("scenario", "seed", "robots", "mode", "sim_seconds", "wall_seconds",
+            for key in ("scenario", "seed", "robots", "mode", "run_ended", "dead_nodes", "sim_seconds", "wall_seconds",
                         "resources_delivered", "total_resources", "collision_time_per_robot_s",
                         "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
                         "resources_collected_pct", "dropoff_time_mean_s", "perimeter_delay_mean_s",
                         "deliveries_outside_docks",
                         "queue_length_mean", "queue_length_max", "resources_per_robot",
-                        "foraging_rate_per_min", "regions", "plot", "trajectories", "video", "video_frames"):
+                        "foraging_rate_per_min", "regions", "rejected_messages", "plot", "trajectories",
+                        "video", "video_frames"):
                 if key in summary:
                     print(f"  {key:28s} {summary[key]}")
     return status
