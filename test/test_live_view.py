@@ -38,13 +38,14 @@ def _start_run(bag: Path) -> subprocess.Popen:
                             cwd=Path(__file__).resolve().parents[1], start_new_session=True)
 
 
-def _url(proc: subprocess.Popen, deadline: float) -> str:
+def _url(proc: subprocess.Popen, deadline: float) -> tuple[str, list[str]]:
+    """The live view's address, and the lines printed up to it."""
     seen = []
     while time.monotonic() < deadline:
         line = proc.stdout.readline()
         seen.append(line)
         if match := re.search(r"live view: (ws://\S+)", line):
-            return match.group(1)
+            return match.group(1), seen
         if not line and proc.poll() is not None:
             break
     raise AssertionError("no live view line:\n" + "".join(seen))
@@ -53,7 +54,7 @@ def _url(proc: subprocess.Popen, deadline: float) -> str:
 def test_a_websocket_client_subscribes_and_decodes_the_live_run(tmp_path):
     proc = _start_run(tmp_path / "bag")
     try:
-        url = _url(proc, time.monotonic() + 60)
+        url, before = _url(proc, time.monotonic() + 60)
         assert url.startswith("ws://127.0.0.1:")
         listening = {c.laddr.ip for p in psutil.Process(proc.pid).children(recursive=True)
                      for c in p.net_connections(kind="inet") if c.status == psutil.CONN_LISTEN}
@@ -79,11 +80,17 @@ def test_a_websocket_client_subscribes_and_decodes_the_live_run(tmp_path):
                     got.setdefault(subscribed[sub], []).append((stamp, bytes(frame[13:])))
                 elif frame[0] == TIME:
                     clock.append(struct.unpack_from("<Q", frame, 1)[0])
-        assert set(got) == set(WANTED), (sorted(got), sorted(c["topic"] for c in channels.values()))
     finally:
         proc.send_signal(signal.SIGINT)  # seen enough: Ctrl-C, which leaves a valid bag
         out, _ = proc.communicate(timeout=120)
+    assert set(got) == set(WANTED), ({t: len(v) for t, v in got.items()}, len(clock), "".join(before) + out[-3000:])
     assert proc.returncode == 130, out[-3000:]
+    # start-up progress: what the launcher started, then what the world waits for
+    printed = "".join(before) + out
+    assert "[swarm-run] started 2 controller/server process(es)" in printed
+    assert re.search(r"\[world\] up \([\d.]+ s after its imports .* of 2 robots\); waiting for the controllers "
+                     r"and servers to connect", printed)
+    assert re.search(r"\[world\] 2/2 controllers connected after [\d.]+ s: starting", printed)
 
     by_topic = {c["topic"]: c for c in channels.values()}
     odom = by_topic["/robot_0/odom"]

@@ -10,7 +10,10 @@ subscribes to a latched topic (state, markers) is sent its last message at once,
 transient-local DDS subscriber would be. No rclpy here: the recorder calls `add` and `write`.
 
 It binds 127.0.0.1 unless told otherwise; the SDK's global context is not used, so nothing else
-in the process can log to it.
+in the process can log to it. The server starts (`start`) once the run's topics exist: foxglove-sdk
+0.30 advertises a channel created while a client is connected before it can take that client's
+subscription ("Unknown channel ID"), so a client that subscribes at once (as Foxglove does) would
+miss it; channels that exist when a client connects are advertised safely.
 """
 
 from __future__ import annotations
@@ -31,7 +34,6 @@ class LiveView:
     def __init__(self, port: int = DEFAULT_PORT, host: str = LOOPBACK, name: str = "swarmforage") -> None:
         """`port` 0 lets the OS choose (see `port`)."""
         import foxglove
-        from foxglove.websocket import Capability
 
         self._foxglove = foxglove
         self.context = foxglove.Context()
@@ -39,11 +41,20 @@ class LiveView:
         self._latched: set[str] = set()
         self._last: dict[str, tuple[bytes, int]] = {}
         self._lock = threading.Lock()
-        self.server = foxglove.start_server(
-            name=name, host=host, port=port, capabilities=[Capability.Time], server_listener=self,
-            context=self.context,
-        )
-        self.host = host
+        self.server = None
+        self.host, self._port, self._name = host, port, name
+        self.closed = False
+
+    def start(self) -> None:
+        """Start serving (idempotent); messages written before are not sent (latched ones are, on
+        subscription)."""
+        from foxglove.websocket import Capability
+
+        if self.server is None and not self.closed:
+            self.server = self._foxglove.start_server(
+                name=self._name, host=self.host, port=self._port, capabilities=[Capability.Time],
+                server_listener=self, context=self.context,
+            )
 
     @property
     def port(self) -> int:
@@ -73,7 +84,7 @@ class LiveView:
         if topic in self._latched:
             self._last[topic] = (data, stamp_ns)
         channel.log(data, log_time=stamp_ns)
-        if topic == CLOCK_TOPIC:
+        if topic == CLOCK_TOPIC and self.server is not None:
             self.server.broadcast_time(stamp_ns)
 
     # foxglove.websocket.ServerListener (called on the SDK's threads)
@@ -88,6 +99,7 @@ class LiveView:
 
     def close(self) -> None:
         """Stop the server (idempotent)."""
+        self.closed = True
         if self.server is not None:
             self.server.stop()
             self.server = None

@@ -183,7 +183,6 @@ class WorldNode(Node):
             from swarm_sim.nodes.live_view import LiveView
 
             live = LiveView(self.config.foxglove_port, self.config.foxglove_host)
-            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
         return Recorder(self, Path(path) if path else None, meta, lambda: self.world.t_ns, live)
 
     def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
@@ -284,6 +283,14 @@ class WorldNode(Node):
             self._published_rejections = counts
             self._diagnostics_pub.publish(diagnostics.encode_rejections(t_ns, self.get_fully_qualified_name(), counts))
 
+    def _start_live_view(self) -> None:
+        """Serve Foxglove clients once the run's topics exist (`swarm_sim.nodes.live_view`)."""
+        live = self.recorder.live if self.recorder is not None else None
+        if live is not None:
+            self._discover()
+            live.start()
+            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
+
     def wait_for_controllers(self, executor: Executor) -> None:
         start = time.monotonic()
         print(f"[world] up ({start - _IMPORTED:.1f} s after its imports to build the world and the topics of "
@@ -382,6 +389,7 @@ class WorldNode(Node):
         cfg, sim = self.config, self.scenario.sim
         self._discover()
         self.wait_for_controllers(executor)
+        self._start_live_view()
         obs = self.world.reset()
         wall0 = last_progress = time.monotonic()
         self.wall_start = wall0
