@@ -41,6 +41,8 @@ from launch_py.dds import (
 from launch_py.lifetime import die_with_parent
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 EXIT_CODES = {
@@ -54,6 +56,10 @@ EXIT_CODES = {
 }
 """swarm-run's exit codes."""
 
+
+
+STARTUP_REPORT_PERIOD = 5.0
+"""Wall seconds between start-up lines while the world node is not up yet."""
 
 
 def split_robots(robots: list[str], processes: int) -> list[list[str]]:
@@ -112,6 +118,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--discovery", choices=("server", "simple"), default="server",
                         help="DDS discovery: the world node as discovery server for every other node (default; "
                              "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), nargs="?", const=DEFAULT_PORT, metavar="PORT",
+                        help=f"serve the run live to Foxglove over WebSocket (default port {DEFAULT_PORT}; 0: any free)")
+    parser.add_argument("--foxglove-host", default=LOOPBACK,
+                        help=f"address the live view binds (default {LOOPBACK}: this machine only)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
@@ -163,6 +173,8 @@ def main(argv: list[str] | None = None) -> int:
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
+    if args.foxglove is not None:
+        world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
         controllers = [("controller processes (one per robot)",
                         [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names])]
@@ -173,11 +185,20 @@ def main(argv: list[str] | None = None) -> int:
     world: subprocess.Popen | None = None
     interrupted = False
     reported: set[int] = set()
+    launched = said = time.monotonic()
     try:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
         children += [start(label, [*cmd, *common]) for label, cmd in controllers]
         children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
+        print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
+              "reports while they start and discover each other", flush=True)
         while world.poll() is None:
+            now = time.monotonic()
+            if now - said >= STARTUP_REPORT_PERIOD and not (bag / METADATA_FILE).exists():
+                said = now  # the world node opens the bag once it is up; it reports from there on
+                running = sum(p.poll() is None for _, p in children)
+                print(f"[swarm-run] {now - launched:5.1f} s: waiting for the world node to come up "
+                      f"({running + 1} processes starting: Python, ROS and pybullet imports)", flush=True)
             for label, p in children:
                 if p.poll() is not None and p.pid not in reported:
                     reported.add(p.pid)
@@ -194,6 +215,8 @@ def main(argv: list[str] | None = None) -> int:
         if port is not None:
             shutil.rmtree(profile.parent, ignore_errors=True)
 
+    if world is None:  # interrupted before anything ran
+        return 130
     world_died = world.returncode != 0 and not interrupted
     if world_died:
         print(f"[swarm-run] the world node (pid {world.pid}) {_how(world.returncode)}: the run stopped early; "

@@ -11,6 +11,10 @@ Messages from other nodes are untrusted: they are checked before the behaviour s
 (`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
 and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
 
+The node serves the standard parameter services (``ros2 param list/get``), created with it; with
+the discovery server each process only learns of the endpoints on its own topics, so their twelve
+DDS endpoints per robot cost the start-up little.
+
 ``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process;
 with ``--fork`` it gives every robot its own process instead, forked from this one once the
 imports and the scenario are loaded (one process per robot, as on real hardware, without paying
@@ -71,7 +75,7 @@ class ControllerNode(Node):
         parse)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
-            "controller", namespace=robot, start_parameter_services=False, enable_rosout=False,
+            "controller", namespace=robot, enable_rosout=False,
             parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.robot = robot
@@ -227,6 +231,7 @@ def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
     minute): import the behaviour, sense and message-family modules and every message type,
     and the interface packages rclpy's Node pulls in lazily. No DDS entity is made here: Fast
     DDS leaves threads behind, and a forked copy of a threaded process can deadlock."""
+    from rcl_interfaces import srv as parameter_services
     from rcl_interfaces.msg import ParameterEvent
     from rclpy.type_support import check_for_type_support
     from rosgraph_msgs.msg import Clock
@@ -238,7 +243,9 @@ def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
     inbound, outbound = registry.robot_topics(algorithm)
     names = [*topics.ROBOT_TOPIC_TYPES.values(), topics.type_string(topics.DIAGNOSTICS),
              *(t.type_name for t in sensing.topics), *(f.type_name for f in (*inbound.values(), *outbound.values()))]
-    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, Clock, GetTypeDescription):
+    services = [getattr(parameter_services, n) for n in ("DescribeParameters", "GetParameterTypes", "GetParameters",
+                                                         "ListParameters", "SetParameters", "SetParametersAtomically")]
+    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, Clock, GetTypeDescription, *services):
         check_for_type_support(cls)  # loads the type support C modules (and rosidl's parser) now
 
 

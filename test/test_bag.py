@@ -189,13 +189,32 @@ def test_metadata_yaml_is_rosbag2_v9(tmp_path: Path) -> None:
     assert info["custom_data"] == {"seed": "7", "scenario.name": "cpfa", "scenario.robots": "2"}
     topics = {t["topic_metadata"]["name"]: t for t in info["topics_with_message_count"]}
     odom_meta = topics["/robot_0/odom"]["topic_metadata"]
-    assert odom_meta["type_description_hash"] == ""
+    # REP 2011's hash of nav_msgs/msg/Odometry (what the graph reports for a publisher of it)
+    assert odom_meta["type_description_hash"] == (
+        "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0"
+    )
     assert odom_meta["serialization_format"] == "cdr"
     assert odom_meta["offered_qos_profiles"][0]["reliability"] == "best_effort"
     assert topics["/depot/state"]["topic_metadata"]["offered_qos_profiles"][0]["durability"] == (
         "transient_local"
     )
     assert topics["/robot_0/odom"]["message_count"] == 20
+
+
+def test_offered_qos_set_later_replaces_the_default_in_metadata_yaml(tmp_path: Path) -> None:
+    bag = tmp_path / "run"
+    offered = [{"history": "keep_last", "depth": 1000, "reliability": "reliable", "durability": "volatile"}]
+    with BagWriter(bag) as w:
+        w.add_topic("/robot_0/status", "diagnostic_msgs/msg/DiagnosticArray")
+        w.add_topic("/clock", "rosgraph_msgs/msg/Clock")
+        w.set_offered_qos("/robot_0/status", offered, "RIHS01_given")
+        with pytest.raises(BagError, match="not registered"):
+            w.set_offered_qos("/nope", offered)
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    topics = {t["topic_metadata"]["name"]: t["topic_metadata"] for t in info["topics_with_message_count"]}
+    assert topics["/robot_0/status"]["offered_qos_profiles"] == offered
+    assert topics["/robot_0/status"]["type_description_hash"] == "RIHS01_given"
+    assert topics["/clock"]["offered_qos_profiles"][0]["depth"] == 10  # the default of its QoS name
 
 
 def test_flatten_metadata() -> None:

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
@@ -22,14 +21,6 @@ from swarm_sim.types import PheromoneMessage, Pose2D
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")
-
-
-@pytest.fixture
-def context():
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    yield ctx
-    ctx.try_shutdown()
 
 
 class ScriptedControllers(Node):

@@ -61,8 +61,7 @@ class ServerNode(Node):
 
     def __init__(self, name: str, config: ServerNodeConfig | None = None, **kwargs) -> None:
         super().__init__(
-            name, start_parameter_services=False,
-            parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
+            name, parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.config = cfg = declare_config(self, ServerNodeConfig, config)
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)

@@ -52,6 +52,10 @@ from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, Robot
 from swarm_sim.world import World
 
 
+_IMPORTED = time.monotonic()
+"""When this module's imports were done (start-up lines count from here)."""
+
+
 class Interrupted(Exception):
     """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
@@ -85,6 +89,11 @@ class WorldNodeConfig:
     """Sim seconds between ``/world/robot_stats`` messages."""
     markers_period: float = 5.0
     """Sim seconds between ``/world/markers`` messages."""
+    foxglove_port: int = -1
+    """Serve the run live over the Foxglove WebSocket protocol on this port (0: any free port;
+    -1: no live view), `swarm_sim.nodes.live_view`."""
+    foxglove_host: str = "127.0.0.1"
+    """Address the live view binds (loopback unless asked otherwise)."""
 
 
 class WorldNode(Node):
@@ -96,7 +105,7 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recorder = self._open_recorder(cfg.bag) if cfg.bag else None
+        self.recorder = self._open_recorder(cfg.bag) if cfg.bag or cfg.foxglove_port >= 0 else None
 
         self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
         self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
@@ -174,7 +183,12 @@ class WorldNode(Node):
             "mode": self.config.mode,
             "robots": str(len(self.world.robots)),
         }
-        return Recorder(self, Path(path), meta, lambda: self.world.t_ns)
+        live = None
+        if self.config.foxglove_port >= 0:
+            from swarm_sim.nodes.live_view import LiveView
+
+            live = LiveView(self.config.foxglove_port, self.config.foxglove_host)
+        return Recorder(self, Path(path) if path else None, meta, lambda: self.world.t_ns, live)
 
     def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
         if send:
@@ -274,12 +288,21 @@ class WorldNode(Node):
             self._published_rejections = counts
             self._diagnostics_pub.publish(diagnostics.encode_rejections(t_ns, self.get_fully_qualified_name(), counts))
 
+    def _start_live_view(self) -> None:
+        """Serve Foxglove clients once the run's topics exist (`swarm_sim.nodes.live_view`)."""
+        live = self.recorder.live if self.recorder is not None else None
+        if live is not None:
+            self._discover()
+            live.start()
+            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
+
     def wait_for_controllers(self, executor: Executor) -> None:
-        """Spin until every controller and server is matched (or `startup_timeout`), saying
-        what it waits for every `progress_period`; prints when the first tick goes out."""
         start = time.monotonic()
-        deadline, say = start + self.config.startup_timeout, start + self.config.progress_period
+        print(f"[world] up ({start - _IMPORTED:.1f} s after its imports to build the world and the topics of "
+              f"{len(self.robots)} robots); waiting for the controllers{' and servers' if self.servers else ''} to connect", flush=True)
+        deadline = start + self.config.startup_timeout
         missing = list(self.robots)
+        said = start
         while missing and time.monotonic() < deadline:
             self._spin(executor, 0.1)
             missing = [
@@ -289,17 +312,15 @@ class WorldNode(Node):
             ]
             if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
                 missing.append("servers (" + ", ".join(self.servers) + ")")
-            if missing and time.monotonic() >= say:
-                say += self.config.progress_period
-                print(f"[world] {time.monotonic() - start:5.1f} s: waiting for {len(missing)} of "
-                      f"{len(self.robots) + bool(self.servers)} nodes to connect: {', '.join(missing[:4])}"
-                      f"{' ...' if len(missing) > 4 else ''}", flush=True)
+            if missing and time.monotonic() - said >= self.config.progress_period:
+                said = time.monotonic()
+                self.print_startup(missing, said - start)
+        print(f"[world] {len(self.robots) - len([m for m in missing if m in self._cmd_subs])}/{len(self.robots)} "
+              f"controllers connected after {time.monotonic() - start:.1f} s: starting", flush=True)
         if missing:
             self.get_logger().warning(
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
             )
-        print(f"[world] first tick after {time.monotonic() - start:.1f} s of start-up: "
-              f"{len(self.robots) - len(missing)} controllers and {len(self.servers)} servers connected", flush=True)
 
     stop_requested = False
     """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
@@ -373,6 +394,7 @@ class WorldNode(Node):
         cfg, sim = self.config, self.scenario.sim
         self._discover()
         self.wait_for_controllers(executor)
+        self._start_live_view()
         obs = self.world.reset()
         wall0 = last_progress = time.monotonic()
         self.wall_start = wall0
@@ -399,6 +421,18 @@ class WorldNode(Node):
         end = time.monotonic() + 0.5
         while time.monotonic() < end:
             self._spin(executor, 0.05)
+
+    def print_startup(self, missing: list[str], waited: float) -> None:
+        """What the start-up is waiting for (nodes starting and discovering each other)."""
+        robots = [m for m in missing if m in self._cmd_subs]
+        others = [m for m in missing if m not in self._cmd_subs]
+        text = f"{len(self.robots) - len(robots)}/{len(self.robots)} controllers connected"
+        if robots:
+            text += f", waiting for {', '.join(robots[:3])}{' ...' if len(robots) > 3 else ''}"
+        if others:
+            text += f"; waiting for {', '.join(others)}"
+        print(f"[world] start-up {waited:5.1f} s: {text} (gives up after {self.config.startup_timeout:.0f} s)",
+              flush=True)
 
     def print_progress(self, wall: float) -> None:
         t = self.world.t_ns / NS_PER_S
@@ -430,10 +464,14 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout)
     parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0)
     parser.add_argument("--bag", default="")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), default=-1, metavar="PORT",
+                        help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
+    parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host)
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
+        foxglove_port=args.foxglove, foxglove_host=args.foxglove_host,
     )
     return config, ros_args
 
