@@ -24,6 +24,10 @@ from pathlib import Path
 
 PROFILE_PATH = Path(__file__).with_name("fastdds_loopback.xml")
 PROFILE_MAX_PROCESSES = 256
+MAX_DOMAIN_ID = 230
+"""The highest ROS_DOMAIN_ID whose ports the profile can compute: participant 255 of domain d
+uses UDP port 7400 + 250 d + 11 + 2 * 255, which passes 65535 from d = 231 on (Fast DDS then
+fails every participant with "Calculated port number is too high")."""
 """Participants per domain the profile can discover (its maxInitialPeersRange)."""
 DOMAIN_RANGE = (100, 200)
 """Inclusive range of private ROS_DOMAIN_IDs (the project's convention, clear of 0).
@@ -56,8 +60,8 @@ def loopback_env(
     replaced, everything else is kept. With `server_port`, the process is a client of the
     graph's discovery server on 127.0.0.1 (`discovery_server_env` makes the server).
     """
-    if not 0 <= domain_id <= 232:
-        raise ValueError(f"ROS_DOMAIN_ID {domain_id} outside 0..232")
+    if not 0 <= domain_id <= MAX_DOMAIN_ID:
+        raise ValueError(f"ROS_DOMAIN_ID {domain_id} outside 0..{MAX_DOMAIN_ID}")
     if processes > PROFILE_MAX_PROCESSES:
         raise ValueError(f"{processes} processes exceed the profile's {PROFILE_MAX_PROCESSES}")
     env = {k: v for k, v in (os.environ if base is None else base).items() if k not in _DROPPED}

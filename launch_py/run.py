@@ -31,6 +31,7 @@ from datetime import datetime
 from pathlib import Path
 
 from launch_py.dds import (
+    MAX_DOMAIN_ID,
     PROFILE_PATH,
     discovery_port,
     discovery_server_env,
@@ -114,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="realtime mode's target")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
-    parser.add_argument("--domain-id", type=number(int, 0, 232), help="ROS_DOMAIN_ID 0-232 (default: a private one)")
+    parser.add_argument("--domain-id", type=number(int, 0, MAX_DOMAIN_ID),
+                        help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID} (default: a private one)")
     parser.add_argument("--discovery", choices=("server", "simple"), default="server",
                         help="DDS discovery: the world node as discovery server for every other node (default; "
                              "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
@@ -262,14 +264,15 @@ def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
     dead = summary.get("dead_nodes") or []
     if dead:
         say(f"declared dead during the run: {', '.join(dead)}")
-    if summary["server_stale_ticks"]:
-        say(f"a server missed {summary['server_stale_ticks']} lockstep ticks")
+    if summary["server_stale_ticks"] or summary["stale_ticks"]:
+        say(f"lockstep ticks answered late: {summary['stale_ticks']} by controllers, {summary['server_stale_ticks']} "
+            "by servers (a slow machine; the run may differ from the batch run of the same seed)")
     ended = summary.get("run_ended", "complete")
     if world_died:
         return 5
     if interrupted or ended == "interrupted":
         return 130
-    if ended.startswith("server") or summary["server_stale_ticks"]:
+    if ended.startswith("server"):
         say(f"the run ended early: {ended}")
         return 3
     return 4 if dead else 0

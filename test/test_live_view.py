@@ -87,7 +87,7 @@ def test_a_websocket_client_subscribes_and_decodes_the_live_run(tmp_path):
     assert proc.returncode == 130, out[-3000:]
     # start-up progress: what the launcher started, then what the world waits for
     printed = "".join(before) + out
-    assert "[swarm-run] started 2 controller/server process(es)" in printed
+    assert "[swarm-run] started the world and 2 controller/server process(es)" in printed
     assert re.search(r"\[world\] up \([\d.]+ s after its imports .* of 2 robots\); waiting for the controllers "
                      r"and servers to connect", printed)
     assert re.search(r"\[world\] 2/2 controllers connected after [\d.]+ s: starting", printed)
