@@ -65,9 +65,10 @@ class ControllerConfig:
 
 class ControllerNode(Node):
     """One robot's controller. It creates its ``cmd_vel`` publisher, which is what the world
-    waits for before the first tick, only once every topic it exchanges with the other robots
-    and the servers is matched (`connect`): a message sent before its receivers are matched
-    would be lost, and the run would no longer be the batch run of the same seed."""
+    waits for before the first tick, only once every topic it exchanges with the servers and
+    with the world's relay of the other robots' messages is matched (`connect`): a message sent
+    before its receiver is matched would be lost, and the run would no longer be the batch run
+    of the same seed."""
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
                  **kwargs) -> None:
@@ -76,7 +77,10 @@ class ControllerNode(Node):
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, enable_rosout=False,
-            parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
+            # No type description service: our types are standard ones every peer has, and its two
+            # endpoints per robot are start-up cost with a process per robot.
+            parameter_overrides=[Parameter("use_sim_time", value=True),
+                                 Parameter("start_type_description_service", value=False)], **kwargs,
         )
         self.robot = robot
         self.config = cfg = declare_config(self, ControllerConfig, config)
@@ -112,8 +116,7 @@ class ControllerNode(Node):
         }
         self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
                           for t, f in outbound.items()}
-        self._peer_topics = set(inbound) & set(outbound)
-        """Topics every robot both sends and hears: matched once all robots are."""
+
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         """Message class -> the topic this robot sends it on."""
         for name, (type_name, decode) in decoders.items():
@@ -132,10 +135,9 @@ class ControllerNode(Node):
         timeout passed); True once it exists."""
         if self._cmd_pub is not None:
             return True
-        robots = self.scenario.robots.count
-        need = {t: robots if t in self._peer_topics else 1 for t in (*self._inbound_subs, *self._outbound)}
-        missing = [t for t, sub in self._inbound_subs.items() if sub.get_publisher_count() < need[t]]
-        missing += [t for t, (_, pub) in self._outbound.items() if pub.get_subscription_count() < need[t]]
+        # One peer on each: a server, or the world relaying what robots send each other.
+        missing = [t for t, sub in self._inbound_subs.items() if sub.get_publisher_count() < 1]
+        missing += [t for t, (_, pub) in self._outbound.items() if pub.get_subscription_count() < 1]
         if missing and time.monotonic() < self._connect_by:
             return False
         if missing:

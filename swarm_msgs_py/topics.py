@@ -111,6 +111,16 @@ def type_name(msg_class: Any) -> str:
     return f"{package}/msg/{msg_class.__name__}"
 
 
+HEARD = "heard"
+
+
+def heard(topic: str) -> str:
+    """Where robots hear what other robots send on `topic` (``/nest/pheromones`` ->
+    ``/nest/pheromones/heard``): the world relays robot-to-robot messages like a radio medium
+    (`swarm_sim.nodes.world_node`), so each robot matches one relay instead of every other robot."""
+    return f"{topic}/{HEARD}"
+
+
 def robot_topic(robot: RobotId, name: str) -> str:
     """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"`` (any relative name: tasks add
     their own sense topics)."""

@@ -34,6 +34,10 @@ class Reason(str, Enum):
     """It names a robot this run does not have."""
     WRONG_TICK = "wrong tick"
     """It is stamped for a tick other than the one it can be taken at."""
+    LATE = "late"
+    """A command for a tick the world has already closed: usually a slow robot's answer after
+    its tick counted as stale (a forged one looks the same); dropped, as lockstep requires, and
+    counted apart from other ticks' stamps."""
     DEAD = "declared dead"
     """Its sender was declared dead by the world (`swarm_sim.nodes.lockstep`)."""
     UNKNOWN_NODE = "unknown node"

@@ -255,18 +255,25 @@ def _channel(cls: type) -> str:
 def robot_topics(algorithm: Algorithm) -> tuple[dict[str, Any], dict[str, Any]]:
     """(inbound, outbound) topic -> message family of a robot's controller: with each server it
     sends the family's messages on the server's channel and hears the rest; its peer families
-    it both sends and hears."""
+    it sends on their topics and hears on the world's relay of them (`peer_topics`)."""
+    from swarm_msgs_py.topics import heard
+
     inbound: dict[str, Any] = {}
     outbound: dict[str, Any] = {}
     for spec in algorithm.servers:
         family = resolve(spec.family)
         for cls, topic in family.topics.items():
             (outbound if _channel(cls) == spec.channel else inbound)[topic] = family
-    for path in algorithm.peers:
-        family = resolve(path)
-        for topic in family.topics.values():
-            inbound[topic] = outbound[topic] = family
+    for topic, family in peer_topics(algorithm).items():
+        outbound[topic] = family
+        inbound[heard(topic)] = family
     return inbound, outbound
+
+
+def peer_topics(algorithm: Algorithm) -> dict[str, Any]:
+    """Topic -> message family of what the robots send each other; the world relays each to
+    ``heard(topic)`` (robots never match each other directly: N relays, not N x N matches)."""
+    return {topic: family for family in map(resolve, algorithm.peers) for topic in family.topics.values()}
 
 
 def server_topics(spec: ServerSpec) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -168,6 +168,7 @@ class Hostile(Node):
             DepotReport(s, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])[0])
         self.pubs["/robot_0/status"].publish(diagnostics.encode_diagnostics(s, [(0, "robot_0", "", "", (("garbage", "1"),))]))
         self.pubs["/robot_1/cmd_vel"].publish(twist.encode_twist("robot_1", s - 5 * 10**8, 0.15, 0.0))
+        self.pubs["/robot_1/cmd_vel"].publish(twist.encode_twist("robot_1", s + 5 * 10**8 + 1, 0.15, 0.0))
         self.pubs["/robot_1/cmd_vel"].publish(b"\x00\x01\x00\x00\xff")
         self.pubs[topics.LOCKSTEP_ACK].publish(ack.encode_ack("nobody", s))
 
@@ -204,7 +205,7 @@ def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_pa
     assert code == 0, err[-3000:]
     rejected = summary["rejected_messages"]
     assert rejected["/depot/reports"]["unknown robot"] >= 4  # by the depot manager's node
-    assert {"wrong tick", "malformed"} <= set(rejected["/robot_1/cmd_vel"])  # by the world
+    assert {"late", "wrong tick", "malformed"} <= set(rejected["/robot_1/cmd_vel"])  # by the world
     assert rejected["/lockstep/ack"]["unknown node"] >= 1
     assert summary["malformed_messages"] >= 1  # the garbage status, recorded as sent
     assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0 and summary["run_ended"] == "complete"

@@ -135,8 +135,9 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
                              lambda d: statuses.append(diagnostics.decode_status(d)), EVENTS, raw=True)
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
             for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
-    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS)
-    # robot_1 of the scenario hears pheromones too: robot_0 answers only once every peer is matched
+    # the world's relay of what the other robots send, and its end that hears what robot_0 sends:
+    # robot_0 answers only once both are matched
+    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.heard(topics.PHEROMONES), EVENTS)
     peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
     original_step = node.behaviour.step
     node.behaviour.step = lambda obs: (inbox.append(obs.messages), original_step(obs))[1]

@@ -29,11 +29,12 @@ def test_shipped_records_and_their_wiring():
     assert registry.known() == ("cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue")
     queue = registry.algorithm("queue")
     inbound, outbound = registry.robot_topics(queue)
-    assert set(inbound) == {topics.DEPOT_GRANTS, topics.RADIO, topics.PHEROMONES}
+    assert set(inbound) == {topics.DEPOT_GRANTS, topics.heard(topics.RADIO), topics.heard(topics.PHEROMONES)}
     assert set(outbound) == {topics.DEPOT_REPORTS, topics.RADIO, topics.PHEROMONES}
     server_in, server_out = registry.server_topics(queue.servers[0])
     assert set(server_in) == {topics.DEPOT_REPORTS} and set(server_out) == {topics.DEPOT_GRANTS}
     assert registry.robot_topics(registry.algorithm("ddsa")) == ({}, {})
+    assert set(registry.peer_topics(queue)) == {topics.RADIO, topics.PHEROMONES}  # the world relays these
 
 
 def test_records_are_refused_twice_and_unknown_names_are_named():

@@ -34,6 +34,9 @@ class Recorder:
         self.live = live
         self.known: set[str] = set()
         """Topics recorded already (by the world itself or by discovery)."""
+        self.skipped: set[str] = set()
+        """Topics discovery leaves out (the world's relay of robots' messages: copies of topics
+        recorded already)."""
         self._latched: set[str] = set()
         self.closed = False
 
@@ -61,7 +64,7 @@ class Recorder:
         """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
         node = self._node
         for topic, types in node.get_topic_names_and_types():
-            if topic in self.known or not types:
+            if topic in self.known or topic in self.skipped or not types:
                 continue
             self.known.add(topic)
             on_new(topic)

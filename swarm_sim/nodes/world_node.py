@@ -39,7 +39,7 @@ from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import number
-from swarm_sim.inbound import Reason, Rejections
+from swarm_sim.inbound import Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.recorder import Recorder
 from swarm_sim.scenario import (
@@ -158,6 +158,19 @@ class WorldNode(Node):
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
+        self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
+        self._relays = {}
+        """Peer topic -> publisher on ``heard(topic)``: the world relays what robots send each
+        other, like a radio medium (`_on_peer`)."""
+        self._relayed: list[tuple[str, bytes]] = []
+        for topic, family in registry.peer_topics(algorithm).items():
+            msg_type = topics.import_type(family.type_name)
+            self._record_topic(topic, family.type_name)
+            if self.recorder is not None:
+                self.recorder.skipped.add(topics.heard(topic))  # the relay's copies: recorded once, as sent
+            self._relays[topic] = self.create_publisher(msg_type, topics.heard(topic), EVENTS)
+            self.create_subscription(msg_type, topic, lambda data, t=topic, f=family: self._on_peer(t, f, data),
+                                     EVENTS, raw=True)
         self._next_discovery = 0.0
 
     # ------------------------------------------------------------------ plumbing
@@ -195,10 +208,6 @@ class WorldNode(Node):
             pub.publish(data)
         self._record(topic, data)
 
-    def _reject(self, where: str, reason: Reason, detail: str) -> None:
-        if self.rejections.add(where, reason, detail):
-            self.get_logger().warning(self.rejections.log_line(where, reason))
-
     @property
     def rejected_commands(self) -> int:
         """Commands dropped so far (any reason)."""
@@ -210,14 +219,18 @@ class WorldNode(Node):
         try:
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
-            self._reject(topic, Reason.MALFORMED, str(exc))
+            self.inbound.reject(topic, Reason.MALFORMED, str(exc))
             return
         if robot in self.barrier.dead:
-            self._reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
+            self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
+            if self.barrier.has_answered(robot, stamp_ns):
+                return  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
-            self._reject(topic, Reason.WRONG_TICK, f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
+            late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
+            self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
+                                f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
             return
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
@@ -227,14 +240,29 @@ class WorldNode(Node):
         try:
             channel, stamp_ns = ack_codec.decode_ack(data)
         except ValueError as exc:
-            self._reject(topics.LOCKSTEP_ACK, Reason.MALFORMED, str(exc))
+            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.MALFORMED, str(exc))
             return
         if channel not in self.servers:
-            self._reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
+            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
         elif channel in self.barrier.dead:
-            self._reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
+            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
         else:
             self.barrier.answered(channel, stamp_ns)
+
+    def _on_peer(self, topic: str, family, data: bytes) -> None:
+        """A robot's message to the others: recorded, checked (`swarm_sim.inbound`) and relayed
+        on ``heard(topic)`` just before the next tick's observations. Lockstep order makes this
+        exact: a robot publishes its messages of tick k before its command k, so they are here
+        before the barrier lets tick k+1 out, and they leave before its observations, from the
+        same sender, in order."""
+        self._record(topic, data)
+        try:
+            messages = family.decode(data)
+        except ValueError as exc:
+            self.inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
+            return
+        if all([self.inbound.admit(topic, m) for m in messages]):  # a list: every bad one is counted
+            self._relayed.append((topic, data))
 
     def _discover(self) -> None:
         """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
@@ -251,6 +279,11 @@ class WorldNode(Node):
         """Tick k's clock and observations; `send=False` records them without asking the
         controllers for another answer (the state at the end of the run)."""
         t_ns = self.world.t_ns
+        self.inbound.now_ns = self.inbound.released_ns = t_ns
+        if send:  # what robots sent each other at the last tick, before this tick's observations
+            for topic, data in self._relayed:
+                self._relays[topic].publish(data)
+        self._relayed = []
         self._publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK, send=send)
         sc = self.scenario.sensors.scan
         # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
