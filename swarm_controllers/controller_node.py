@@ -26,7 +26,7 @@ from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, family_qos
 from swarm_msgs_py.records import post_all
 from swarm_sim import registry
 from swarm_sim.messaging import Mailbox
@@ -75,7 +75,7 @@ class ControllerNode(Node):
                 lambda data, f=family: post_all(f, data, self.mailbox.post, self.get_logger().warning),
                 EVENTS, raw=True,
             )
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
                           for t, f in outbound.items()}
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         """Message class -> the topic this robot sends it on."""

@@ -28,7 +28,7 @@ from swarm_msgs_py import ack, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, family_qos
 from swarm_msgs_py.records import post_all
 from swarm_sim import registry
 from swarm_sim.messaging import Mailbox
@@ -73,7 +73,7 @@ class ServerNode(Node):
             )
             for t, f in inbound.items()
         ]
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
                           for t, f in outbound.items()}
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,

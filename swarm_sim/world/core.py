@@ -48,6 +48,7 @@ from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
+from swarm_sim.world.start import start_positions
 from swarm_sim.world.tasks import TaskFactory, WorldTask
 
 ROBOT_MASS = 1.0
@@ -231,18 +232,14 @@ class World:
 
         # Robots first, so their body ids are 0..n-1.
         n = self._n
-        side = math.ceil(math.sqrt(n))
-        cx, cy = s.depot.center
-        pitch = s.robots.start_spacing
         yaws = rng_start.uniform(-math.pi, math.pi, size=n)
+        starts = start_positions(s, rng_start).tolist()
         shape = p.createCollisionShape(
             p.GEOM_CYLINDER, radius=self._radius, height=s.robots.height, physicsClientId=cid
         )
         izz = 0.5 * ROBOT_MASS * self._radius**2
         self._bodies: list[int] = []
-        for i in range(n):
-            x = cx + (i % side - (side - 1) / 2) * pitch
-            y = cy + (i // side - (side - 1) / 2) * pitch
+        for i, (x, y) in enumerate(starts):
             body = p.createMultiBody(
                 ROBOT_MASS, shape, -1, [x, y, self._z0], yaw_to_quaternion(float(yaws[i])),
                 physicsClientId=cid,

@@ -179,6 +179,11 @@ class ForagingTask:
             self._ground_changed()
 
     def sense(self) -> list[ForagingSense]:
+        return list(map(_new_sense, zip(*self.sense_fields())))
+
+    def sense_fields(self) -> tuple[list[tuple[tuple[float, float], ...]], list[bool]]:
+        """Per robot, the resources it detects (nearest first) and whether it carries one: the
+        fields of `ForagingSense`, for tasks whose sense extends it."""
         n = len(self._world.robots)
         detected: list[tuple[tuple[float, float], ...]] = [()] * n
         robot, g, d2 = self._near_cached()
@@ -190,8 +195,7 @@ class ForagingTask:
                 if k == len(robot) or robot[k] != robot[start]:
                     detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
                     start = k
-        carrying = (self._carrying >= 0).tolist()
-        return list(map(_new_sense, zip(detected, carrying)))
+        return detected, (self._carrying >= 0).tolist()
 
     def drain_events(self) -> list[PickupEvent | DropEvent]:
         events, self._events = self._events, []
