@@ -3,12 +3,13 @@
 One state machine for both (Fig. 1, Table 1); they differ only in the threshold theta of eq. (7).
 
 * **Waiting S_W.** Every robot starts waiting in the nest. A waiting robot stands still, except
-  right after a deposit (below). It counts its ticks in S_W from 0; once t_1 >= T_1 it draws on
-  every tick, as the ARGoS foraging example the paper's set-up follows (T_1 = 50 ticks is its
-  ``minimum_resting_time``) does: with probability P_s of eq. (7) ("roulette wheel selection"
-  between leaving and staying) it switches to S_S and tells the nest (LEFT). P_s uses the last
-  `NestState` it heard: S(t) = F_d - F(t) (eq. (2)) and theta from the subclass; before it has
-  heard the nest it does not draw. n is drawn once per robot, uniform in [2, 9].
+  right after a deposit (below). It counts its ticks in S_W from 0 (t_1); when t_1 reaches T_1
+  it draws: with probability P_s of eq. (7) ("roulette wheel selection" between leaving and
+  staying) it switches to S_S and tells the nest (LEFT); if it stays, it draws again every
+  ``draw_period`` ticks (default T_1: its timer restarts; see `ThresholdConfig.draw_period` for
+  the every-tick reading of the ARGoS example). P_s uses the last `NestState` it heard:
+  S(t) = F_d - F(t) (eq. (2)) and theta from the subclass; before it has heard the nest it does
+  not draw. n is drawn once per robot, uniform in [2, 9].
 * **Searching S_S** (ASM, eq. (1)): A(t) = 0, a random walk driven by the noise epsilon (full
   speed, turn rate ~ N(0, walk_turn_std^2) each tick), until a food token is detected; then
   A(t) = 1 and f(x) steers to the nearest detected token. The world picks it up when the robot
@@ -71,6 +72,7 @@ class ThresholdForager:
         self._rng = rng
         self.exponent = int(rng.integers(th.exponent_min, th.exponent_max + 1))
         """n of eq. (7), fixed for the run."""
+        self._period = th.period()
         self._robots = scenario.robots.count
         self._side = scenario.arena.size
         self._desired = NestConfig.of(scenario).desired_food
@@ -140,7 +142,9 @@ class ThresholdForager:
     # ------------------------------------------------------------------ states
 
     def _waiting(self, obs: Observation, reports: list[NestEvent]) -> tuple[float, float]:
-        if self._waited >= self.config.min_wait_steps and self.nest is not None and self._draw():
+        c = self.config
+        if (self._waited >= c.min_wait_steps and (self._waited - c.min_wait_steps) % self._period == 0
+                and self.nest is not None and self._draw()):
             self._state = ForagerState.SEARCHING
             self._settle = 0
             reports.append(NestEvent.LEFT)

@@ -54,6 +54,16 @@ class ThresholdConfig(Section):
 
     min_wait_steps: int = 50
     """T_1: ticks a robot waits in the nest before it first draws P_s (eq. (7))."""
+    draw_period: int | None = None
+    """Once t_1 >= T_1, a waiting robot that stays draws again after this many ticks. None: T_1,
+    i.e. its timer restarts (Sec. 2: "initializes a timer t_1 = 0 ... when the waiting time
+    expires ... uses the DRTM to calculate its foraging probability"); 1: every tick, as the ARGoS
+    foraging example (whose minimum resting time is T_1) does, which turns any P_s above a few
+    percent into leaving at once and leaves eq. (6) no time to act on k."""
+
+    def period(self) -> int:
+        """Ticks between draws."""
+        return self.min_wait_steps if self.draw_period is None else self.draw_period
     exponent_min: int = 2
     """n of eq. (7) is an integer drawn uniformly in [exponent_min, exponent_max] per robot."""
     exponent_max: int = 9
@@ -96,6 +106,8 @@ def check_nest(scenario: Scenario) -> None:
         raise ValueError("controller.nest.oae_window: must be positive (or null for L / 2v)")
     if th.min_wait_steps < 0:
         raise ValueError("controller.threshold.min_wait_steps: must not be negative")
+    if th.period() < 1:
+        raise ValueError("controller.threshold.draw_period: must be at least 1 (or null with min_wait_steps >= 1)")
     if not 1 <= th.exponent_min <= th.exponent_max:
         raise ValueError("controller.threshold.exponent_min: need 1 <= exponent_min <= exponent_max")
     if not 0 <= th.threshold_min <= th.initial_threshold <= th.threshold_max:
