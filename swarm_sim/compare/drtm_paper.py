@@ -178,7 +178,7 @@ def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:
     lines = ["# DRTM paper comparison: two-sample t-tests on F_t and M_T (Tables 2 and 4)", "",
              "scipy.stats.ttest_ind(DRTM, ARTM), equal variances, two-sided, as the paper (50 + 50 runs, 98 "
              "d.o.f.). Our t is signed (negative: DRTM's mean is lower); the paper's t are all positive and "
-             "it gives no sign convention. Stars: *** p<0.001, ** p<0.01, * p<0.05, ns otherwise.", ""]
+             "it gives no sign convention. `significant`: *** p<0.001, ** p<0.01, * p<0.05, else no.", ""]
     body = []
     for cell in conditions:
         c = DRTM_CONDITIONS[cell]
