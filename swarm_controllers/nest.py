@@ -6,7 +6,9 @@ A world task cannot hear robots, and reading their state out of the controllers 
 ARGoS loop functions have, so the robots report those as `NestReport` messages and this server,
 stepped once per tick like the depot manager, keeps the books. It trusts the reports (a robot
 learns of its delivery from its gripper, a world fact); reports from robots the run does not
-have are ignored and listed in `errors`.
+have, or from robots the world declared dead, are refused and counted in `rejections`. A dead
+robot (`robot_lost`, graph runs only) stops counting as foraging: it stands still and the paper's
+ledger charges only moving foragers.
 
 Each tick (stamp t_k) the server applies the reports stamped before t_k, in order, then charges
 the tick just ended [t_{k-1}, t_k): `step_energy` per robot in S_S or S_R, C_rate dt / 60 tokens
@@ -22,6 +24,7 @@ from collections.abc import Sequence
 
 from swarm_controllers.nest_config import NestConfig
 from swarm_controllers.nest_protocol import NestEvent, NestReport, NestState
+from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.types import NS_PER_S
 
 
@@ -82,10 +85,17 @@ class NestServer:
         self._recent: deque[int] = deque()
         """Stamps of the OAEs of the last T_2."""
         self._last_ns: int | None = None
-        self.errors: list[str] = []
-        """One line per report that could not be applied."""
+        self.rejections = Rejections()
+        """Reports that could not be applied, by reason."""
+        self.lost: set[str] = set()
+        """Robots the world declared dead."""
         self.history: list[NestState] = []
         """Every state sent, in order."""
+
+    def robot_lost(self, robot: str, stamp_ns: int) -> None:
+        """`robot` was declared dead: it no longer forages, its later reports are refused."""
+        self.lost.add(robot)
+        self.active.discard(robot)
 
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[NestState, ...]:
         for m in messages:
@@ -104,7 +114,10 @@ class NestServer:
 
     def _apply(self, m: NestReport, stamp_ns: int) -> None:
         if m.robot not in self._known:
-            self.errors.append(f"t={stamp_ns / NS_PER_S:.3f} report from unknown robot {m.robot!r} ignored")
+            self.rejections.add("NestReport", Reason.UNKNOWN_ROBOT, f"t={stamp_ns / NS_PER_S:.3f} {m.robot[:40]!r}")
+            return
+        if m.robot in self.lost:
+            self.rejections.add("NestReport", Reason.DEAD, f"t={stamp_ns / NS_PER_S:.3f} {m.robot}")
             return
         if m.event is NestEvent.LEFT:
             self.active.add(m.robot)

@@ -41,6 +41,8 @@ DEPOT_MARKERS = "/depot/markers"
 RADIO = "/radio"
 NEST_REPORTS = "/nest/reports"
 NEST_STATE = "/nest/state"
+DIAGNOSTICS = "/diagnostics"
+"""Every node's rejected-message counts (`swarm_sim.inbound`), one status per node, on change."""
 LOCKSTEP_ACK = "/lockstep/ack"
 """Servers (center, depot manager, nest) answer each lockstep tick here: header.stamp = the tick,
 header.frame_id = the server's channel (`center`, `depot`)."""
@@ -73,6 +75,7 @@ GLOBAL_TOPIC_TYPES: dict[str, str] = {
     NEST_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
     NEST_STATE: "diagnostic_msgs/msg/DiagnosticArray",
     LOCKSTEP_ACK: "std_msgs/msg/Header",
+    DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
 }
 """Absolute topic -> ROS type string."""
 

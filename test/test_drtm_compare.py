@@ -10,6 +10,7 @@ from swarm_sim.compare.drtm_paper import (
     DRTM_CONDITIONS,
     PAPER,
     condition_overrides,
+    drtm_headlines,
     drtm_plans,
     mean_series,
     write_drtm_report,
@@ -72,16 +73,25 @@ def test_mean_series_over_seeds():
     assert np.allclose(mean, [6.0, 6.1, 6.2, 6.3, 6.4]) and np.allclose(std, np.sqrt(2.0))
 
 
-def test_cli_runs_the_drtm_comparison_with_a_fake_runner(tmp_path):
+def test_cli_runs_the_drtm_comparison_with_a_fake_run(tmp_path):
     calls = []
 
-    def runner(name, overrides, fields, seeds, jobs):
+    def run(job):
+        name, overrides, fields, seed = job
         calls.append((name, tuple(overrides)))
-        behaviour = next((o.split("=")[1] for o in overrides if o.startswith("controller.behaviour")), name)
-        for seed in seeds:
-            yield {**_row(behaviour, 0, seed, 0.0 if name == "drtm" else 1.0), "seed": seed, "scenario": name}
+        return {**_row(name, 0, seed, 0.0 if name == "drtm" else 1.0), "seed": seed, "scenario": name}
 
-    assert main(["drtm", "--seeds", "3", "--conditions", "4.2", "--out", str(tmp_path)], runner=runner) == 0
-    assert calls == [("drtm", ("controller.nest.avoidance_energy=20.0",)),
-                     ("artm", ("controller.nest.avoidance_energy=20.0",))]
+    assert main(["drtm", "--seeds", "3", "--conditions", "4.2", "--out", str(tmp_path)], run=run) == 0
+    assert sorted(set(calls)) == [("artm", ("controller.nest.avoidance_energy=20.0",)),
+                                  ("drtm", ("controller.nest.avoidance_energy=20.0",))]
     assert "## Sec. 4.2: E_a = 20" in (tmp_path / "table.md").read_text()
+
+
+def test_headlines_count_the_conditions_drtm_wins():
+    rows = [_row(s, c, seed, shift) for c in (0, 1) for s, shift in (("drtm", 0.0), ("artm", 1.0)) for seed in range(3)]
+    rows += [_row("drtm", 2, 0, 1.0), _row("artm", 2, 0, 0.0)]  # condition 4.2: ARTM better
+    found = {h.claim.split(" (")[0]: h for h in drtm_headlines(rows, [0, 1, 2, 3])}
+    assert found["DRTM keeps the food closer to F_d"].ours == "DRTM better in 2/3: 3.1, 4.1"
+    assert found["DRTM keeps the food closer to F_d"].holds is False
+    assert found["DRTM is more energy-efficient"].ours == "DRTM better in 1/3: 4.2"
+    assert drtm_headlines([], [0])[0].holds is None

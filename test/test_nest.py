@@ -81,11 +81,13 @@ def test_recent_oaes_and_waiting_robots_from_a_hand_made_history():
     assert window == 20 * 10**9  # T_2 = L / 2v = 4 / (2 x 0.1) = 20 s
 
 
-def test_reports_from_unknown_robots_are_ignored_and_listed():
+def test_reports_from_unknown_or_dead_robots_are_refused_and_counted():
     nest = NestServer(_scenario())
-    nest.step(0, [])
-    state = nest.step(DT_NS, [NestReport(0, "robot_9", NestEvent.DEPOSITED)])[0]
-    assert state.food == 5.0 - 5.0 / 1500.0 * 1 and len(nest.errors) == 1  # one tick of C_rate only
+    nest.step(0, [_report(-1, 0, NestEvent.LEFT)])
+    nest.robot_lost("robot_0", DT_NS)  # the world declared it dead: it stands still
+    state = nest.step(DT_NS, [NestReport(0, "robot_9", NestEvent.DEPOSITED), _report(0, 0, NestEvent.DEPOSITED)])[0]
+    assert state.food == 5.0 - 5.0 / 1500.0 and state.waiting == 3  # one tick of C_rate only
+    assert dict(nest.rejections.counts) == {("NestReport", "unknown robot"): 1, ("NestReport", "declared dead"): 1}
 
 
 @given(st.lists(st.tuples(st.integers(0, 2), st.sampled_from(list(NestEvent))), max_size=60),

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table
 from swarm_sim.compare.stats import describe, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
@@ -255,6 +255,32 @@ def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int]
     return written
 
 
+HEADLINES: tuple[tuple[str, str, str, bool], ...] = (
+    ("food_deviation", "DRTM keeps the food closer to F_d (V_f lower than ARTM's)", "Secs. 3.1, 4.1-4.4", True),
+    ("oae_total", "DRTM has fewer obstacle-avoidance events (M_T lower than ARTM's)", "Secs. 3.1, 4.1-4.4; t-tests", True),
+    ("energy_efficiency", "DRTM is more energy-efficient (E_e higher than ARTM's)", "Secs. 3.1, 4.1-4.4", False),
+)
+"""(field, claim, where the paper says it, DRTM better when lower): the paper's headline claims,
+each made for every condition."""
+
+
+def drtm_headlines(rows: Sequence[dict], conditions: Sequence[int]) -> list[Headline]:
+    """Each headline claim checked on the means of every condition run: it holds where DRTM beats
+    ARTM in all of them (None without both models' runs)."""
+    out = []
+    for metric, claim, where, lower in HEADLINES:
+        wins, seen = [], []
+        for cell in conditions:
+            a, b = (describe(values_of(rows, s, cell, metric)).mean for s in DRTM_STRATEGIES)
+            if math.isfinite(a) and math.isfinite(b):
+                seen.append(DRTM_CONDITIONS[cell].section)
+                if (a < b) == lower and a != b:
+                    wins.append(DRTM_CONDITIONS[cell].section)
+        ours = f"DRTM better in {len(wins)}/{len(seen)}: {', '.join(wins) or 'none'}" if seen else "—"
+        out.append(Headline(claim, f"all five ({where})", ours, len(wins) == len(seen) if seen else None))
+    return out
+
+
 def _sections(text: Sequence[str] | None) -> list[int]:
     known = [c.section for c in DRTM_CONDITIONS]
     if not text:
@@ -278,6 +304,10 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_drtm_report(rows, out, _sections(args.conditions), strategies)
 
 
+def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
+    return drtm_headlines(rows, _sections(args.conditions))
+
+
 DRTM_COMPARISON = Comparison(
     name="drtm",
     help="DRTM paper: DRTM vs ARTM in Secs. 3.1 and 4.1-4.4, tables, t-tests (Tables 2, 4), Figs. 5-6",
@@ -286,4 +316,5 @@ DRTM_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
+    headlines=_headlines,
 )
