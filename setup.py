@@ -53,6 +53,7 @@ setup(
             "swarm-controllers = swarm_controllers.controller_node:main",
             "swarm-center = swarm_controllers.center_node:main",
             "swarm-depot-manager = depot_manager.node:main",
+            "swarm-nest = swarm_controllers.nest_node:main",
             "swarm-compare = swarm_sim.compare.cli:main",
         ],
     },

@@ -90,6 +90,11 @@ class ObstacleAvoidance:
         """True while the last `update` returned a turn."""
         return self._active
 
+    def reset(self) -> None:
+        """Forget the current episode (the robot stopped moving): the next blocked tick starts
+        a new one."""
+        self._active = False
+
     @property
     def front_rays(self) -> tuple[int, ...]:
         """Indices of the rays watched for obstacles."""
@@ -170,6 +175,12 @@ class AvoidThenEscape:
     @property
     def active(self) -> bool:
         return self.avoidance.active
+
+    def reset(self) -> None:
+        """Forget the current episode and escape run (the robot stopped moving)."""
+        self.avoidance.reset()
+        self._escape_left = 0
+        self._was_avoiding = False
 
     def update(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
         """The command that overrides the behaviour this tick (a turn away or the escape run),

@@ -45,7 +45,7 @@ from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound, Rejections, merged
 from swarm_sim.messaging import Mailbox
@@ -112,9 +112,7 @@ class ControllerNode(Node):
                 lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
                 EVENTS, raw=True,
             )
-            for topic, family in inbound.items()
-        }
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
                           for t, f in outbound.items()}
 
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}

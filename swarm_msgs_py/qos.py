@@ -8,6 +8,9 @@
   state at once.
 - `EVENTS` (world events, behaviour status, pheromones): reliable and deep,
   because every event counts and bursts (many pickups in one tick) must not be dropped.
+- `STATE_STREAM` (a state published every tick that robots also act on, e.g. the DRTM nest's
+  ``/nest/state``): reliable + transient-local like `STATE_LATCHED`, with a little depth so
+  that no tick's state is overwritten before a slow subscriber has it.
 """
 
 from __future__ import annotations
@@ -34,6 +37,21 @@ EVENTS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST,
     depth=1000,
 )
+
+STATE_STREAM = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=10,
+)
+
+
+def family_qos(family: object, topic: str) -> QoSProfile:
+    """The publisher QoS of a message family's topic: `STATE_STREAM` for the family's latched
+    topics (`swarm_msgs_py.records.RecordFamily.latched`), `EVENTS` otherwise. Subscribers use
+    `EVENTS`, which matches both."""
+    return STATE_STREAM if topic in getattr(family, "latched", ()) else EVENTS
+
 
 RECORD_LATCHED = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,

@@ -117,9 +117,15 @@ class RecordFamily:
 
     type_name = TYPE_NAME
 
-    def __init__(self, name: str, topics: Mapping[type, str]) -> None:
+    def __init__(self, name: str, topics: Mapping[type, str], latched: Iterable[str] = ()) -> None:
         self.name = name
         self.topics = dict(topics)
+        self.latched = frozenset(latched)
+        """Topics published reliable + transient-local (a stream of states: a late joiner gets
+        the latest at once); the others are volatile (`swarm_msgs_py.qos.family_qos`)."""
+        unknown = self.latched - set(self.topics.values())
+        if unknown:
+            raise ValueError(f"{name}: latched topics {sorted(unknown)} are not topics of the family")
         self._classes = {cls.__name__: cls for cls in self.topics}
         self._fields: dict[type, tuple[str, ...]] = {}
         self._parsers: dict[type, tuple[Callable[[str], Any], ...]] = {}

@@ -39,10 +39,12 @@ DEPOT_GRANTS = "/depot/grants"
 DEPOT_STATE = "/depot/state"
 DEPOT_MARKERS = "/depot/markers"
 RADIO = "/radio"
+NEST_REPORTS = "/nest/reports"
+NEST_STATE = "/nest/state"
 DIAGNOSTICS = "/diagnostics"
 """Every node's rejected-message counts (`swarm_sim.inbound`), one status per node, on change."""
 LOCKSTEP_ACK = "/lockstep/ack"
-"""Servers (center, depot manager) answer each lockstep tick here: header.stamp = the tick,
+"""Servers (center, depot manager, nest) answer each lockstep tick here: header.stamp = the tick,
 header.frame_id = the server's channel (`center`, `depot`)."""
 
 ROBOT_TOPIC_TYPES: dict[str, str] = {
@@ -70,6 +72,8 @@ GLOBAL_TOPIC_TYPES: dict[str, str] = {
     DEPOT_STATE: "diagnostic_msgs/msg/DiagnosticArray",
     DEPOT_MARKERS: "visualization_msgs/msg/MarkerArray",
     RADIO: "diagnostic_msgs/msg/DiagnosticArray",
+    NEST_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
+    NEST_STATE: "diagnostic_msgs/msg/DiagnosticArray",
     LOCKSTEP_ACK: "std_msgs/msg/Header",
     DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
 }

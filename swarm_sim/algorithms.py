@@ -73,3 +73,41 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         paths="swarm_controllers.center:planned_paths",
         comparison="swarm_sim.compare.spiral_paper:SPIRAL_COMPARISON",
     ))
+
+register_task(TaskSpec(
+    name="nest",
+    core="swarm_sim.world.tasks.nest:NestTask",
+    sensing="swarm_msgs_py.nest:SENSING",
+    metrics="swarm_sim.analysis.metrics:foraging_metrics",
+))
+
+_NEST_SECTIONS = (("nest", "swarm_controllers.nest_config:NestConfig"),
+                  ("threshold", "swarm_controllers.nest_config:ThresholdConfig"))
+_NEST_SERVER = ServerSpec(
+    channel="nest", core="swarm_controllers.nest:NestServer", node="swarm_controllers.nest_node",
+    script="swarm-nest", family="swarm_msgs_py.nest_protocol:NEST",
+    replay="swarm_controllers.nest:replay_nest_state",
+)
+_NEST_METRICS = tuple(
+    Metric(name, f"swarm_controllers.nest_metrics:{function}", None)
+    for name, function in (
+        ("food_deviation", "food_deviation"), ("energy_efficiency", "energy_efficiency"),
+        ("oae_total", "oae_total"), ("food_collected", "food_collected"),
+        ("nest_food_final", "nest_food_final"), ("nest_food_series", "nest_food_series"),
+        ("active_robots_series", "active_robots_series"), ("oae_series", "oae_series"),
+    )
+)
+
+for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
+                             ("artm", "ArtmBehaviour", "ARTM (Castello et al.), the baseline")):
+    register(Algorithm(
+        name=_name,
+        paper=f"drtm_task_allocation.md (Pang et al. 2023) secs. 2-4: {_what}",
+        behaviour=f"swarm_controllers.drtm:{_class}",
+        task="nest",
+        config=_NEST_SECTIONS,
+        checks=("swarm_controllers.nest_config:check_nest",),
+        servers=(_NEST_SERVER,),
+        metrics=_NEST_METRICS,
+        comparison="swarm_sim.compare.drtm_paper:DRTM_COMPARISON",
+    ))

@@ -27,6 +27,7 @@ from swarm_sim.registry import make_behaviour, make_servers
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
+from swarm_sim.world.core import with_messages
 
 
 @dataclass
@@ -53,14 +54,13 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     try:
         obs = world.reset()
         for k in range(scenario.ticks):
-            xy = [(o.pose.x, o.pose.y) for o in obs.values()]
-            perimeter.update(world.t_ns / NS_PER_S, xy)
+            perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
             inbox = router.take_before(ROBOTS, world.t_ns)
             commands = {}
             for r, b in behaviours.items():
-                o = obs[r] if not inbox else dataclasses.replace(obs[r], messages=inbox)
+                o = obs[r] if not inbox else with_messages(obs[r], inbox)
                 command = b.step(o)
                 commands[r] = command
                 for message in command.messages:
@@ -71,7 +71,7 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
             last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
-        perimeter.update(world.t_ns / NS_PER_S, [(o.pose.x, o.pose.y) for o in obs.values()])
+        perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
         status = {r: b.status(last_step_ns) for r, b in behaviours.items()}

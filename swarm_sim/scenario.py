@@ -74,7 +74,13 @@ class RobotConfig:
     max_angular_speed: float = 2.0
     """[rad/s]."""
     start_spacing: float = 0.4
-    """Robots start on a square grid of this pitch [m] centred on the depot."""
+    """Robots start on a square grid of this pitch [m] centred on the depot (`start_layout`
+    grid); the other layouts keep robot centres at least this far apart."""
+    start_layout: Literal["grid", "depot_random", "depot_ring"] = "grid"
+    """Where robots start (`swarm_sim.world.start`): `grid` on the square grid above;
+    `depot_random` uniformly at random inside the depot disc (the DRTM paper's "placed in the
+    nest randomly"); `depot_ring` evenly spaced on a circle just inside the depot's edge (the
+    DRTM paper's e-puck set-up, "evenly distributed along the perimeter of the nest")."""
     radio_range: float = 0.4
     """gamma: robot-to-robot messages reach only robots within this distance [m] (queue paper
     sec. III; used by tail joining)."""
@@ -103,6 +109,9 @@ class SensorConfig:
     pickup_radius: float = 0.05
     """An empty robot whose centre is within this distance of a resource picks it up [m]
     (the ARGoS CPFA FoodRadius)."""
+    light_range: float = 2.0
+    """Light sensing (world tasks with a light, e.g. the DRTM nest): a light farther than this
+    from the robot's centre is not detected [m]."""
 
 
 @dataclass(frozen=True)
@@ -438,6 +447,9 @@ def load_scenario(
     return scenario
 
 
+START_RANDOM_COVERAGE = 0.4
+"""`depot_random` start: robots may cover at most this fraction of the disc their centres
+(widened by half the spacing) can use, so rejection sampling always finds room."""
 MAX_DURATION = 1e7
 """[s] of sim time (about 116 days): a longer run is a typo, not an experiment."""
 MIN_DT, MAX_DT = 1e-3, 10.0
@@ -548,13 +560,31 @@ def validate(s: Scenario) -> None:
         r.start_spacing >= r.diameter,
         f"robots.start_spacing: {r.start_spacing} m is less than the robot diameter {r.diameter} m",
     )
-    side = math.ceil(math.sqrt(r.count))
-    extent = (side - 1) * r.start_spacing / 2 + r.diameter / 2
-    _require(
-        _inside(s.depot.center, half, extent),
-        f"robots.count: {r.count} robots on a {side}x{side} grid of pitch {r.start_spacing} m "
-        f"do not fit in the {s.arena.size} m arena",
-    )
+    if r.start_layout == "grid":
+        side = math.ceil(math.sqrt(r.count))
+        extent = (side - 1) * r.start_spacing / 2 + r.diameter / 2
+        _require(
+            _inside(s.depot.center, half, extent),
+            f"robots.count: {r.count} robots on a {side}x{side} grid of pitch {r.start_spacing} m "
+            f"do not fit in the {s.arena.size} m arena",
+        )
+    else:
+        room = s.depot.radius - r.diameter / 2  # robot centres stay this close to the depot centre
+        _require(room > 0, f"robots.start_layout: robots of diameter {r.diameter} m do not fit in the "
+                           f"depot of radius {s.depot.radius} m")
+        if r.start_layout == "depot_ring":
+            _require(
+                r.count == 1 or 2 * room * math.sin(math.pi / r.count) >= r.start_spacing,
+                f"robots.count: {r.count} robots {r.start_spacing} m apart do not fit on a ring of "
+                f"radius {room:.3f} m inside the depot",
+            )
+        else:  # random sequential addition jams near 55 % coverage; stay well below it
+            _require(
+                r.count * (r.start_spacing / 2) ** 2 <= START_RANDOM_COVERAGE * (room + r.start_spacing / 2) ** 2,
+                f"robots.count: {r.count} robots {r.start_spacing} m apart are too many to place at "
+                f"random in the depot of radius {s.depot.radius} m",
+            )
+    _require(s.sensors.light_range > 0, "sensors.light_range: must be positive")
     sc = s.sensors.scan
     _require(sc.rays >= 1, "sensors.scan.rays: need at least one ray")
     _require(0 < sc.fov <= 2 * math.pi + 1e-9, "sensors.scan.fov: must be in (0, 2*pi]")

@@ -11,6 +11,7 @@ import json
 import sys
 from pathlib import Path
 
+from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
@@ -94,6 +95,9 @@ def main(argv: list[str] | None = None) -> int:
                         "video", "video_frames"):
                 if key in summary:
                     print(f"  {key:28s} {summary[key]}")
+            for m in registry.of(trace.config).metrics if trace.config is not None else ():
+                if not isinstance(summary.get(m.name), (list, dict)):  # the run's own algorithm's fields
+                    print(f"  {m.name:28s} {summary.get(m.name)}")
     return status
 
 

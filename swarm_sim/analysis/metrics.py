@@ -36,6 +36,8 @@ class PerimeterLog:
         """`xy`: (robots, 2) positions at time `t` [m, world frame], in `robots` order."""
         d = np.asarray(xy, dtype=float) - self._center
         inside = np.einsum("ij,ij->i", d, d) < self._r2
+        if np.array_equal(inside, self._inside):  # nobody crossed (almost every tick)
+            return
         for i in np.flatnonzero(inside & ~self._inside):
             self.entries[self.robots[i]].append(t)
         for i in np.flatnonzero(~inside & self._inside):

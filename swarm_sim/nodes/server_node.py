@@ -33,7 +33,7 @@ from swarm_msgs_py import ack, diagnostics, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound, Reason, Rejections, merged
 from swarm_sim.messaging import Mailbox
@@ -85,7 +85,7 @@ class ServerNode(Node):
             )
             for t, f in inbound.items()
         ]
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
                           for t, f in outbound.items()}
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,

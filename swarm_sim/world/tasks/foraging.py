@@ -40,6 +40,11 @@ _new_sense = functools.partial(tuple.__new__, ForagingSense)
 ``__new__``: built for every robot on every tick (measured: 112 robots, +8 % per tick)."""
 
 
+_ALL_PAIRS = 4096
+"""Up to this many (robot, resource) pairs every pair is tested at once; more (the queue paper's
+112 robots and 320 resources) go through the sorted x window. Both give the same result."""
+
+
 class ForagingTask:
     """Resources, pick-up and delivery for one world; rebuilt with it at every reset."""
 
@@ -85,6 +90,14 @@ class ForagingTask:
             return empty, empty, np.zeros(0)
         pos = self._world.positions
         rx = pos[:, 0]
+        if len(rx) * len(self._ground_ids) <= _ALL_PAIRS:
+            dx = self._ground_xy[None, :, 0] - rx[:, None]
+            dy = self._ground_xy[None, :, 1] - pos[:, 1, None]
+            d2 = dx * dx + dy * dy
+            robot, g = np.nonzero(d2 <= radius * radius)
+            d2 = d2[robot, g]
+            order = np.lexsort((g, d2, robot))
+            return robot[order], g[order], d2[order]
         lo = np.searchsorted(self._ground_x_sorted, rx - radius, side="left")
         hi = np.searchsorted(self._ground_x_sorted, rx + radius, side="right")
         count = hi - lo
@@ -179,6 +192,11 @@ class ForagingTask:
             self._ground_changed()
 
     def sense(self) -> list[ForagingSense]:
+        return list(map(_new_sense, zip(*self.sense_fields())))
+
+    def sense_fields(self) -> tuple[list[tuple[tuple[float, float], ...]], list[bool]]:
+        """Per robot, the resources it detects (nearest first) and whether it carries one: the
+        fields of `ForagingSense`, for tasks whose sense extends it."""
         n = len(self._world.robots)
         detected: list[tuple[tuple[float, float], ...]] = [()] * n
         robot, g, d2 = self._near_cached()
@@ -190,8 +208,7 @@ class ForagingTask:
                 if k == len(robot) or robot[k] != robot[start]:
                     detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
                     start = k
-        carrying = (self._carrying >= 0).tolist()
-        return list(map(_new_sense, zip(detected, carrying)))
+        return detected, (self._carrying >= 0).tolist()
 
     def drain_events(self) -> list[PickupEvent | DropEvent]:
         events, self._events = self._events, []
