@@ -22,9 +22,9 @@ import numpy as np
 from swarm_controllers.api import behaviour_rng
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
-from swarm_sim.messaging import Router
+from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.registry import make_behaviour, make_servers
+from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
@@ -51,8 +51,13 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     )
     perimeter = PerimeterLog(robots, scenario.depot.center, scenario.depot.perimeter_radius)
     poses = np.zeros((scenario.ticks + 1, len(robots), 3)) if record_poses else None
+    algorithm = of(scenario)
+    spec = task(algorithm.task).state
+    state_topics = resolve(spec) if spec else ()
+    keep = tuple(cls for path in algorithm.peers for cls in resolve(path).topics) if algorithm.trace_peers else ()
     try:
         obs = world.reset()
+        _record_state(world, state_topics, trace)
         for k in range(scenario.ticks):
             xy = [(o.pose.x, o.pose.y) for o in obs.values()]
             perimeter.update(world.t_ns / NS_PER_S, xy)
@@ -66,12 +71,15 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
                 commands[r] = command
                 for message in command.messages:
                     router.post(message)
+                    if keep and isinstance(message, keep):
+                        trace.messages.append(message)
             for channel, server in servers.items():
                 for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
                     router.post(message)
             last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
+            _record_state(world, state_topics, trace)
         perimeter.update(world.t_ns / NS_PER_S, [(o.pose.x, o.pose.y) for o in obs.values()])
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
@@ -82,10 +90,20 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
         trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
         for server in servers.values():
             trace.series.update(server.series())
+        trace.messages.sort(key=delivery_order)
     finally:
         world.close()
     trace.wall_seconds = time.monotonic() - wall0
     return BatchRun(trace, poses)
+
+
+def _record_state(world: World, state_topics: tuple, trace: RunTrace) -> None:
+    """The task's state of the current tick as the bag would hold it (`StateTopic.wire`)."""
+    if not state_topics:
+        return
+    values, t_ns = world.task.state(), world.t_ns
+    for st in state_topics:
+        trace.series.setdefault(st.field, []).append((t_ns / NS_PER_S, st.wire(t_ns, values[st.field])))
 
 
 def _collect_events(world: World, trace: RunTrace) -> None:
