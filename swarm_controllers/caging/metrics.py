@@ -17,9 +17,9 @@ tick), so a batch run and the bag of a graph run give the same numbers.
   path (the paper's "normalised error", about 3.8 %);
 - max path deviation: the object centre's largest distance from the planned polyline;
 - cage held: at every tick of the transport the object's centre lay inside the polygon of the
-  cage's robots (in cage order), and no robot of the cage stayed farther than r + 2w + c from the
-  object's centre (one robot width beyond its cage position, eq. (5)) for more than
-  CONTACT_BOUND seconds in a row.
+  cage's robots (in cage order), and no robot lost contact with its cage for more than
+  CONTACT_BOUND seconds in a row, where losing contact means opening a gap to a cage neighbour
+  (edge to edge) as wide as the object (2 r): a gap the object could slip through.
 """
 
 from __future__ import annotations
@@ -30,13 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_controllers.caging.config import CagingConfig
-from swarm_controllers.caging.geometry import cage_radius
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_sim.types import NS_PER_S, robot_index
 from swarm_sim.world.landmarks import landmarks
 
 CONTACT_BOUND = 5.0
-"""[s]: the longest a cage robot may stay out of reach of the object while the cage still counts
+"""[s]: the longest a gap the object could pass through may stay open while the cage still counts
 as held."""
 
 
@@ -86,30 +85,51 @@ def inside_polygon(point: np.ndarray, polygon: np.ndarray) -> bool:
     return inside
 
 
+@dataclass(frozen=True, eq=False)
+class Transport:
+    """What the figures need besides the report: the transport stage of a run."""
+
+    start_s: float
+    """When the cage was complete [s]."""
+    end_s: float
+    """When the last type 4 of the final landmark was sent (or the run's end) [s]."""
+    planned: np.ndarray
+    """(N, 2) the planned path [m, world frame]."""
+    cage: tuple[str, ...]
+    """The cage's robots in cage order."""
+
+
 def _series(trace, name: str) -> tuple[np.ndarray, list]:
     points = trace.series.get(name, [])
     return np.array([t for t, _ in points]), [v for _, v in points]
 
 
-_cache: tuple[object, CagingReport] | None = None
+_cache: tuple[object, CagingReport, Transport | None] | None = None
 
 
 def caging_report(trace) -> CagingReport:
     """The run's measures (None where the run did not get that far); computed once per trace."""
+    return _analysis(trace)[0]
+
+
+def transport_stage(trace) -> Transport | None:
+    """The transport stage (None if the cage was never complete)."""
+    return _analysis(trace)[1]
+
+
+def _analysis(trace) -> tuple[CagingReport, Transport | None]:
     global _cache
-    if _cache is not None and _cache[0] is trace:
-        return _cache[1]
-    report = _report(trace)
-    _cache = (trace, report)
-    return report
+    if _cache is None or _cache[0] is not trace:
+        _cache = (trace, *_report(trace))
+    return _cache[1], _cache[2]
 
 
-def _report(trace) -> CagingReport:
+def _report(trace) -> tuple[CagingReport, Transport | None]:
     scenario = trace.config
     marks = landmarks(scenario)
     recruitments = [m for m in trace.messages if isinstance(m, Recruitment)]
     if not recruitments:
-        return CagingReport(landmarks=len(marks))
+        return CagingReport(landmarks=len(marks)), None
     first = min(recruitments, key=lambda m: (m.stamp_ns, robot_index(m.origin)))
     recruiter = first.origin
     s = 1.0 / NS_PER_S
@@ -118,7 +138,7 @@ def _report(trace) -> CagingReport:
     cage = sorted({recruiter, *positioned}, key=robot_index)
     result = {"search_time_s": t_detect, "landmarks": len(marks), "cage_size": len(cage)}
     if not any(isinstance(m, Oriented) for m in trace.messages):
-        return CagingReport(**result)
+        return CagingReport(**result), None
     cfg = CagingConfig.of(scenario)
     unanswered = [m.stamp_ns * s + cfg.call_timeout for m in trace.messages
                   if isinstance(m, Summon) and m.origin == recruiter and m.destination not in positioned]
@@ -136,27 +156,27 @@ def _report(trace) -> CagingReport:
     times, poses = _series(trace, "object")
     window = (times >= t_caged - 1e-9) & (times <= t_done + 1e-9)
     if not window.any():
-        return CagingReport(**result)
+        return CagingReport(**result), None
     obj = np.array([(x, y) for x, y, _ in poses])[window]
     planned = np.array([obj[0], *(marks.position(j) for j in reversed(first.trajectory)),
                         (first.start_x, first.start_y)])
     result["max_path_deviation_m"] = float(distance_to_polyline(obj, planned).max())
-    result["cage_held"] = _cage_held(trace, scenario, cfg, cage, times[window], obj)
+    result["cage_held"] = _cage_held(trace, scenario, cage, times[window], obj)
     if done:
         planned_m, travelled_m = polyline_length(planned), polyline_length(obj)
         error = abs(travelled_m - planned_m)
         result |= {"planned_path_m": planned_m, "object_path_m": travelled_m, "trajectory_error_m": error,
                    "trajectory_error_pct": 100.0 * error / planned_m if planned_m > 0 else None}
-    return CagingReport(**result)
+    return CagingReport(**result), Transport(t_caged, t_done, planned, tuple(cage))
 
 
-def _cage_held(trace, scenario, cfg: CagingConfig, cage: list[str], times: np.ndarray, obj: np.ndarray) -> bool:
+def _cage_held(trace, scenario, cage: list[str], times: np.ndarray, obj: np.ndarray) -> bool:
     robot_times, robot_poses = _series(trace, "robots")
     at = {round(t, 6): p for t, p in zip(robot_times, robot_poses)}
     members = [robot_index(r) for r in cage]
-    reach = cage_radius(scenario.transport.object.radius, scenario.robots.diameter, cfg.clearance) \
-        + scenario.robots.diameter
-    out_since: dict[int, float] = {}
+    widest = 2.0 * scenario.transport.object.radius + scenario.robots.diameter
+    """Adjacent robots' centres this far apart leave a gap the object passes through."""
+    open_since: float | None = None
     for t, center in zip(times, obj):
         poses = at.get(round(t, 6))
         if poses is None or len(cage) < 3:
@@ -164,13 +184,12 @@ def _cage_held(trace, scenario, cfg: CagingConfig, cage: list[str], times: np.nd
         polygon = np.array([poses[i][:2] for i in members])
         if not inside_polygon(center, polygon):
             return False
-        for i, (x, y) in zip(members, polygon):
-            if math.hypot(x - center[0], y - center[1]) > reach:
-                out_since.setdefault(i, t)
-                if t - out_since[i] > CONTACT_BOUND:
-                    return False
-            else:
-                out_since.pop(i, None)
+        if np.hypot(*(polygon - np.roll(polygon, -1, axis=0)).T).max() >= widest:
+            open_since = t if open_since is None else open_since
+            if t - open_since > CONTACT_BOUND:
+                return False
+        else:
+            open_since = None
     return True
 
 

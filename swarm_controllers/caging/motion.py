@@ -155,11 +155,16 @@ class Formation:
     theta_r at their ideal angle within +-sigma, with the seven PIDs of Table 1.
 
     Each PID turns the part of its error beyond the tolerance into a planar velocity: D_lambda
-    toward p_i+, D_object along the line to the object's centre, D_ell / D_r along the line to
+    toward p_i+ (at most the robot's top speed, so that on a long leg the corrections still
+    count), D_object along the line to the object's centre, D_ell / D_r along the line to
     that neighbour, theta_ell / theta_r along the cage (tangent to the circle around the
-    object). Their sum is driven by the machine of Fig. 1a (alpha_p on its direction, reversing
-    when it points behind the robot) until the robot is within d of p_i+. The paper names the
-    seven variables and gains but not how they combine; summing velocities is our reading.
+    object). The robot drives that sum as a differential-drive robot can: speed = its length
+    times the cosine of the heading error, turn rate = PID(alpha_p) on its direction, backing up
+    when it points behind; ARRIVED within d of p_i+. The paper names the seven variables and
+    their gains but not how they combine ("a state machine similar to Fig. 1a"): summing is our
+    reading. Unlike Fig. 1a the robot does not stop to rotate while the heading error exceeds
+    sigma: the corrections turn the sum by a few degrees all the time, and with stop-and-rotate
+    (measured) the rear robots stood turning while the front ones drove off, tearing the cage.
     """
 
     def __init__(self, cfg: CagingConfig, limits: Limits, cage_radius: float) -> None:
@@ -185,7 +190,7 @@ class Formation:
         x, y = pose.x, pose.y
         dx, dy = target[0] - x, target[1] - y
         d_lambda = math.hypot(dx, dy)
-        speed = self._distance(d_lambda)
+        speed = self.limits.clamp(self._distance(d_lambda), 0.0)[0]  # no faster than the robot goes
         vx, vy = speed * dx / d_lambda, speed * dy / d_lambda
         if obj is not None:
             ox, oy = obj[0] - x, obj[1] - y
@@ -218,9 +223,5 @@ class Formation:
         direction = 1.0
         if abs(alpha) > math.pi / 2:  # it points behind: back up instead of turning round
             direction, alpha = -1.0, math.remainder(alpha - math.pi, 2.0 * math.pi)
-        turn = self._heading(alpha)
-        if abs(alpha) > self.limits.sigma:
-            self.state = Motion.ROTATE
-            return self.limits.clamp(0.0, turn)
         self.state = Motion.MOVE
-        return self.limits.clamp(direction * math.hypot(vx, vy) * math.cos(alpha), turn)
+        return self.limits.clamp(direction * math.hypot(vx, vy) * math.cos(alpha), self._heading(alpha))
