@@ -62,8 +62,6 @@ class StateTopic:
     encode: Callable[[int, Any], bytes]
     """(stamp_ns, value) -> CDR bytes."""
     decode: Callable[[bytes], tuple[int, Any]]
-    """CDR bytes -> (stamp_ns, value); raises CodecError (a ValueError) on malformed bytes."""
-
-    def wire(self, stamp_ns: int, value: Any) -> Any:
-        """`value` as a bag replay reads it back (what the batch runner keeps, so both agree)."""
-        return self.decode(self.encode(stamp_ns, value))[1]
+    """CDR bytes -> (stamp_ns, value) with ``value == state()[field]`` exactly (the task applies
+    the wire's rounding, e.g. yaw through a quaternion), so the batch runner's series equal a
+    bag's; raises CodecError (a ValueError) on malformed bytes."""

@@ -98,12 +98,12 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
 
 
 def _record_state(world: World, state_topics: tuple, trace: RunTrace) -> None:
-    """The task's state of the current tick as the bag would hold it (`StateTopic.wire`)."""
+    """The task's state of the current tick, as a bag replay reads it back (`StateTopic`)."""
     if not state_topics:
         return
-    values, t_ns = world.task.state(), world.t_ns
+    values, t = world.task.state(), world.t_ns / NS_PER_S
     for st in state_topics:
-        trace.series.setdefault(st.field, []).append((t_ns / NS_PER_S, st.wire(t_ns, values[st.field])))
+        trace.series.setdefault(st.field, []).append((t, values[st.field]))
 
 
 def _collect_events(world: World, trace: RunTrace) -> None:

@@ -144,10 +144,10 @@ class Neighbour:
     chord: float
     """Ideal D_ell or D_r: the distance between the two cage positions [m]."""
     separation: float
-    """Ideal theta_ell or theta_r: the angle between the two cage positions around the object,
-    k phi for neighbours k places apart [rad]."""
+    """Ideal theta_ell or theta_r: the angle between the two cage positions around the cage's
+    centre, k phi for neighbours k places apart [rad]."""
     side: int
-    """+1 left (counter-clockwise around the object), -1 right."""
+    """+1 left (counter-clockwise around the cage), -1 right."""
 
 
 class Formation:
@@ -156,9 +156,14 @@ class Formation:
 
     Each PID turns the part of its error beyond the tolerance into a planar velocity: D_lambda
     toward p_i+ (at most the robot's top speed, so that on a long leg the corrections still
-    count), D_object along the line to the object's centre, D_ell / D_r along the line to
-    that neighbour, theta_ell / theta_r along the cage (tangent to the circle around the
-    object). The robot drives that sum as a differential-drive robot can: speed = its length
+    count), D_object toward the object's centre when the robot is more than d farther than its
+    cage distance (only then: the object moves only when the robots behind it touch and push it,
+    and holding them off it stalled the cage short of its places), D_ell / D_r along the line to
+    that neighbour, theta_ell / theta_r along the cage (tangent to its circle). theta is the
+    angle between robot i and its neighbour around the cage's centre as robot i places it (its
+    own position minus its cage offset of eq. (5)): around the object's centre, which lags
+    inside the loose cage, the robots could not all be at p_i+ with theta = phi, and they
+    stalled short of it (measured). The robot drives that sum as a differential-drive robot can: speed = its length
     times the cosine of the heading error, turn rate = PID(alpha_p) on its direction, backing up
     when it points behind; ARRIVED within d of p_i+. The paper names the seven variables and
     their gains but not how they combine ("a state machine similar to Fig. 1a"): summing is our
@@ -167,10 +172,12 @@ class Formation:
     (measured) the rear robots stood turning while the front ones drove off, tearing the cage.
     """
 
-    def __init__(self, cfg: CagingConfig, limits: Limits, cage_radius: float) -> None:
+    def __init__(self, cfg: CagingConfig, limits: Limits, cage_radius: float, slot_angle: float) -> None:
         self.limits = limits
         self.d = cfg.distance_tolerance
         self.R = cage_radius
+        self.slot_angle = slot_angle
+        """i phi: where robot i sits on the cage [rad]."""
         dt = limits.dt
         self._heading = Pid(cfg.heading, dt)
         self._distance = Pid(cfg.distance, dt)
@@ -195,8 +202,8 @@ class Formation:
         if obj is not None:
             ox, oy = obj[0] - x, obj[1] - y
             d_obj = math.hypot(ox, oy)
-            if d_obj > 0:
-                u = self._object(deadband(d_obj - self.R, self.d))
+            if d_obj > 0:  # only "too far": robots behind the object must touch it to push it
+                u = self._object(max(0.0, deadband(d_obj - self.R, self.d)))
                 vx, vy = vx + u * ox / d_obj, vy + u * oy / d_obj
         for n in neighbours:
             nx, ny = n.position[0] - x, n.position[1] - y
@@ -204,13 +211,12 @@ class Formation:
             if d_n > 0:
                 u = self._neighbour_distance[n.side](deadband(d_n - n.chord, self.d))
                 vx, vy = vx + u * nx / d_n, vy + u * ny / d_n
-            if obj is not None:
-                mine = math.atan2(y - obj[1], x - obj[0])
-                theirs = math.atan2(n.position[1] - obj[1], n.position[0] - obj[0])
-                theta = n.side * math.remainder(theirs - mine, 2.0 * math.pi)
-                u = self._neighbour_angle[n.side](deadband(theta - n.separation, self.limits.sigma))
-                # toward the neighbour along the cage: counter-clockwise for the left one
-                vx, vy = vx - n.side * u * math.sin(mine), vy + n.side * u * math.cos(mine)
+            mine = self.slot_angle  # around the cage's centre (x, y) - R (cos mine, sin mine)
+            theirs = math.atan2(n.position[1] - y + self.R * math.sin(mine), n.position[0] - x + self.R * math.cos(mine))
+            theta = n.side * math.remainder(theirs - mine, 2.0 * math.pi)
+            u = self._neighbour_angle[n.side](deadband(theta - n.separation, self.limits.sigma))
+            # toward the neighbour along the cage: counter-clockwise for the left one
+            vx, vy = vx - n.side * u * math.sin(mine), vy + n.side * u * math.cos(mine)
         return vx, vy
 
     def step(self, pose: Pose2D, target: Point, obj: Point | None, neighbours: Sequence[Neighbour]) -> tuple[float, float]:

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pybullet as p
 
-from swarm_sim.geometry import yaw_to_quaternion
+from swarm_sim.geometry import wire_yaw, yaw_to_quaternion
 from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import Pose2D
 from swarm_sim.world.landmarks import landmarks
@@ -187,11 +187,12 @@ class TransportTask:
         return out
 
     def state(self) -> dict[str, object]:
-        """``object``: its true (x, y, yaw); ``robots``: every robot's true (x, y, yaw), in order."""
+        """``object``: its true (x, y, yaw); ``robots``: every robot's true (x, y, yaw), in order
+        (yaw rounded as its quaternion on the wire rounds it, so a bag holds exactly this)."""
         o = self.object_pose
         pos, yaw = self._world.positions.tolist(), self._world.headings.tolist()
-        return {"object": (o.x, o.y, o.yaw),
-                "robots": tuple((x, y, t) for (x, y), t in zip(pos, yaw))}
+        return {"object": (o.x, o.y, wire_yaw(o.yaw)),
+                "robots": tuple((x, y, wire_yaw(t)) for (x, y), t in zip(pos, yaw))}
 
     def drain_events(self) -> list:
         return []
