@@ -85,7 +85,7 @@ class CagingBehaviour:
         self.landmarks = landmarks(scenario)
         self._go = GoTo(cfg, limits)
         self._spin = Spin(cfg, limits)
-        self._formation = Formation(cfg, limits, self.cage_radius, self.index * self.phi)
+        self._formation = Formation(cfg, limits, self.cage_radius)
         self._call_timeout_ns = round(cfg.call_timeout * NS_PER_S)
         self._barrier_timeout_ns = round(cfg.barrier_timeout * NS_PER_S)
 

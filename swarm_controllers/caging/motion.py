@@ -135,6 +135,14 @@ class Spin:
         return self.limits.clamp(0.0, self._heading(alpha))
 
 
+HOLD_DISTANCE = 2.0
+"""[in d]: how near p_i+ a robot the formation holds still counts as arrived (`Formation`)."""
+HOLD_SPEED = 0.005
+"""[m/s]"""
+HOLD_TICKS = 20
+"""Control ticks (2 s at 10 Hz)."""
+
+
 @dataclass(frozen=True)
 class Neighbour:
     """A cage neighbour as robot i sees it during transport."""
@@ -144,10 +152,10 @@ class Neighbour:
     chord: float
     """Ideal D_ell or D_r: the distance between the two cage positions [m]."""
     separation: float
-    """Ideal theta_ell or theta_r: the angle between the two cage positions around the cage's
-    centre, k phi for neighbours k places apart [rad]."""
+    """Ideal theta_ell or theta_r: the angle between the two cage positions around the object,
+    k phi for neighbours k places apart [rad]."""
     side: int
-    """+1 left (counter-clockwise around the cage), -1 right."""
+    """+1 left (counter-clockwise around the object), -1 right."""
 
 
 class Formation:
@@ -159,25 +167,30 @@ class Formation:
     count), D_object toward the object's centre when the robot is more than d farther than its
     cage distance (only then: the object moves only when the robots behind it touch and push it,
     and holding them off it stalled the cage short of its places), D_ell / D_r along the line to
-    that neighbour, theta_ell / theta_r along the cage (tangent to its circle). theta is the
-    angle between robot i and its neighbour around the cage's centre as robot i places it (its
-    own position minus its cage offset of eq. (5)): around the object's centre, which lags
-    inside the loose cage, the robots could not all be at p_i+ with theta = phi, and they
-    stalled short of it (measured). The robot drives that sum as a differential-drive robot can: speed = its length
+    that neighbour, theta_ell / theta_r around the object's centre (tangent to the circle
+    around it: this keeps the robots spread around the object, so that one pushing it off
+    centre does not slide past it; measured around the cage's own centre instead, the cage let
+    the object slip out on long legs). The robot drives that sum as a differential-drive robot can: speed = its length
     times the cosine of the heading error, turn rate = PID(alpha_p) on its direction, backing up
     when it points behind; ARRIVED within d of p_i+. The paper names the seven variables and
     their gains but not how they combine ("a state machine similar to Fig. 1a"): summing is our
     reading. Unlike Fig. 1a the robot does not stop to rotate while the heading error exceeds
     sigma: the corrections turn the sum by a few degrees all the time, and with stop-and-rotate
     (measured) the rear robots stood turning while the front ones drove off, tearing the cage.
+
+    Beyond the paper: a robot held within HOLD_DISTANCE x d of p_i+ by the other PIDs (asking for
+    less than HOLD_SPEED for HOLD_TICKS ticks) counts as arrived. The object, caged with the
+    clearance of eq. (5), ends each leg a few centimetres short of lambda, so the robots spread
+    around it sit a little off their p_i+; with four robots (measured) the pull toward p_i+ and
+    the angle PIDs balanced 3-15 mm outside d and the cage waited for ever.
     """
 
-    def __init__(self, cfg: CagingConfig, limits: Limits, cage_radius: float, slot_angle: float) -> None:
+    def __init__(self, cfg: CagingConfig, limits: Limits, cage_radius: float) -> None:
         self.limits = limits
         self.d = cfg.distance_tolerance
         self.R = cage_radius
-        self.slot_angle = slot_angle
-        """i phi: where robot i sits on the cage [rad]."""
+        self._held = 0
+        """Ticks in a row the robot has been held short of p_i+ (see `step`)."""
         dt = limits.dt
         self._heading = Pid(cfg.heading, dt)
         self._distance = Pid(cfg.distance, dt)
@@ -191,6 +204,7 @@ class Formation:
                     *self._neighbour_angle.values()):
             pid.reset()
         self.state = Motion.ROTATE
+        self._held = 0
 
     def velocity(self, pose: Pose2D, target: Point, obj: Point | None, neighbours: Sequence[Neighbour]) -> Point:
         """The planar velocity the seven PIDs ask for [m/s, world frame]."""
@@ -211,17 +225,19 @@ class Formation:
             if d_n > 0:
                 u = self._neighbour_distance[n.side](deadband(d_n - n.chord, self.d))
                 vx, vy = vx + u * nx / d_n, vy + u * ny / d_n
-            mine = self.slot_angle  # around the cage's centre (x, y) - R (cos mine, sin mine)
-            theirs = math.atan2(n.position[1] - y + self.R * math.sin(mine), n.position[0] - x + self.R * math.cos(mine))
-            theta = n.side * math.remainder(theirs - mine, 2.0 * math.pi)
-            u = self._neighbour_angle[n.side](deadband(theta - n.separation, self.limits.sigma))
-            # toward the neighbour along the cage: counter-clockwise for the left one
-            vx, vy = vx - n.side * u * math.sin(mine), vy + n.side * u * math.cos(mine)
+            if obj is not None:
+                mine = math.atan2(y - obj[1], x - obj[0])
+                theirs = math.atan2(n.position[1] - obj[1], n.position[0] - obj[0])
+                theta = n.side * math.remainder(theirs - mine, 2.0 * math.pi)
+                u = self._neighbour_angle[n.side](deadband(theta - n.separation, self.limits.sigma))
+                # toward the neighbour around the object: counter-clockwise for the left one
+                vx, vy = vx - n.side * u * math.sin(mine), vy + n.side * u * math.cos(mine)
         return vx, vy
 
     def step(self, pose: Pose2D, target: Point, obj: Point | None, neighbours: Sequence[Neighbour]) -> tuple[float, float]:
         """(linear, angular) for this tick; `state` ARRIVED once within d of `target`."""
-        if math.hypot(target[0] - pose.x, target[1] - pose.y) <= self.d:
+        d_lambda = math.hypot(target[0] - pose.x, target[1] - pose.y)
+        if d_lambda <= self.d or self._held >= HOLD_TICKS:
             self.state = Motion.ARRIVED
             return 0.0, 0.0
         vx, vy = self.velocity(pose, target, obj, neighbours)
@@ -230,4 +246,7 @@ class Formation:
         if abs(alpha) > math.pi / 2:  # it points behind: back up instead of turning round
             direction, alpha = -1.0, math.remainder(alpha - math.pi, 2.0 * math.pi)
         self.state = Motion.MOVE
-        return self.limits.clamp(direction * math.hypot(vx, vy) * math.cos(alpha), self._heading(alpha))
+        v, w = self.limits.clamp(direction * math.hypot(vx, vy) * math.cos(alpha), self._heading(alpha))
+        held = d_lambda <= HOLD_DISTANCE * self.d and abs(v) < HOLD_SPEED
+        self._held = self._held + 1 if held else 0
+        return v, w
