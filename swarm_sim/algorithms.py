@@ -99,4 +99,5 @@ register(Algorithm(
         ("landmarks", "landmark_count"), ("cage_size", "cage_size"),
     )),
     figures="swarm_controllers.caging.figures:transport_figure",
+    comparison="swarm_sim.compare.caging_paper:CAGING_COMPARISON",
 ))
