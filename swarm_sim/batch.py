@@ -2,8 +2,10 @@
 
 It plays the roles the graph splits over nodes, in the same order: observations of tick k go
 to every behaviour together with the messages stamped before k, the commands come back, the
-servers (center, depot manager) handle their messages stamped before k, the world steps. Same scenario and seed as a lockstep graph run -> same trajectories and metrics
-(tested in test/test_determinism.py).
+servers (center, depot manager) handle their messages stamped before k, the world steps. Same
+scenario and seed as a lockstep graph run -> same trajectories and metrics (tested in
+test/test_determinism.py). With ``sim.stop_when_finished`` a run ends early once every behaviour
+says it is finished (sweeps); the world task's state is kept every tick as the trace's series.
 """
 
 from __future__ import annotations
@@ -80,6 +82,10 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
             obs = world.step(commands)
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
+            if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):
+                if poses is not None:
+                    poses = poses[:k + 2]
+                break
         perimeter.update(world.t_ns / NS_PER_S, [(o.pose.x, o.pose.y) for o in obs.values()])
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]

@@ -44,6 +44,10 @@ class SimConfig:
     """pybullet steps per tick (each of dt / physics_substeps seconds)."""
     duration: float = 1080.0
     """Run length [s of sim time]."""
+    stop_when_finished: bool = False
+    """Batch runner only: end a run as soon as every behaviour says its task is over (a
+    ``finished`` attribute, e.g. the caging robots once the object is delivered); the run's
+    ``sim_seconds`` then says when. For sweeps: a graph run always lasts ``duration``."""
 
 
 @dataclass(frozen=True)

@@ -345,6 +345,11 @@ class CagingBehaviour:
             out.append(Neighbour(bodies[other], chord, separation, side))
         return out
 
+    @property
+    def finished(self) -> bool:
+        """The transport is over for this robot (`swarm_sim.scenario.SimConfig.stop_when_finished`)."""
+        return self.phase is Phase.DONE
+
     # ------------------------------------------------------------------ status
 
     def status(self, stamp_ns: int | None = None) -> BehaviourStatus:

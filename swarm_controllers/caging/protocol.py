@@ -17,15 +17,22 @@ from swarm_sim.types import RobotId
 
 
 @dataclass(frozen=True, slots=True)
-class Recruitment:
+class _Message:
+    """msg<type, origin, destination, ...>: what every type carries (the type is the class's TYPE)."""
+
+    CHANNEL: ClassVar[str] = ROBOTS
+    stamp_ns: int
+    """The tick it was sent in [ns]."""
+    origin: RobotId
+    destination: RobotId
+
+
+@dataclass(frozen=True, slots=True)
+class Recruitment(_Message):
     """Type 0, recruiter -> every other robot (Alg. 3 line 7): a recruiter r* exists; payload
     C_object and the recruiter's trajectory T_r*."""
 
     TYPE: ClassVar[int] = 0
-    CHANNEL: ClassVar[str] = ROBOTS
-    stamp_ns: int
-    origin: RobotId
-    destination: RobotId
     object_x: float
     """C_object when detected [m, world frame]."""
     object_y: float
@@ -37,51 +44,35 @@ class Recruitment:
 
 
 @dataclass(frozen=True, slots=True)
-class Summon:
+class Summon(_Message):
     """Type 1, recruiter -> the robot mu_r*j (Alg. 5 line 7): take your place in the cage."""
 
     TYPE: ClassVar[int] = 1
-    CHANNEL: ClassVar[str] = ROBOTS
-    stamp_ns: int
-    origin: RobotId
-    destination: RobotId
 
 
 @dataclass(frozen=True, slots=True)
-class Positioned:
+class Positioned(_Message):
     """Type 2, a summoned robot -> every other robot (Alg. 4 line 15): I am at my cage position."""
 
     TYPE: ClassVar[int] = 2
-    CHANNEL: ClassVar[str] = ROBOTS
-    stamp_ns: int
-    origin: RobotId
-    destination: RobotId
 
 
 @dataclass(frozen=True, slots=True)
-class Oriented:
+class Oriented(_Message):
     """Type 3, robot -> every other robot (Alg. 6 line 13): I face landmark `leg`."""
 
     TYPE: ClassVar[int] = 3
-    CHANNEL: ClassVar[str] = ROBOTS
-    stamp_ns: int
-    origin: RobotId
-    destination: RobotId
     leg: int
     """Which landmark of the transport path (0 = the first). The paper's payload is empty; we
     carry the leg so that no message is ever counted for the wrong landmark."""
 
 
 @dataclass(frozen=True, slots=True)
-class Reached:
+class Reached(_Message):
     """Type 4, robot -> every other robot (Alg. 6 line 24): I am at my place p_i+ around
     landmark `leg`."""
 
     TYPE: ClassVar[int] = 4
-    CHANNEL: ClassVar[str] = ROBOTS
-    stamp_ns: int
-    origin: RobotId
-    destination: RobotId
     leg: int
     """As in `Oriented`."""
 

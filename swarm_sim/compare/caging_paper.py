@@ -21,8 +21,9 @@ from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 STRATEGY = "caging"
 DURATION_S = 2400.0
-"""Sim seconds per run: the transport follows the recruiter's whole random walk reversed, so a long
-search means a long transport (our longest runs end after ~1400 s)."""
+"""Sim seconds a run may last: the transport follows the recruiter's whole random walk reversed,
+so a long search means a long transport (our longest runs end after ~1400 s). Runs end as soon as
+every robot is done (``sim.stop_when_finished``)."""
 
 
 @dataclass(frozen=True)
@@ -78,7 +79,8 @@ TABLE2_METRICS: dict[str, str] = {
 def caging_plans(cells: Sequence[int] | None = None, duration: float | None = None,
                  overrides: Sequence[str] = ()) -> list[RunPlan]:
     """One plan per cell (every seed of a cell is a run of the `caging` scenario)."""
-    fields = frozen_fields({"sim__duration": duration if duration is not None else DURATION_S})
+    fields = frozen_fields({"sim__duration": duration if duration is not None else DURATION_S,
+                            "sim__stop_when_finished": True})
     return [RunPlan(STRATEGY, c.number, (*c.overrides, *overrides), fields,
                     (("step", c.step), ("rho", c.robots), ("radius", c.radius), ("mass", c.mass)))
             for c in CELLS if cells is None or c.number in cells]
