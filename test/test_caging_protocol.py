@@ -186,3 +186,12 @@ def test_stage_times_add_up_and_come_from_the_messages(field):
     assert summary[field] > 0
     last = max(m.stamp_ns for m in trace.messages if isinstance(m, Reached)) / NS_PER_S
     assert summary["total_time_s"] == pytest.approx(last)
+
+
+def test_a_sweep_run_stops_once_every_robot_is_done_with_the_same_measures():
+    full, early = summarize(_run(0)), summarize(_run(0, "sim.stop_when_finished=true"))
+    assert early["sim_seconds"] < full["sim_seconds"] == 200
+    # the last type 4 reaches the others a tick later; they are done once that tick is stepped
+    assert early["sim_seconds"] == pytest.approx(early["total_time_s"] + 2 * TICK)
+    for key in ("search_time_s", "recruitment_time_s", "transport_time_s", "trajectory_error_m", "cage_held"):
+        assert early[key] == full[key]

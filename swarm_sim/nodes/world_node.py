@@ -8,8 +8,8 @@ after `dead_after` stale ticks in a row it is no longer waited for until it answ
 then steps the core. Free-running (`realtime`): steps every dt / real_time_factor wall
 seconds with whatever commands have arrived.
 
-Observations are encoded straight to CDR bytes, published raw and written to the bag as the
-same bytes. Topics published by other nodes are discovered and recorded too (like
+Observations (and the world task's state topics, e.g. the caging object's pose) are encoded
+straight to CDR bytes, published raw and written to the bag as the same bytes. Topics published by other nodes are discovered and recorded too (like
 ``ros2 bag record -a``), stamped with the sim time at which they arrive.
 """
 
