@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm_controllers.caging.metrics import _series, caging_report, transport_stage
+from swarm_controllers.caging.metrics import caging_report, series_of, transport_stage
 from swarm_sim.types import robot_index
 from swarm_sim.world.landmarks import landmarks
 
@@ -27,8 +27,8 @@ def transport_figure(trace, directory: Path) -> list[Path]:
     scenario = trace.config
     stage = transport_stage(trace)
     report = caging_report(trace)
-    obj_t, obj_poses = _series(trace, "object")
-    rob_t, rob_poses = _series(trace, "robots")
+    obj_t, obj_poses = series_of(trace, "object")
+    rob_t, rob_poses = series_of(trace, "robots")
     fig = plt.figure(figsize=(16, 7.5))
     grid = fig.add_gridspec(2, 5, width_ratios=[2.2, 2.2, 1, 1, 1])
     ax = fig.add_subplot(grid[:, :2])

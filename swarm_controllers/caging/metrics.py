@@ -24,7 +24,6 @@ tick), so a batch run and the bag of a graph run give the same numbers.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,7 +98,8 @@ class Transport:
     """The cage's robots in cage order."""
 
 
-def _series(trace, name: str) -> tuple[np.ndarray, list]:
+def series_of(trace, name: str) -> tuple[np.ndarray, list]:
+    """(times [s], values) of one of the run's series."""
     points = trace.series.get(name, [])
     return np.array([t for t, _ in points]), [v for _, v in points]
 
@@ -153,7 +153,7 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
     if done:
         result |= {"transport_time_s": t_done - t_caged, "total_time_s": t_done}
 
-    times, poses = _series(trace, "object")
+    times, poses = series_of(trace, "object")
     window = (times >= t_caged - 1e-9) & (times <= t_done + 1e-9)
     if not window.any():
         return CagingReport(**result), None
@@ -171,7 +171,7 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
 
 
 def _cage_held(trace, scenario, cage: list[str], times: np.ndarray, obj: np.ndarray) -> bool:
-    robot_times, robot_poses = _series(trace, "robots")
+    robot_times, robot_poses = series_of(trace, "robots")
     at = {round(t, 6): p for t, p in zip(robot_times, robot_poses)}
     members = [robot_index(r) for r in cage]
     widest = 2.0 * scenario.transport.object.radius + scenario.robots.diameter
