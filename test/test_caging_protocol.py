@@ -24,6 +24,7 @@ from swarm_sim.world.tasks.transport import CagingSense
 
 SMALL = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=200"]
 """Six robots (the paper's smallest swarm) on a 2 x 2 m grid: the whole protocol in ~3 min of sim."""
+EARLY = "sim.stop_when_finished=true"
 D = 0.05
 TICK = 0.1
 
@@ -43,7 +44,7 @@ def _at(series: list, t: float):
 @settings(max_examples=3, derandomize=True, suppress_health_check=[HealthCheck.too_slow], deadline=None)
 @given(st.integers(0, 7))
 def test_every_run_follows_the_protocol(seed):
-    trace = _run(seed)
+    trace = _run(seed, EARLY)
     s = trace.config
     messages = trace.messages
     robots = set(trace.robots)
@@ -124,12 +125,13 @@ class _Dead:
 
 def test_a_recruited_robot_that_never_answers_is_skipped_after_the_timeout(monkeypatch):
     seed = 1
-    recruiter = next(m.origin for m in _run(seed).messages if isinstance(m, Recruitment))
+    recruiter = next(m.origin for m in _run(seed, EARLY).messages if isinstance(m, Recruitment))
     dead = f"robot_{(robot_index(recruiter) + 1) % 6}"  # the first robot mu_r* summons
     real = batch.make_behaviour
     monkeypatch.setattr(batch, "make_behaviour",
                         lambda scenario, robot, rng: _Dead(robot) if robot == dead else real(scenario, robot, rng))
-    scenario = load_scenario("caging", [*SMALL, "sim.duration=300", "controller.caging.call_timeout=45"], seed=seed)
+    scenario = load_scenario("caging", [*SMALL, "sim.duration=300", EARLY, "controller.caging.call_timeout=45"],
+                             seed=seed)
     trace = batch.run_batch(scenario).trace
     summons = [m for m in trace.messages if isinstance(m, Summon)]
     assert summons[0].destination == dead
@@ -179,7 +181,7 @@ def test_messages_from_strangers_or_naming_unknown_landmarks_are_ignored_and_cou
 
 @pytest.mark.parametrize("field", ["search_time_s", "recruitment_time_s", "transport_time_s"])
 def test_stage_times_add_up_and_come_from_the_messages(field):
-    trace = _run(0)
+    trace = _run(0, EARLY)
     summary = summarize(trace)
     total = summary["search_time_s"] + summary["recruitment_time_s"] + summary["transport_time_s"]
     assert summary["total_time_s"] == pytest.approx(total)
@@ -189,7 +191,7 @@ def test_stage_times_add_up_and_come_from_the_messages(field):
 
 
 def test_a_sweep_run_stops_once_every_robot_is_done_with_the_same_measures():
-    full, early = summarize(_run(0)), summarize(_run(0, "sim.stop_when_finished=true"))
+    full, early = summarize(_run(0)), summarize(_run(0, EARLY))
     assert early["sim_seconds"] < full["sim_seconds"] == 200
     # the last type 4 reaches the others a tick later; they are done once that tick is stepped
     assert early["sim_seconds"] == pytest.approx(early["total_time_s"] + 2 * TICK)
