@@ -4,11 +4,11 @@
 |---|---|---|
 | ``/<robot>/proximity`` | diagnostic_msgs/msg/DiagnosticArray | one status ``proximity``, values ``(ir_k, id)`` per sensor k in order; id "" = nothing detected |
 | ``/<robot>/bodies`` | diagnostic_msgs/msg/DiagnosticArray | one status per sensed body: name = its id (``object``, ``robot_3``), values ``x``, ``y`` [m, world frame] |
-| ``/caging/object`` | geometry_msgs/msg/PoseStamped | the object's true pose (frame ``world``, z = 0) |
-| ``/caging/robots`` | geometry_msgs/msg/PoseArray | every robot's true pose in robot order (frame ``world``, z = 0) |
+| ``/caging/object`` | geometry_msgs/msg/PoseStamped | the object's true position (frame ``world``, z = 0, identity orientation) |
+| ``/caging/robots`` | geometry_msgs/msg/PoseArray | every robot's true position in robot order (frame ``world``, z = 0, identity orientations) |
 
-Floats travel as ``repr`` text or float64, so positions round-trip exactly; yaw travels as a
-quaternion and decodes as `swarm_sim.geometry.wire_yaw`.
+Floats travel as ``repr`` text or float64, so positions round-trip exactly (orientations are not
+carried: a quaternion does not give a yaw back bit for bit, and the measures need positions).
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ from swarm_msgs_py.cdr import Reader, Writer, codec
 from swarm_msgs_py.diagnostics import OK, decode_diagnostics, encode_diagnostics
 from swarm_msgs_py.diagnostics import TYPE_NAME as DIAGNOSTICS
 from swarm_msgs_py.sensing import SenseTopic, Sensing, StateTopic
-from swarm_sim.geometry import quaternion_to_yaw, yaw_to_quaternion
 from swarm_sim.world.tasks.transport import CagingSense
 
 PROXIMITY = "proximity"
@@ -31,8 +30,8 @@ POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 POSE_ARRAY = "geometry_msgs/msg/PoseArray"
 WORLD_FRAME = "world"
 
-Pose = tuple[float, float, float]
-"""(x [m], y [m], yaw [rad]) in the world frame."""
+Position = tuple[float, float]
+"""(x, y) [m, world frame]."""
 
 
 @codec(f"{DIAGNOSTICS} (proximity)")
@@ -76,43 +75,43 @@ def decode_bodies(data: bytes) -> tuple[int, tuple[tuple[str, float, float], ...
     return stamp_ns, tuple(out)
 
 
-def _write_pose(w: Writer, pose: Pose) -> None:
-    x, y, yaw = pose
-    w.f64(float(x), float(y), 0.0, *yaw_to_quaternion(float(yaw)))
+def _write_pose(w: Writer, position: Position) -> None:
+    x, y = position
+    w.f64(float(x), float(y), 0.0, 0.0, 0.0, 0.0, 1.0)
 
 
-def _read_pose(r: Reader) -> Pose:
-    x, y, _, _, _, qz, qw = r.unpack("d", 7)
-    return (x, y, quaternion_to_yaw(qz, qw))
+def _read_pose(r: Reader) -> Position:
+    x, y, _, _, _, _, _ = r.unpack("d", 7)
+    return (x, y)
 
 
 @codec(POSE_STAMPED)
-def encode_object(stamp_ns: int, pose: Pose) -> bytes:
+def encode_object(stamp_ns: int, position: Position) -> bytes:
     w = Writer()
     w.header(stamp_ns, WORLD_FRAME)
-    _write_pose(w, pose)
+    _write_pose(w, position)
     return w.message()
 
 
 @codec(POSE_STAMPED)
-def decode_object(data: bytes) -> tuple[int, Pose]:
+def decode_object(data: bytes) -> tuple[int, Position]:
     r = Reader(data)
     stamp_ns, _ = r.header()
     return stamp_ns, _read_pose(r)
 
 
 @codec(POSE_ARRAY)
-def encode_robots(stamp_ns: int, poses: Sequence[Pose]) -> bytes:
+def encode_robots(stamp_ns: int, positions: Sequence[Position]) -> bytes:
     w = Writer()
     w.header(stamp_ns, WORLD_FRAME)
-    w.u32(len(poses))
-    for pose in poses:
-        _write_pose(w, pose)
+    w.u32(len(positions))
+    for position in positions:
+        _write_pose(w, position)
     return w.message()
 
 
 @codec(POSE_ARRAY)
-def decode_robots(data: bytes) -> tuple[int, tuple[Pose, ...]]:
+def decode_robots(data: bytes) -> tuple[int, tuple[Position, ...]]:
     r = Reader(data)
     stamp_ns, _ = r.header()
     return stamp_ns, tuple(_read_pose(r) for _ in range(r.sequence_length(56)))

@@ -59,4 +59,4 @@ def test_caging_graph_run_records_the_protocol_and_equals_batch(tmp_path):
     for key in CAGING_FIELDS:
         assert graph[key] == bagged[key] == batch[key], key
     assert batch["transport_time_s"] is not None and batch["cage_held"] is True
-    assert polyline_length(np.array([v[:2] for _, v in trace.series["object"]])) > 0.5  # it was carried
+    assert polyline_length(np.array([v for _, v in trace.series["object"]])) > 0.5  # it was carried

@@ -74,9 +74,9 @@ def test_every_run_follows_the_protocol(seed):
     positioned = {m.origin: m.stamp_ns for m in messages if isinstance(m, Positioned)}
     for k, m in enumerate(summons):
         t = m.stamp_ns / NS_PER_S
-        x, y, _ = _at(objects, t)
+        x, y = _at(objects, t)
         place = cage_position((x, y), robot_index(recruiter), len(robots), r, w, c)
-        assert math.dist(_at(positions, t)[robot_index(recruiter)][:2], place) <= D + 1e-9
+        assert math.dist(_at(positions, t)[robot_index(recruiter)], place) <= D + 1e-9
         if k:
             previous = summons[k - 1].destination
             assert positioned[previous] < m.stamp_ns  # the previous robot's type 2 came first
@@ -95,13 +95,13 @@ def test_every_run_follows_the_protocol(seed):
         oriented = {m.origin: m.stamp_ns for m in messages if isinstance(m, Oriented) and m.leg == leg}
         reached = {m.origin: m.stamp_ns for m in messages if isinstance(m, Reached) and m.leg == leg}
         assert set(oriented) == set(reached) == cage
-        still = [v[:2] for t, v in objects
+        still = [v for t, v in objects
                  if min(oriented.values()) / NS_PER_S <= t <= max(oriented.values()) / NS_PER_S]
         assert all(math.dist(xy, still[0]) < 1e-4 for xy in still)  # contacts settle by < 1 um
         assert max(positioned.values()) < min(oriented.values())
         for robot, stamp in reached.items():
             place = cage_position(target, robot_index(robot), len(robots), r, w, c)
-            assert math.dist(_at(positions, stamp / NS_PER_S)[robot_index(robot)][:2], place) <= D + 1e-9
+            assert math.dist(_at(positions, stamp / NS_PER_S)[robot_index(robot)], place) <= D + 1e-9
             assert oriented[robot] < stamp
         if leg:  # a robot turns to the next landmark only once everyone reached the previous one
             before = {m.origin: m.stamp_ns for m in messages if isinstance(m, Reached) and m.leg == leg - 1}

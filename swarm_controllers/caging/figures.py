@@ -27,8 +27,8 @@ def transport_figure(trace, directory: Path) -> list[Path]:
     scenario = trace.config
     stage = transport_stage(trace)
     report = caging_report(trace)
-    obj_t, obj_poses = series_of(trace, "object")
-    rob_t, rob_poses = series_of(trace, "robots")
+    obj_t, obj_positions = series_of(trace, "object")
+    rob_t, rob_positions = series_of(trace, "robots")
     fig = plt.figure(figsize=(16, 7.5))
     grid = fig.add_gridspec(2, 5, width_ratios=[2.2, 2.2, 1, 1, 1])
     ax = fig.add_subplot(grid[:, :2])
@@ -36,10 +36,10 @@ def transport_figure(trace, directory: Path) -> list[Path]:
     ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="black", lw=1)
     marks = landmarks(scenario).points
     ax.plot(marks[:, 0], marks[:, 1], ".", color="0.8", ms=2, label=f"landmarks ({len(marks)})")
-    robots = np.array([[p[:2] for p in poses] for poses in rob_poses]) if rob_poses else np.zeros((0, 0, 2))
+    robots = np.array(rob_positions) if rob_positions else np.zeros((0, 0, 2))
     for i in range(robots.shape[1]):
         ax.plot(robots[:, i, 0], robots[:, i, 1], lw=0.4, color="0.6")
-    obj = np.array([p[:2] for p in obj_poses]) if obj_poses else np.zeros((0, 2))
+    obj = np.array(obj_positions) if obj_positions else np.zeros((0, 2))
     if stage is not None:
         ax.plot(stage.planned[:, 0], stage.planned[:, 1], "--o", color="black", lw=1.2, ms=3, label="planned path")
         moving = (obj_t >= stage.start_s) & (obj_t <= stage.end_s)

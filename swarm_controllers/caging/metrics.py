@@ -1,7 +1,7 @@
 """The caging paper's measures of a run (sec. 5, Tables 1 and 2), from its trace alone.
 
 Everything comes from the recorded protocol (`RunTrace.messages`: types 0-4) and the transport
-task's state series (``object``: the object's true pose, ``robots``: the robots' true poses, every
+task's state series (``object``: the object's true position, ``robots``: the robots', every
 tick), so a batch run and the bag of a graph run give the same numbers.
 
 - search time: from the start to the recruiter's type 0 (the first detection);
@@ -153,11 +153,11 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
     if done:
         result |= {"transport_time_s": t_done - t_caged, "total_time_s": t_done}
 
-    times, poses = series_of(trace, "object")
+    times, positions = series_of(trace, "object")
     window = (times >= t_caged - 1e-9) & (times <= t_done + 1e-9)
     if not window.any():
         return CagingReport(**result), None
-    obj = np.array([(x, y) for x, y, _ in poses])[window]
+    obj = np.array(positions)[window]
     planned = np.array([obj[0], *(marks.position(j) for j in reversed(first.trajectory)),
                         (first.start_x, first.start_y)])
     result["max_path_deviation_m"] = float(distance_to_polyline(obj, planned).max())
@@ -171,17 +171,17 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
 
 
 def _cage_held(trace, scenario, cage: list[str], times: np.ndarray, obj: np.ndarray) -> bool:
-    robot_times, robot_poses = series_of(trace, "robots")
-    at = {round(t, 6): p for t, p in zip(robot_times, robot_poses)}
+    robot_times, robot_positions = series_of(trace, "robots")
+    at = {round(t, 6): p for t, p in zip(robot_times, robot_positions)}
     members = [robot_index(r) for r in cage]
     widest = 2.0 * scenario.transport.object.radius + scenario.robots.diameter
     """Adjacent robots' centres this far apart leave a gap the object passes through."""
     open_since: float | None = None
     for t, center in zip(times, obj):
-        poses = at.get(round(t, 6))
-        if poses is None or len(cage) < 3:
+        positions = at.get(round(t, 6))
+        if positions is None or len(cage) < 3:
             return False
-        polygon = np.array([poses[i][:2] for i in members])
+        polygon = np.array([positions[i] for i in members])
         if not inside_polygon(center, polygon):
             return False
         if np.hypot(*(polygon - np.roll(polygon, -1, axis=0)).T).max() >= widest:

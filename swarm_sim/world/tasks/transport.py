@@ -26,7 +26,7 @@ What robots additionally sense (`CagingSense`), from the true state:
   ``sensors.position_range`` [m, world frame], object first, then robots in index order.
 
 Its state, published every tick on ``/caging/object`` and ``/caging/robots`` (`state`): the
-object's true pose and every robot's true pose, which analysis reads back as the ``object`` and
+object's and every robot's true position, which analysis reads back as the ``object`` and
 ``robots`` series (transport error, deviation, whether the cage held).
 """
 
@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pybullet as p
 
-from swarm_sim.geometry import wire_yaw, yaw_to_quaternion
+from swarm_sim.geometry import yaw_to_quaternion
 from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import Pose2D
 from swarm_sim.world.landmarks import landmarks
@@ -187,12 +187,9 @@ class TransportTask:
         return out
 
     def state(self) -> dict[str, object]:
-        """``object``: its true (x, y, yaw); ``robots``: every robot's true (x, y, yaw), in order
-        (yaw rounded as its quaternion on the wire rounds it, so a bag holds exactly this)."""
+        """``object``: its true (x, y); ``robots``: every robot's true (x, y), in robot order."""
         o = self.object_pose
-        pos, yaw = self._world.positions.tolist(), self._world.headings.tolist()
-        return {"object": (o.x, o.y, wire_yaw(o.yaw)),
-                "robots": tuple((x, y, wire_yaw(t)) for (x, y), t in zip(pos, yaw))}
+        return {"object": (o.x, o.y), "robots": tuple(map(tuple, self._world.positions.tolist()))}
 
     def drain_events(self) -> list:
         return []
