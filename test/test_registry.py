@@ -26,7 +26,7 @@ def _plugin_env() -> dict[str, str]:
 
 
 def test_shipped_records_and_their_wiring():
-    assert registry.known() == ("cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue")
+    assert {"cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue", "caging"} <= set(registry.known())
     queue = registry.algorithm("queue")
     inbound, outbound = registry.robot_topics(queue)
     assert set(inbound) == {topics.DEPOT_GRANTS, topics.RADIO, topics.PHEROMONES}
@@ -34,12 +34,15 @@ def test_shipped_records_and_their_wiring():
     server_in, server_out = registry.server_topics(queue.servers[0])
     assert set(server_in) == {topics.DEPOT_REPORTS} and set(server_out) == {topics.DEPOT_GRANTS}
     assert registry.robot_topics(registry.algorithm("ddsa")) == ({}, {})
+    caging_in, caging_out = registry.robot_topics(registry.algorithm("caging"))
+    assert set(caging_in) == set(caging_out) == {f"/caging/type{k}_{name}" for k, name in enumerate(
+        ("recruitment", "summon", "positioned", "oriented", "reached"))}
 
 
 def test_records_are_refused_twice_and_unknown_names_are_named():
     with pytest.raises(ValueError, match="already registered"):
         registry.register(registry.algorithm("cpfa"))
-    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour 'nope' \\(known: cpfa"):
+    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour 'nope' \\(known: .*cpfa"):
         load_scenario("cpfa", ["controller.behaviour=nope"])
     with pytest.raises(ScenarioError, match="unknown key controller.colour"):
         load_scenario("cpfa", ["controller.colour=red"])
