@@ -33,9 +33,9 @@ def test_the_report_puts_our_cells_next_to_the_papers_numbers(tmp_path):
     rows.append(_row(0, 3, transport_time_s=None, total_time_s=None, cage_held=False, planned_path_m=None,
                      object_path_m=None, trajectory_error_m=None, trajectory_error_pct=None))
     text = caging_tables_md(rows)
-    assert "| Search | 0.5 | 101.500 ± 1.291 (n=4) | 222.165 |" in text
-    assert "| Recruitment | 1 | 150.000 ± 0.000 (n=3) | 164.481 |" in text
-    assert "| 6 | 10.000 ± 0.000 (n=3) |" in text and "| 4.3284 | 0.1778 | 4.1 | 215.07 |" in text
+    assert "| Search | 0.5 | 101.50 ± 1.29 (median 101.50, n=4) | 222.165 |" in text
+    assert "| Recruitment | 1 | 150.00 ± 0.00 (median 150.00, n=3) | 164.481 |" in text
+    assert "| 6 | 10.00 ± 0.00 (median 10.00, n=3) |" in text and "| 4.3284 | 0.1778 | 4.1 | 215.07 |" in text
     assert "3/4 transported, cage held in 3" in text  # the run that never delivered counts
     assert "(paper: about 3.8 %)" in text
     written = write_caging_report(rows, tmp_path)

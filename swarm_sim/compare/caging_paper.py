@@ -87,7 +87,7 @@ def caging_plans(cells: Sequence[int] | None = None, duration: float | None = No
 
 
 def _cell(rows: Sequence[dict], number: int, metric: str) -> str:
-    return cell_text(describe(values_of(rows, STRATEGY, number, metric)), digits=3)
+    return cell_text(describe(values_of(rows, STRATEGY, number, metric)), digits=2, median=True)
 
 
 def _done(rows: Sequence[dict], number: int) -> str:
@@ -100,9 +100,11 @@ def _done(rows: Sequence[dict], number: int) -> str:
 def caging_tables_md(rows: Sequence[dict]) -> str:
     lines = ["# Caging paper comparison (Cardoso, Nedjah & Mourelle, sec. 5)", "",
              "Our runs: the `caging` scenario with the cell's settings, seeds 0..n-1, batch runner. "
-             "Cells: mean ± sample std (n). The paper's numbers are single averages (its run count is not "
+             "Cells: mean ± sample std (median, n); search times, and with them path lengths and "
+             "transport times, are heavy-tailed. The paper's numbers are single averages (its run count is not "
              "stated). Times are sim seconds. Runs whose transport did not finish within the run have no "
-             "transport time, path or error.", ""]
+             "transport time, path or error.", "",
+             "Cells (the box plots' x axis): " + "; ".join(f"{c.number} = {c.name}" for c in CELLS) + ".", ""]
     lines += ["## Table 1: search and recruitment (8 robots, r = 0.3 m, M = 0.3 kg)", ""]
     body = []
     for metric, stage in (("search_time_s", "Search"), ("recruitment_time_s", "Recruitment")):
@@ -138,16 +140,15 @@ def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
     tables.write_text(caging_tables_md(rows))
     cells = [c.number for c in CELLS]
     labels = {STRATEGY: "ours"}
-    legend = "; ".join(f"{c.number}: {c.name}" for c in CELLS)
     written = [tables]
     written.append(boxplot_figure(
         [("search_time_s", "search time [s]"), ("recruitment_time_s", "recruitment time [s]"),
          ("transport_time_s", "transport time [s]")], rows, cells, [STRATEGY], labels,
-        "cell", f"Stage times by cell ({legend})", out / "times.png"))
+        "cell (see tables.md)", "Stage times by cell", out / "times.png"))
     written.append(boxplot_figure(
         [("trajectory_error_pct", "trajectory error [% of the planned path]"),
          ("max_path_deviation_m", "largest deviation from the planned path [m]")], rows, cells, [STRATEGY], labels,
-        "cell", "Transport accuracy by cell", out / "error.png"))
+        "cell (see tables.md)", "Transport accuracy by cell", out / "error.png"))
     return written
 
 
