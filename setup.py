@@ -14,7 +14,7 @@ setup(
     python_requires=">=3.10",
     packages=find_packages(include=["swarm_sim*", "swarm_controllers*", "swarm_msgs_py*",
                                     "depot_manager*", "launch_py*"]),
-    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml"]},
+    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml", "*.json"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
@@ -30,6 +30,10 @@ setup(
         "rosbags",
         "matplotlib",
         "scipy",
+        "foxglove-sdk",  # swarm-run --foxglove: the official Foxglove WebSocket server
+        "imageio",  # swarm-analyze --video
+        "imageio-ffmpeg",  # its ffmpeg (a binary inside the wheel) for .mp4
+        "tqdm",  # sweep progress bars
     ],
     extras_require={
         "ros": [
@@ -37,7 +41,8 @@ setup(
             "ros-jazzy-common-interfaces",
             "ros-jazzy-rmw-fastrtps-cpp",
         ],
-        "test": ["pytest", "hypothesis"],
+        "dask": ["distributed"],  # sweeps on a Dask cluster (--scheduler, --dask-local)
+        "test": ["pytest", "hypothesis", "websockets", "distributed"],
     },
     entry_points={
         "console_scripts": [

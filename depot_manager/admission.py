@@ -303,6 +303,18 @@ class DepotAdmission:
             raise ValueError(f"{robot}: unloaded while not at its dock (at {r.labels[r.pos]})")
         r.unloaded = True
 
+    def remove(self, robot: str) -> bool:
+        """Take `robot` out of the depot wherever it is (it was declared dead): every cell it
+        owns, its dock and its inner queue are free again. False if it was not inside."""
+        r = self._robots.pop(robot, None)
+        if r is None:
+            return False
+        for c, owner in enumerate(self._owner):
+            if owner == robot:
+                self._owner[c] = None
+        self._reported.pop(robot, None)
+        return True
+
     # ------------------------------------------------------------------ grants
 
     def step(self, t: float) -> dict[str, tuple[str, int]]:

@@ -18,11 +18,16 @@ this module never imports rclpy.
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 
 PROFILE_PATH = Path(__file__).with_name("fastdds_loopback.xml")
 PROFILE_MAX_PROCESSES = 256
+MAX_DOMAIN_ID = 230
+"""The highest ROS_DOMAIN_ID whose ports the profile can compute: participant 255 of domain d
+uses UDP port 7400 + 250 d + 11 + 2 * 255, which passes 65535 from d = 231 on (Fast DDS then
+fails every participant with "Calculated port number is too high")."""
 """Participants per domain the profile can discover (its maxInitialPeersRange)."""
 DOMAIN_RANGE = (100, 200)
 """Inclusive range of private ROS_DOMAIN_IDs (the project's convention, clear of 0).
@@ -42,19 +47,21 @@ _DROPPED = (
     "RMW_FASTRTPS_USE_QOS_FROM_XML",
     "FASTDDS_ENVIRONMENT_FILE",
     "SKIP_DEFAULT_XML_FILE",
+    "RMW_FASTRTPS_PUBLICATION_MODE",
 )
 
 
 def loopback_env(
-    domain_id: int, processes: int, base: Mapping[str, str] | None = None
+    domain_id: int, processes: int, base: Mapping[str, str] | None = None, *, server_port: int | None = None,
 ) -> dict[str, str]:
     """Environment for a child process of a graph of ``processes`` DDS processes.
 
     ``base`` defaults to ``os.environ``; discovery-related variables in it are
-    replaced, everything else is kept.
+    replaced, everything else is kept. With `server_port`, the process is a client of the
+    graph's discovery server on 127.0.0.1 (`discovery_server_env` makes the server).
     """
-    if not 0 <= domain_id <= 232:
-        raise ValueError(f"ROS_DOMAIN_ID {domain_id} outside 0..232")
+    if not 0 <= domain_id <= MAX_DOMAIN_ID:
+        raise ValueError(f"ROS_DOMAIN_ID {domain_id} outside 0..{MAX_DOMAIN_ID}")
     if processes > PROFILE_MAX_PROCESSES:
         raise ValueError(f"{processes} processes exceed the profile's {PROFILE_MAX_PROCESSES}")
     env = {k: v for k, v in (os.environ if base is None else base).items() if k not in _DROPPED}
@@ -65,7 +72,53 @@ def loopback_env(
     env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SYSTEM_DEFAULT"
     env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 2.x name
     env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(PROFILE_PATH)  # the Fast DDS 3.x name
+    # Lockstep delivery relies on it: publish() puts the bytes on the socket before it returns,
+    # so a robot's message stamped k reaches its peers before its cmd_vel k lets the world send
+    # tick k+1 (asynchronous publication would let a sender thread reorder them under load).
+    env["RMW_FASTRTPS_PUBLICATION_MODE"] = "SYNCHRONOUS"
+    if server_port is not None:
+        # Fast DDS turns the profile's SIMPLE discovery into a client of server id 0 there.
+        env["ROS_DISCOVERY_SERVER"] = f"127.0.0.1:{server_port}"
     return env
+
+
+# --------------------------------------------------------------------------- discovery server
+
+SERVER_PREFIX = "44.53.00.5f.45.50.52.4f.53.49.4d.41"
+"""GUID prefix of discovery server id 0: the one ``ROS_DISCOVERY_SERVER=127.0.0.1:PORT`` names."""
+
+
+def discovery_port(domain_id: int) -> int:
+    """The graph's discovery server port: 7000 + domain, below every domain's own ports
+    (7400 + 250 d ...), so concurrent runs on other domains never share it."""
+    return 7000 + domain_id
+
+
+def server_profile(port: int) -> str:
+    """The loopback profile with discovery-server role: prefix of server id 0, metatraffic on
+    127.0.0.1:`port` (everything else, transports and interface allow-list, unchanged)."""
+    ns = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
+    ET.register_namespace("", ns)
+    root = ET.parse(PROFILE_PATH).getroot()
+    q = lambda tag: f"{{{ns}}}{tag}"
+    rtps = root.find(f".//{q('participant')}/{q('rtps')}")
+    assert rtps is not None
+    prefix = ET.Element(q("prefix"))
+    prefix.text = SERVER_PREFIX
+    rtps.insert(0, prefix)
+    builtin = rtps.find(q("builtin"))
+    builtin.find(f"{q('discovery_config')}/{q('discoveryProtocol')}").text = "SERVER"
+    udp = builtin.find(f"{q('metatrafficUnicastLocatorList')}/{q('locator')}/{q('udpv4')}")
+    ET.SubElement(udp, q("port")).text = str(port)
+    builtin.remove(builtin.find(q("initialPeersList")))
+    return ET.tostring(root, encoding="unicode")
+
+
+def discovery_server_env(env: Mapping[str, str], profile_path: Path) -> dict[str, str]:
+    """`env` (a client's) made the discovery server's: its own profile, no server to call."""
+    out = {k: v for k, v in env.items() if k != "ROS_DISCOVERY_SERVER"}
+    out["FASTRTPS_DEFAULT_PROFILES_FILE"] = out["FASTDDS_DEFAULT_PROFILES_FILE"] = str(profile_path)
+    return out
 
 
 def private_domain_id(seed: int | None = None) -> int:

@@ -4,8 +4,16 @@ depot manager for the queue strategies).
 
 Controllers run all in one process by default; ``--controller-processes K`` spreads them over
 K processes and ``0`` gives every robot its own process, as on real hardware. DDS stays on
-loopback and on a private domain id (`launch_py.dds`). Ctrl-C stops every process and still
+loopback and on a private domain id (`launch_py.dds`). Discovery goes through the world node, a
+Fast DDS discovery server on 127.0.0.1:7000+domain (peer-to-peer SIMPLE discovery took 120 s to
+connect 112 robot processes on 2 cores, the server about a third of that: each process learns
+only of the endpoints of its own topics); ``--discovery simple`` is the peer-to-peer way. Ctrl-C stops every process and still
 leaves a valid bag. Needs no ros2cli or launch: plain subprocesses with the right environment.
+
+The launcher owns its children: Ctrl-C, SIGTERM and SIGHUP stop them all (the world first, so
+it closes the bag), and each child gets SIGTERM from the kernel if the launcher dies in any
+other way (``PR_SET_PDEATHSIG``), so no node outlives it. It names every node that died, and
+its exit code says how the run went (`EXIT_CODES`).
 """
 
 from __future__ import annotations
@@ -13,17 +21,46 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from datetime import datetime
 from pathlib import Path
 
-from launch_py.dds import loopback_env, private_domain_id
+from launch_py.dds import (
+    MAX_DOMAIN_ID,
+    PROFILE_PATH,
+    discovery_port,
+    discovery_server_env,
+    loopback_env,
+    private_domain_id,
+    server_profile,
+)
+from launch_py.lifetime import die_with_parent
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
+
+EXIT_CODES = {
+    0: "the run is complete and every node lived to its end",
+    1: "the bag could not be read",
+    2: "bad flags or scenario (nothing was started)",
+    3: "a server (depot manager, center) died: the run ended early",
+    4: "the run is complete, but robots were declared dead on the way (named in the output)",
+    5: "the world node died: the bag was repaired and analysed up to its last flushed data",
+    130: "interrupted (Ctrl-C, SIGTERM or SIGHUP): the bag holds the run up to then",
+}
+"""swarm-run's exit codes."""
+
+
+
+STARTUP_REPORT_PERIOD = 5.0
+"""Wall seconds between start-up lines while the world node is not up yet."""
 
 
 def split_robots(robots: list[str], processes: int) -> list[list[str]]:
@@ -78,7 +115,15 @@ def main(argv: list[str] | None = None) -> int:
                         help="realtime mode's target")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
-    parser.add_argument("--domain-id", type=number(int, 0, 232), help="ROS_DOMAIN_ID 0-232 (default: a private one)")
+    parser.add_argument("--domain-id", type=number(int, 0, MAX_DOMAIN_ID),
+                        help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID} (default: a private one)")
+    parser.add_argument("--discovery", choices=("server", "simple"), default="server",
+                        help="DDS discovery: the world node as discovery server for every other node (default; "
+                             "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), nargs="?", const=DEFAULT_PORT, metavar="PORT",
+                        help=f"serve the run live to Foxglove over WebSocket (default port {DEFAULT_PORT}; 0: any free)")
+    parser.add_argument("--foxglove-host", default=LOOPBACK,
+                        help=f"address the live view binds (default {LOOPBACK}: this machine only)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
@@ -101,7 +146,15 @@ def main(argv: list[str] | None = None) -> int:
     groups = split_robots(scenario.robot_names, args.controller_processes)
     domain = args.domain_id if args.domain_id is not None else private_domain_id()
     servers = registry.of(scenario).servers
-    env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ)
+    port = discovery_port(domain) if args.discovery == "server" else None
+    env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ, server_port=port)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
+        env.setdefault(var, "1")  # which would also not survive the controllers' fork
+    world_env = env
+    if port is not None:
+        profile = Path(tempfile.mkdtemp(prefix="swarmforage-")) / "discovery_server.xml"
+        profile.write_text(server_profile(port), encoding="utf-8")
+        world_env = discovery_server_env(env, profile)
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -109,43 +162,75 @@ def main(argv: list[str] | None = None) -> int:
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
+    if port is not None:
+        print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
+              f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
+              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list", flush=True)
     python = [sys.executable, "-m"]
-    controllers = [
-        subprocess.Popen([*python, "swarm_controllers.controller_node", "--robots", *group, *common],
-                         env=env, start_new_session=True)
-        for group in groups
-    ]
-    controllers += [
-        subprocess.Popen([*python, spec.node, *common], env=env, start_new_session=True)
-        for spec in servers
-    ]
+    me = os.getpid()
+
+    def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
+        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: die_with_parent(me))
+        return label, proc
+
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
                  "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
-    world = subprocess.Popen(world_cmd, env=env, start_new_session=True)
+    if args.foxglove is not None:
+        world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
+    if args.controller_processes == 0:  # one process per robot, forked after the imports
+        controllers = [("controller processes (one per robot)",
+                        [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names])]
+    else:
+        controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
+                        [*python, "swarm_controllers.controller_node", "--robots", *g]) for g in groups]
+    children: list[tuple[str, subprocess.Popen]] = []
+    world: subprocess.Popen | None = None
     interrupted = False
+    reported: set[int] = set()
+    launched = said = time.monotonic()
     try:
+        _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
+        children += [start(label, [*cmd, *common]) for label, cmd in controllers]
+        children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
+        print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
+              "reports while they start and discover each other", flush=True)
         while world.poll() is None:
-            if any(c.poll() not in (None, 0) for c in controllers) and not interrupted:
-                print("[swarm-run] a controller or server process exited early; the world counts it stale",
-                      flush=True)
-                interrupted = True
+            now = time.monotonic()
+            if now - said >= STARTUP_REPORT_PERIOD and not (bag / METADATA_FILE).exists():
+                said = now  # the world node opens the bag once it is up; it reports from there on
+                running = sum(p.poll() is None for _, p in children)
+                print(f"[swarm-run] {now - launched:5.1f} s: waiting for the world node to come up "
+                      f"({running + 1} processes starting: Python, ROS and pybullet imports)", flush=True)
+            for label, p in children:
+                if p.poll() is not None and p.pid not in reported:
+                    reported.add(p.pid)
+                    print(f"[swarm-run] the {label} (pid {p.pid}) {_how(p.returncode)} while the run went on; "
+                          "the world declares what it ran dead", file=sys.stderr, flush=True)
             time.sleep(0.2)
     except KeyboardInterrupt:
-        print("[swarm-run] Ctrl-C: stopping the world (it closes the bag) and the controllers", flush=True)
-        _stop([world], grace=60.0)
+        interrupted = True
+        print("[swarm-run] stopping: the world first (it closes the bag), then the other nodes", flush=True)
+        _stop([world] if world else [], grace=60.0)
     finally:
-        _stop(controllers, grace=10.0)
-        _stop([world], grace=60.0)
+        _stop([p for _, p in children], grace=10.0)
+        _stop([world] if world else [], grace=60.0)
+        if port is not None:
+            shutil.rmtree(profile.parent, ignore_errors=True)
 
-    if world.returncode != 0:
-        cause = f"killed by signal {-world.returncode}" if world.returncode < 0 else f"exited with {world.returncode}"
-        print(f"[swarm-run] the world node {cause}: the run stopped early and the bag's last file may be "
-              f"cut off (swarm-analyze reads what was written)", file=sys.stderr, flush=True)
+    if world is None:  # interrupted before anything ran
+        return 130
+    world_died = world.returncode != 0 and not interrupted
+    if world_died:
+        print(f"[swarm-run] the world node (pid {world.pid}) {_how(world.returncode)}: the run stopped early; "
+              f"repairing the bag's cut-off last file", file=sys.stderr, flush=True)
 
     from swarm_sim.analysis.metrics import summarize
     from swarm_sim.analysis.replay import load_run
+    from swarm_sim.recording import repair_bag
 
     try:
+        if world_died:
+            repair_bag(bag)
         summary = summarize(load_run(bag))
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
@@ -161,11 +246,36 @@ def main(argv: list[str] | None = None) -> int:
             f"[swarm-run] bag: {bag}  (swarm-analyze {bag})",
             flush=True,
         )
-    if summary["server_stale_ticks"]:
-        print(f"[swarm-run] a server missed {summary['server_stale_ticks']} lockstep ticks (did it die?): "
-              "its answers are missing from those ticks on", file=sys.stderr, flush=True)
-        return world.returncode or 3
-    return 0 if world.returncode == 0 else world.returncode
+    return _verdict(summary, world_died=world_died, interrupted=interrupted)
+
+
+def _how(returncode: int) -> str:
+    return f"was killed by signal {-returncode}" if returncode < 0 else f"exited with code {returncode}"
+
+
+def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
+    """Say what went wrong, if anything; the exit code (`EXIT_CODES`)."""
+    say = lambda text: print(f"[swarm-run] {text}", file=sys.stderr, flush=True)
+    rejected = summary.get("rejected_messages") or {}
+    if rejected:
+        total = sum(n for by_reason in rejected.values() for n in by_reason.values())
+        kinds = "; ".join(f"{w}: {', '.join(f'{n} {r}' for r, n in rs.items())}" for w, rs in list(rejected.items())[:6])
+        say(f"{total} messages from the bus were rejected ({kinds})")
+    dead = summary.get("dead_nodes") or []
+    if dead:
+        say(f"declared dead during the run: {', '.join(dead)}")
+    if summary["server_stale_ticks"] or summary["stale_ticks"]:
+        say(f"lockstep ticks answered late: {summary['stale_ticks']} by controllers, {summary['server_stale_ticks']} "
+            "by servers (a slow machine; the run may differ from the batch run of the same seed)")
+    ended = summary.get("run_ended", "complete")
+    if world_died:
+        return 5
+    if interrupted or ended == "interrupted":
+        return 130
+    if ended.startswith("server"):
+        say(f"the run ended early: {ended}")
+        return 3
+    return 4 if dead else 0
 
 
 if __name__ == "__main__":

@@ -58,6 +58,7 @@ import numpy as np
 
 from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
 from swarm_controllers.config import SpiralConfig
+from swarm_sim.inbound import Reason, Rejections
 from swarm_controllers.spiral import (
     SpiralPath,
     mdbsa_leg_steps,
@@ -146,6 +147,7 @@ class RegionAssigner:
         self._current: dict[RobotId, Assignment] = {}
         self._pending: set[RobotId] = set()  # initial assignments not yet handed out
         self._last_walk: dict[tuple[RobotId, int], int] = {}  # (robot, region) -> direction
+        self._gone: set[RobotId] = set()  # removed robots
         n_regions = len(paths)
         for k, robot in enumerate(self._robots):
             if k < n_regions:
@@ -248,8 +250,16 @@ class RegionAssigner:
 
     # ---------------------------------------------------------------- internals
 
+    def remove(self, robot: RobotId) -> None:
+        """`robot` is gone (declared dead): its walk ends where it last reported, so its region
+        can be given to another robot (its coverage is kept); it gets nothing more."""
+        self._check_robot(robot)
+        self._pending.discard(robot)
+        self._release(robot)
+        self._gone.add(robot)
+
     def _check_robot(self, robot: RobotId) -> None:
-        if robot not in self._robots:
+        if robot not in self._robots or robot in self._gone:
             raise ValueError(f"unknown robot {robot!r}")
 
     def _release(self, robot: RobotId) -> None:
@@ -394,8 +404,9 @@ class CenterServer:
 
     The center is a hub robots talk to only near it (paper Sec. IV): a `ProgressReport` counts
     only if its sender was within ``controller.spiral.center_range`` of the depot centre when
-    sending; others (and reports from unknown robots or about unknown regions) are dropped and
-    counted in `ignored`. For each report that counts, in the order received:
+    sending; others (and reports from unknown or dead robots, or about unknown regions) are
+    dropped and counted in `rejections`. A robot the world declared dead (`robot_lost`) loses
+    its walk, so its region can go to another robot. For each report that counts, in the order received:
 
     * the progress of its region is recorded (region >= 0) with `RegionAssigner.report_progress`;
     * if ``done`` or the robot holds no walk, it gets a new one (`RegionAssigner.request`) in a
@@ -417,8 +428,9 @@ class CenterServer:
         self._center = (float(cx), float(cy))
         self._range = float(SpiralConfig.of(scenario).center_range)
         self._told_stop: dict[RobotId, float] = {}
-        self.ignored = 0
-        """Reports dropped: sent out of range, from an unknown robot or about an unknown region."""
+        self.rejections = Rejections()
+        """Reports dropped: sent out of range, from an unknown or dead robot, about an unknown region."""
+        self.lost: set[RobotId] = set()
 
     def snapshot(self) -> list[RegionState]:
         """Per-region state (walkers, covered arc lengths, remaining) for publishing."""
@@ -432,15 +444,30 @@ class CenterServer:
         """No time series for the run trace (the center's state is recorded on /center/state)."""
         return {}
 
+    def robot_lost(self, robot: RobotId, stamp_ns: int) -> None:
+        """`robot` was declared dead: free its region's walker slot, refuse its later reports."""
+        if robot in self.assigner.robots and robot not in self.lost:
+            self.lost.add(robot)
+            self.assigner.remove(robot)
+            self._told_stop.pop(robot, None)
+
+    @property
+    def ignored(self) -> int:
+        """Reports dropped so far."""
+        return self.rejections.total
+
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[RegionAssignment, ...]:
         t = stamp_ns / NS_PER_S
         out: dict[RobotId, RegionAssignment] = {}
         for m in messages:
             if not isinstance(m, ProgressReport):
                 continue
-            if (m.robot not in self.assigner.robots or m.region >= self.assigner.n_regions
-                    or not self.in_range(m.x, m.y)):
-                self.ignored += 1
+            reason = (Reason.UNKNOWN_ROBOT if m.robot not in self.assigner.robots
+                      else Reason.DEAD if m.robot in self.lost
+                      else Reason.REFUSED if m.region >= self.assigner.n_regions or not self.in_range(m.x, m.y)
+                      else None)
+            if reason is not None:
+                self.rejections.add("ProgressReport", reason, f"t={t:.3f} {m.robot[:40]} region {m.region}")
                 continue
             stop = None
             if m.region >= 0:

@@ -7,13 +7,31 @@ from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviou
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
 
-``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process.
+Messages from other nodes are untrusted: they are checked before the behaviour sees them
+(`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
+and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
+
+The node serves the standard parameter services (``ros2 param list/get``), created with it; with
+the discovery server each process only learns of the endpoints on its own topics, so their twelve
+DDS endpoints per robot cost the start-up little.
+
+``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process;
+with ``--fork`` it gives every robot its own process instead, forked from this one once the
+imports and the scenario are loaded (one process per robot, as on real hardware, without paying
+a Python start-up per robot: 112 robots reach their first tick in seconds, not minutes). Each
+forked process is named after its robot (``ps -o comm``) and dies with its parent; the parent
+passes Ctrl-C and SIGTERM on, and says which robot's process died and how.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import gc
+import os
+import signal
 import sys
+import time
 from collections import defaultdict
 from dataclasses import dataclass
 
@@ -22,15 +40,16 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from launch_py.lifetime import die_with_parent, set_process_name
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
-from swarm_msgs_py.records import post_all
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim import registry
+from swarm_sim.inbound import Inbound, Rejections, merged
 from swarm_sim.messaging import Mailbox
-from swarm_sim.scenario import DEFAULT_SCENARIO, load_scenario
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 from swarm_sim.types import Observation, robot_index
 
 
@@ -40,22 +59,36 @@ class ControllerConfig:
     """Scenario name or YAML path (the same one the world loads)."""
     overrides: tuple[str, ...] = ()
     seed: int = 0
+    startup_timeout: float = 60.0
+    """Wall seconds to wait for every peer and server to be matched before answering anyway."""
 
 
 class ControllerNode(Node):
-    def __init__(self, robot: str, config: ControllerConfig | None = None, **kwargs) -> None:
+    """One robot's controller. It creates its ``cmd_vel`` publisher, which is what the world
+    waits for before the first tick, only once every topic it exchanges with the other robots
+    and the servers is matched (`connect`): a message sent before its receivers are matched
+    would be lost, and the run would no longer be the batch run of the same seed."""
+
+    def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
+                 **kwargs) -> None:
+        """`scenario`: the one `config` names, already loaded (saves each forked process the
+        parse)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
-            "controller", namespace=robot, start_parameter_services=False, enable_rosout=False,
+            "controller", namespace=robot, enable_rosout=False,
             parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.robot = robot
         self.config = cfg = declare_config(self, ControllerConfig, config)
-        self.scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
+        self.scenario = scenario or load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
         self.mailbox = Mailbox()
+        self.rejections = Rejections()
+        self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
+                               self.get_logger().warning)
+        self._published_rejections: dict = {}
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
@@ -69,14 +102,18 @@ class ControllerNode(Node):
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
         inbound, outbound = registry.robot_topics(algorithm)
-        for topic, family in inbound.items():
-            self.create_subscription(
+        self._inbound_subs = {
+            topic: self.create_subscription(
                 topics.import_type(family.type_name), topic,
-                lambda data, f=family: post_all(f, data, self.mailbox.post, self.get_logger().warning),
+                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
                 EVENTS, raw=True,
             )
+            for topic, family in inbound.items()
+        }
         self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, EVENTS))
                           for t, f in outbound.items()}
+        self._peer_topics = set(inbound) & set(outbound)
+        """Topics every robot both sends and hears: matched once all robots are."""
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         """Message class -> the topic this robot sends it on."""
         for name, (type_name, decode) in decoders.items():
@@ -84,10 +121,31 @@ class ControllerNode(Node):
                 topics.import_type(type_name), name,
                 lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
             )
-        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        self._cmd_pub = None
+        self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
+        self._diagnostics_pub = self.create_publisher(
+            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
+
+    def connect(self) -> bool:
+        """Create the ``cmd_vel`` publisher once every exchange topic is matched (or the start-up
+        timeout passed); True once it exists."""
+        if self._cmd_pub is not None:
+            return True
+        robots = self.scenario.robots.count
+        need = {t: robots if t in self._peer_topics else 1 for t in (*self._inbound_subs, *self._outbound)}
+        missing = [t for t, sub in self._inbound_subs.items() if sub.get_publisher_count() < need[t]]
+        missing += [t for t, (_, pub) in self._outbound.items() if pub.get_subscription_count() < need[t]]
+        if missing and time.monotonic() < self._connect_by:
+            return False
+        if missing:
+            self.get_logger().warning(f"answering without all peers matched on {', '.join(sorted(missing))}")
+        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        return True
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
+        if self._cmd_pub is None:  # not connected yet: the world cannot have started
+            return
         stamp = decoded[0]
         if stamp == self._answered_stamp:  # the world re-sent a tick: our answer was late or lost
             self._cmd_pub.publish(self._answer)
@@ -97,6 +155,7 @@ class ControllerNode(Node):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
+        self.inbound.now_ns = self.inbound.released_ns = stamp_ns
         _, pose, v, w = self._latest[topics.ODOM]
         sensed = self.sensing.sense(**{t.field: self._latest[t.name][1] for t in self.sensing.topics})
         obs = Observation(
@@ -119,40 +178,142 @@ class ControllerNode(Node):
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
+        counts = merged(self.rejections, getattr(self.behaviour, "rejections", None))
+        if counts != self._published_rejections:
+            self._published_rejections = counts
+            self._diagnostics_pub.publish(
+                diagnostics.encode_rejections(stamp_ns, self.get_fully_qualified_name(), counts))
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
 
 
-def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str]]:
+def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool]:
     parser = argparse.ArgumentParser(prog="swarm-controllers", description=__doc__.splitlines()[0])
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
     parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--fork", action="store_true", help="one process per robot, forked from this one")
     args, ros_args = parser.parse_known_args(argv)
-    return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args
+    return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args, args.fork
 
 
-def main(argv: list[str] | None = None) -> int:
-    robots, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
+          scenario: Scenario | None = None) -> int:
+    """The robots' controller nodes in this process, spun until shut down; `teardown=False`
+    leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
     nodes: list[ControllerNode] = []
     try:
         executor = make_executor()
         for robot in robots:
-            nodes.append(ControllerNode(robot, config))
+            nodes.append(ControllerNode(robot, config, scenario=scenario))
             executor.add_node(nodes[-1])
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
+        connecting = list(nodes)
         while rclpy.ok():
-            executor.spin_once(timeout_sec=0.5)
+            executor.spin_once(timeout_sec=0.1 if connecting else 0.5)
+            connecting = [n for n in connecting if not n.connect()]
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        for node in nodes:
-            node.destroy_node()
-        rclpy.try_shutdown()
+        if teardown:
+            for node in nodes:
+                node.destroy_node()
+            rclpy.try_shutdown()
     return 0
+
+
+def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
+    """Do, once before forking, what every robot process would otherwise do first (measured: a
+    forked process's first node took 0.2-0.6 s of CPU, 112 of them on 2 cores most of a
+    minute): import the behaviour, sense and message-family modules and every message type,
+    and the interface packages rclpy's Node pulls in lazily. No DDS entity is made here: Fast
+    DDS leaves threads behind, and a forked copy of a threaded process can deadlock."""
+    from rcl_interfaces import srv as parameter_services
+    from rcl_interfaces.msg import ParameterEvent
+    from rclpy.type_support import check_for_type_support
+    from rosgraph_msgs.msg import Clock
+    from type_description_interfaces.srv import GetTypeDescription
+
+    registry.make_behaviour(scenario, robot, behaviour_rng(config.seed, robot))
+    algorithm = registry.of(scenario)
+    sensing = registry.resolve(registry.task(algorithm.task).sensing)
+    inbound, outbound = registry.robot_topics(algorithm)
+    names = [*topics.ROBOT_TOPIC_TYPES.values(), topics.type_string(topics.DIAGNOSTICS),
+             *(t.type_name for t in sensing.topics), *(f.type_name for f in (*inbound.values(), *outbound.values()))]
+    services = [getattr(parameter_services, n) for n in ("DescribeParameters", "GetParameterTypes", "GetParameters",
+                                                         "ListParameters", "SetParameters", "SetParametersAtomically")]
+    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, Clock, GetTypeDescription, *services):
+        check_for_type_support(cls)  # loads the type support C modules (and rosidl's parser) now
+
+
+STOP_GRACE = 5.0
+"""Wall seconds the forked robot processes get to leave after Ctrl-C/SIGTERM before SIGKILL."""
+
+
+def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str]) -> int:
+    """One process per robot, forked from this one (see the module docstring).
+
+    A robot process leaves without tearing its DDS participant down (`os._exit` once its loop
+    ends): when a hundred participants leave at once, Fast DDS 2.14 can hang in participant
+    deletion, and an exiting process needs no goodbye (its peers see it gone by its lease). It
+    gets SIGKILL if this process dies, and this process SIGKILLs any that has not left
+    `STOP_GRACE` seconds after a stop."""
+    scenario = load_scenario(config.scenario, config.overrides, seed=config.seed)  # refuse a bad file once, here
+    _warm_up(scenario, robots[0], config)
+    gc.freeze()  # what the children inherit stays shared (no copy-on-write from the collector)
+    parent = os.getpid()
+    children: dict[int, str] = {}
+    for robot in robots:
+        pid = os.fork()
+        if pid == 0:
+            die_with_parent(parent, signal.SIGKILL)
+            set_process_name(robot)
+            code = 1
+            try:
+                code = serve([robot], config, ros_args, teardown=False, scenario=scenario)
+            finally:
+                sys.stdout.flush()
+                sys.stderr.flush()
+                os._exit(code)
+        children[pid] = robot
+    stopping = 0.0  # when the stop began (monotonic)
+
+    def signal_all(sig: int) -> None:
+        for pid in children:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, sig)
+
+    def stop(signum: int, _frame: object) -> None:
+        nonlocal stopping
+        stopping = stopping or time.monotonic()
+        signal_all(signal.SIGINT)
+
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, stop)
+    while children:
+        try:
+            pid, status = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            break
+        if pid == 0:
+            if stopping and time.monotonic() > stopping + STOP_GRACE:
+                signal_all(signal.SIGKILL)
+            time.sleep(0.05)
+            continue
+        robot = children.pop(pid, "?")
+        code = os.waitstatus_to_exitcode(status)
+        if not stopping or code not in (0, -signal.SIGINT, -signal.SIGKILL):
+            how = f"was killed by signal {-code}" if code < 0 else f"exited with code {code}"
+            print(f"[controllers] the process of {robot} (pid {pid}) {how}", file=sys.stderr, flush=True)
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    robots, config, ros_args, fork = parse_args(sys.argv[1:] if argv is None else argv)
+    return (serve_forked if fork else serve)(robots, config, ros_args)
 
 
 if __name__ == "__main__":

@@ -61,6 +61,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioRep
 from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
+from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
 
@@ -111,7 +112,7 @@ class QueueBehaviour:
         depot, queue = scenario.depot, QueueConfig.of(scenario)
         self.robot = robot
         self._rng = rng
-        self.ignored_messages = 0
+        self.rejections = Rejections()
         """Grants and radio replies naming a line or slot our layout does not have (dropped)."""
         self._limits = DriveLimits.from_scenario(scenario)
         self._center = (float(depot.center[0]), float(depot.center[1]))
@@ -233,16 +234,16 @@ class QueueBehaviour:
                 if m.to == self.robot and self._phase is Phase.SEEKING and within_range(m, x, y, self._gamma):
                     self._on_reply(m, obs, out)
 
-    def _valid_slot(self, line: str, cell: int) -> bool:
+    def _valid_slot(self, what: str, line: str, cell: int) -> bool:
         """Whether (line, cell) names a slot of our layout: messages from the bus are untrusted."""
         cells = self._cells.get(line)
         if cells is None or not 0 <= cell < len(cells):
-            self.ignored_messages += 1
+            self.rejections.add(what, Reason.REFUSED, f"no slot {line[:40]!r}/{cell} in our layout")
             return False
         return True
 
     def _on_grant(self, grant: DepotGrant, obs: Observation) -> None:
-        if grant.cell >= 0 and not self._valid_slot(grant.line, grant.cell):
+        if grant.cell >= 0 and not self._valid_slot("DepotGrant", grant.line, grant.cell):
             return
         if grant.cell < 0:  # a refused join
             if self._phase is Phase.JOINING and self._join is not None and grant.line == self._join[0]:
@@ -277,7 +278,7 @@ class QueueBehaviour:
             if self._rng.random() < 0.5:
                 self._yield_until = obs.t + YIELD_TIME
             return
-        if not self._valid_slot(reply.line, reply.cell) or reply.line not in self._entry_lines:
+        if not self._valid_slot("RadioReply", reply.line, reply.cell) or reply.line not in self._entry_lines:
             return
         if self._join is not None:
             return

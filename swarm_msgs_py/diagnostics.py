@@ -8,7 +8,9 @@ Typed payloads (one status per record, level OK):
 
 - `/world/events` (`encode_events`): name ``pickup`` or ``drop``, hardware_id = robot,
   message = a human-readable summary, values ``resource``, ``zone`` (drop only), ``x``, ``y``,
-  ``stamp_ns`` (the event's own stamp; the array's header stamp is the publishing tick).
+  ``stamp_ns`` (the event's own stamp; the array's header stamp is the publishing tick); or
+  name ``node_down`` (level ERROR), hardware_id = the robot or server channel, values ``kind``
+  (``robot``/``server``), ``ticks`` (missed in a row), ``stamp_ns``.
 - `/world/robot_stats` (`encode_robot_stats`): name = hardware_id = robot, values
   ``collision_time_s``, ``pickups``, ``deliveries``, ``clamped_commands``, ``stale_ticks``.
 - `/<robot>/status` (`encode_status`): one status, name = hardware_id = robot,
@@ -22,7 +24,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import NamedTuple
 
 from swarm_msgs_py.cdr import Reader, Writer, codec
-from swarm_sim.types import BehaviourStatus, DropEvent, PickupEvent, RobotId, RobotStats
+from swarm_sim.types import NODE_KINDS, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 TYPE_NAME = "diagnostic_msgs/msg/DiagnosticArray"
 
@@ -96,9 +98,17 @@ def _fields(status: Status, expected: Sequence[str], what: str) -> dict[str, str
 
 _PICKUP_KEYS = ("resource", "x", "y", "stamp_ns")
 _DROP_KEYS = ("resource", "zone", "x", "y", "stamp_ns")
+_DOWN_KEYS = ("kind", "ticks", "stamp_ns")
+
+WorldEvent = PickupEvent | DropEvent | NodeDownEvent
 
 
-def _event_status(event: PickupEvent | DropEvent) -> Status:
+def _event_status(event: WorldEvent) -> Status:
+    if isinstance(event, NodeDownEvent):
+        return Status(
+            ERROR, "node_down", f"{event.kind} {event.node} declared dead after {event.ticks} missed ticks",
+            event.node, (("kind", event.kind), ("ticks", str(int(event.ticks))), ("stamp_ns", str(int(event.stamp_ns)))),
+        )  # fmt: skip
     x, y = repr(float(event.x)), repr(float(event.y))
     resource, stamp = str(int(event.resource)), str(int(event.stamp_ns))
     if isinstance(event, PickupEvent):
@@ -116,16 +126,16 @@ def _event_status(event: PickupEvent | DropEvent) -> Status:
 
 
 @codec(f"{TYPE_NAME} (world events)")
-def encode_events(stamp_ns: int, events: Iterable[PickupEvent | DropEvent]) -> bytes:
+def encode_events(stamp_ns: int, events: Iterable[WorldEvent]) -> bytes:
     """All events of one tick in one array, in the order given."""
     return encode_diagnostics(stamp_ns, [_event_status(e) for e in events])
 
 
 @codec(f"{TYPE_NAME} (world events)")
-def decode_events(data: bytes) -> tuple[int, tuple[PickupEvent | DropEvent, ...]]:
+def decode_events(data: bytes) -> tuple[int, tuple[WorldEvent, ...]]:
     """-> (the array's stamp [ns], the events in message order)."""
     stamp_ns, statuses = decode_diagnostics(data)
-    events: list[PickupEvent | DropEvent] = []
+    events: list[WorldEvent] = []
     for s in statuses:
         if s.name == "pickup":
             f = _fields(s, _PICKUP_KEYS, "event")
@@ -143,8 +153,13 @@ def decode_events(data: bytes) -> tuple[int, tuple[PickupEvent | DropEvent, ...]
                     float(f["x"]), float(f["y"]),
                 )  # fmt: skip
             )
+        elif s.name == "node_down":
+            f = _fields(s, _DOWN_KEYS, "event")
+            if f["kind"] not in NODE_KINDS:
+                raise ValueError(f"event node_down: kind {f['kind']!r} not one of {NODE_KINDS}")
+            events.append(NodeDownEvent(s.hardware_id, int(f["stamp_ns"]), f["kind"], int(f["ticks"])))
         else:
-            raise ValueError(f"unknown event {s.name!r} (expected 'pickup' or 'drop')")
+            raise ValueError(f"unknown event {s.name!r} (expected 'pickup', 'drop' or 'node_down')")
     return stamp_ns, tuple(events)
 
 
@@ -219,3 +234,35 @@ def decode_status(data: bytes) -> BehaviourStatus:
         raise ValueError(f"status {s.name!r}: leading keys {keys}, expected {_BEHAVIOUR_KEYS}")
     (_, state), (_, avoid), (_, trips) = s.values[:3]
     return BehaviourStatus(s.name, stamp_ns, state, int(avoid), int(trips), s.values[3:])
+
+
+# --------------------------------------------------------------------------- /diagnostics
+
+_SEP = " | "
+
+
+@codec(f"{TYPE_NAME} (rejected messages)")
+def encode_rejections(stamp_ns: int, node: str, counts: Mapping[tuple[str, str], int]) -> bytes:
+    """One status per node (name = hardware_id = the node), level WARN once it has dropped
+    anything; values ``<topic or message class> | <reason>`` = the count so far."""
+    total = sum(counts.values())
+    values = tuple((f"{where}{_SEP}{reason}", str(int(n))) for (where, reason), n in counts.items())
+    return encode_diagnostics(
+        stamp_ns, [Status(WARN if total else OK, node, f"{total} messages rejected", node, values)]
+    )
+
+
+@codec(f"{TYPE_NAME} (rejected messages)")
+def decode_rejections(data: bytes) -> tuple[int, dict[str, dict[tuple[str, str], int]]]:
+    """-> (stamp [ns], per node its counts by (where, reason))."""
+    stamp_ns, statuses = decode_diagnostics(data)
+    out: dict[str, dict[tuple[str, str], int]] = {}
+    for s in statuses:
+        counts: dict[tuple[str, str], int] = {}
+        for key, value in s.values:
+            where, sep, reason = key.rpartition(_SEP)
+            if not sep or not value.isdigit():
+                raise ValueError(f"rejections of {s.name!r}: bad entry {key!r} = {value!r}")
+            counts[(where, reason)] = int(value)
+        out[s.name] = counts
+    return stamp_ns, out

@@ -58,20 +58,6 @@ def topic_of(family: MessageFamily, message: Any) -> str:
         raise TypeError(f"{family.name}: no topic for message type {type(message).__name__}") from None
 
 
-def post_all(family: MessageFamily, data: bytes, post: Callable[[Any], None], warn: Callable[[str], None]) -> int:
-    """A node's raw subscription callback body: decode `data` and `post` every message; a
-    malformed message is dropped with a warning naming the problem (nothing else is lost).
-    Returns the number of messages posted."""
-    try:
-        messages = family.decode(data)
-    except ValueError as exc:
-        warn(f"dropping a malformed {family.name} message: {exc}")
-        return 0
-    for m in messages:
-        post(m)
-    return len(messages)
-
-
 def field_text(value: Any) -> str:
     """A field's value as record text (what `field_parser` reads back)."""
     if isinstance(value, tuple):

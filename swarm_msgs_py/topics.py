@@ -39,6 +39,8 @@ DEPOT_GRANTS = "/depot/grants"
 DEPOT_STATE = "/depot/state"
 DEPOT_MARKERS = "/depot/markers"
 RADIO = "/radio"
+DIAGNOSTICS = "/diagnostics"
+"""Every node's rejected-message counts (`swarm_sim.inbound`), one status per node, on change."""
 LOCKSTEP_ACK = "/lockstep/ack"
 """Servers (center, depot manager) answer each lockstep tick here: header.stamp = the tick,
 header.frame_id = the server's channel (`center`, `depot`)."""
@@ -69,6 +71,7 @@ GLOBAL_TOPIC_TYPES: dict[str, str] = {
     DEPOT_MARKERS: "visualization_msgs/msg/MarkerArray",
     RADIO: "diagnostic_msgs/msg/DiagnosticArray",
     LOCKSTEP_ACK: "std_msgs/msg/Header",
+    DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
 }
 """Absolute topic -> ROS type string."""
 

@@ -13,10 +13,8 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import multiprocessing
 import sys
 import time
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +22,7 @@ import numpy as np
 from swarm_controllers.api import behaviour_rng
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
@@ -120,27 +119,18 @@ def _collect_events(world: World, trace: RunTrace) -> None:
             trace.pickups.append(event)
 
 
-def _run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
+def run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
+    """One sweep run, (scenario, overrides, fields, seed) -> its summary (what executors call)."""
     name, overrides, fields, seed = job
     scenario = load_scenario(name, overrides, **fields, seed=seed)
     return summarize(run_batch(scenario).trace)
-
-
-def run_many(name: str, overrides: Iterable[str], fields: dict, seeds: list[int], jobs: int):
-    """Yield one summary per seed (in seed order), `jobs` runs at a time."""
-    work = [(name, tuple(overrides), fields, s) for s in seeds]
-    if jobs <= 1 or len(work) == 1:
-        yield from map(_run_one, work)
-        return
-    with multiprocessing.get_context("fork").Pool(jobs) as pool:
-        yield from pool.imap(_run_one, work)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="swarm-batch", description=__doc__.splitlines()[0])
     add_scenario_arguments(parser)
     parser.add_argument("--runs", type=number(int, 1, 10**6), default=1, help="runs with seeds seed, seed+1, ...")
-    parser.add_argument("--jobs", type=number(int, 1, 1024), default=1, help="runs in parallel (processes)")
+    add_executor_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per run")
     args = parser.parse_args(argv)
     try:
@@ -149,19 +139,39 @@ def main(argv: list[str] | None = None) -> int:
         print(f"swarm-batch: {exc}", file=sys.stderr)
         return 2
     seeds = [base.seed + i for i in range(args.runs)]
-    for result in run_many(args.scenario, args.overrides, scenario_fields(args), seeds, args.jobs):
-        if args.json:
-            print(json.dumps(result), flush=True)
-        else:
-            print(
-                f"{result['scenario']} seed={result['seed']} robots={result['robots']}: "
-                f"delivered {result['resources_delivered']}/{result['total_resources']} in "
-                f"{result['sim_seconds']:.0f} s sim, {result['wall_seconds']:.1f} s wall "
-                f"({result['real_time_factor']}x), collision {result['collision_time_per_robot_s']:.2f} "
-                f"s/robot, OAE {result['oae_per_robot']:.1f}/robot",
-                flush=True,
-            )
-    return 0
+    jobs = [(args.scenario, tuple(args.overrides), scenario_fields(args), s) for s in seeds]
+    failed = 0
+    try:
+        with executor_from_args(args) as executor, Progress(len(jobs), f"swarm-batch ({executor.name})") as bar:
+            for outcome in executor.map(run_one, jobs):
+                if outcome.ok:
+                    bar.write(_result_line(outcome.value, args.json), numbered=False)
+                else:
+                    failed += 1
+                    bar.write(f"swarm-batch: seed {seeds[outcome.index]} failed: {outcome.error}",
+                              lambda text: print(text, file=sys.stderr, flush=True), numbered=False)
+                bar.update(outcome.ok)
+    except (RuntimeError, OSError) as exc:  # no Dask installed, scheduler unreachable
+        print(f"swarm-batch: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("swarm-batch: interrupted", file=sys.stderr)
+        return 130
+    if failed:
+        print(f"swarm-batch: {failed} of {len(jobs)} runs failed", file=sys.stderr)
+    return 1 if failed else 0
+
+
+def _result_line(result: dict, as_json: bool) -> str:
+    if as_json:
+        return json.dumps(result)
+    return (
+        f"{result['scenario']} seed={result['seed']} robots={result['robots']}: "
+        f"delivered {result['resources_delivered']}/{result['total_resources']} in "
+        f"{result['sim_seconds']:.0f} s sim, {result['wall_seconds']:.1f} s wall "
+        f"({result['real_time_factor']}x), collision {result['collision_time_per_robot_s']:.2f} "
+        f"s/robot, OAE {result['oae_per_robot']:.1f}/robot"
+    )
 
 
 if __name__ == "__main__":

@@ -44,3 +44,8 @@ class Server(Protocol):
     def series(self) -> dict[str, list[tuple[float, Any]]]:
         """Time series for the run trace, by name: (t [s], value) whenever it changed."""
         ...
+
+    # Optional, found with getattr by the server node:
+    #   rejections: swarm_sim.inbound.Rejections -- messages the core refused, by class and reason;
+    #   robot_lost(robot, stamp_ns) -> None -- the world declared `robot` dead: free what it held
+    #   and refuse its later messages (graph runs only: in batch every robot answers every tick).

@@ -502,6 +502,11 @@ def load_scenario(
 
 MAX_DURATION = 1e7
 """[s] of sim time (about 116 days): a longer run is a typo, not an experiment."""
+MIN_DT, MAX_DT = 1e-3, 10.0
+"""[s] bounds of the control tick: the robots' controllers run at 1 kHz at most (a 1 ns tick
+would make a one-second run a billion ticks), and a tick longer than 10 s is not control."""
+MAX_SUBSTEPS = 1000
+"""pybullet steps per tick."""
 MAX_FILE_BYTES = 1 << 20
 """A scenario file larger than this is refused (ours are ~1 KB)."""
 
@@ -584,8 +589,9 @@ def _inside(point: tuple[float, float], half: float, clearance: float) -> bool:
 
 def validate(s: Scenario) -> None:
     """Refuse impossible scenarios, naming the key at fault."""
-    _require(s.sim.dt > 0, "sim.dt: must be positive")
-    _require(s.sim.physics_substeps >= 1, "sim.physics_substeps: must be at least 1")
+    _require(MIN_DT <= s.sim.dt <= MAX_DT, f"sim.dt: must be between {MIN_DT:g} and {MAX_DT:g} s")
+    _require(1 <= s.sim.physics_substeps <= MAX_SUBSTEPS,
+             f"sim.physics_substeps: must be between 1 and {MAX_SUBSTEPS}")
     _require(s.sim.duration >= s.sim.dt, "sim.duration: must be at least one tick (sim.dt)")
     _require(s.sim.duration <= MAX_DURATION, f"sim.duration: at most {MAX_DURATION:g} s of sim time")
     _require(s.seed >= 0, "seed: must not be negative")

@@ -11,11 +11,20 @@ nanoseconds so that graph and batch runs compare exactly.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 
-RobotId = str
+class _RobotIdMark:
+    """Marks a message field that names a robot, so a node can refuse ids of no robot of the
+    run (`swarm_sim.inbound`)."""
+
+    def __repr__(self) -> str:
+        return "robot id"
+
+
+ROBOT_ID = _RobotIdMark()
+RobotId = Annotated[str, ROBOT_ID]
 """A robot's name, which is also its ROS namespace (``robot_0``, ``robot_1``, ...)."""
 
 NS_PER_S = 1_000_000_000
@@ -132,6 +141,22 @@ class DropEvent:
     zone: str
     x: float
     y: float
+
+
+@dataclass(frozen=True, slots=True)
+class NodeDownEvent:
+    """The world declared a node dead: it missed its lockstep answers `ticks` times in a row
+    (``dead_after``, each after the tick timeout). `kind` is ``robot`` (a controller: its robot
+    stands still for the rest of the run and the servers free what it held) or ``server``
+    (a server's channel, e.g. ``depot``: the run ends here, incomplete)."""
+
+    node: str
+    stamp_ns: int
+    kind: str
+    ticks: int
+
+
+NODE_KINDS = ("robot", "server")
 
 
 @dataclass(slots=True)

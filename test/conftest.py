@@ -18,3 +18,17 @@ from hypothesis import HealthCheck, settings  # noqa: E402
 
 settings.register_profile("swarmforage", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("swarmforage")
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture
+def context():
+    """A fresh rclpy context for a node test (node tests never share the global one)."""
+    import rclpy
+
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx)
+    yield ctx
+    ctx.try_shutdown()

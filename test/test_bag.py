@@ -189,13 +189,32 @@ def test_metadata_yaml_is_rosbag2_v9(tmp_path: Path) -> None:
     assert info["custom_data"] == {"seed": "7", "scenario.name": "cpfa", "scenario.robots": "2"}
     topics = {t["topic_metadata"]["name"]: t for t in info["topics_with_message_count"]}
     odom_meta = topics["/robot_0/odom"]["topic_metadata"]
-    assert odom_meta["type_description_hash"] == ""
+    # REP 2011's hash of nav_msgs/msg/Odometry (what the graph reports for a publisher of it)
+    assert odom_meta["type_description_hash"] == (
+        "RIHS01_3cc97dc7fb7502f8714462c526d369e35b603cfc34d946e3f2eda2766dfec6e0"
+    )
     assert odom_meta["serialization_format"] == "cdr"
     assert odom_meta["offered_qos_profiles"][0]["reliability"] == "best_effort"
     assert topics["/depot/state"]["topic_metadata"]["offered_qos_profiles"][0]["durability"] == (
         "transient_local"
     )
     assert topics["/robot_0/odom"]["message_count"] == 20
+
+
+def test_offered_qos_set_later_replaces_the_default_in_metadata_yaml(tmp_path: Path) -> None:
+    bag = tmp_path / "run"
+    offered = [{"history": "keep_last", "depth": 1000, "reliability": "reliable", "durability": "volatile"}]
+    with BagWriter(bag) as w:
+        w.add_topic("/robot_0/status", "diagnostic_msgs/msg/DiagnosticArray")
+        w.add_topic("/clock", "rosgraph_msgs/msg/Clock")
+        w.set_offered_qos("/robot_0/status", offered, "RIHS01_given")
+        with pytest.raises(BagError, match="not registered"):
+            w.set_offered_qos("/nope", offered)
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    topics = {t["topic_metadata"]["name"]: t["topic_metadata"] for t in info["topics_with_message_count"]}
+    assert topics["/robot_0/status"]["offered_qos_profiles"] == offered
+    assert topics["/robot_0/status"]["type_description_hash"] == "RIHS01_given"
+    assert topics["/clock"]["offered_qos_profiles"][0]["depth"] == 10  # the default of its QoS name
 
 
 def test_flatten_metadata() -> None:
@@ -346,6 +365,47 @@ def test_sigkill_loses_at_most_the_last_flush_period(tmp_path: Path) -> None:
     counters = [deserialize_message(m.data, TwistStamped).twist.linear.x for m in got]
     assert counters == [float(i) for i in range(len(got))]  # an unbroken prefix of what was written
     assert got[-1].stamp_ns >= last_written - NS // 2 - stall
+
+
+def test_a_killed_bag_is_repaired_for_rosbags_with_nothing_lost(tmp_path: Path) -> None:
+    """rosbags' AnyReader refuses a file without its footer ("File end magic is invalid");
+    repair_bag finalises what was recovered, keeping every message, type, QoS and metadata."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.interfaces import QosDurability
+
+    from swarm_sim.recording import repair_bag
+
+    bag = tmp_path / "run"
+    clock = FakeClock()
+    written = []
+    with BagWriter(bag, flush_seconds=1.0, clock=clock, metadata={"seed": 7}) as w:
+        w.add_topic("/robot_0/odom", "nav_msgs/msg/Odometry", "best_effort")
+        w.add_topic("/depot/state", "geometry_msgs/msg/TwistStamped", "latched")
+        for i in range(60):
+            topic, data = ("/depot/state", twist(i)) if i % 5 == 0 else ("/robot_0/odom", odom(i))
+            w.write(topic, i, data)
+            written.append((topic, i, data))
+            clock.t += 0.3  # a chunk every ~4 messages
+    assert not repair_bag(bag)  # complete: nothing to do
+    (last,) = bag.glob("*.mcap")
+    data = last.read_bytes()
+    last.write_bytes(data[: len(data) // 3])  # the recorder was killed mid-write
+    with pytest.raises(Exception):  # noqa: B017 - rosbags' own error type differs by version
+        with AnyReader([bag]) as reader:
+            list(reader.messages())
+    with pytest.warns(BagTruncatedWarning):
+        recovered = [(m.topic, m.stamp_ns, m.data) for m in read_bag(bag)]
+    assert 0 < len(recovered) < len(written)
+    assert repair_bag(bag)
+    info = bag_info(bag)  # no warning: complete now
+    assert not info.truncated and info.metadata["seed"] == "7" and "repaired_from" in info.metadata
+    assert [(m.topic, m.stamp_ns, m.data) for m in read_bag(bag)] == recovered
+    with AnyReader([bag]) as reader:
+        got = [(c.topic, t, bytes(raw)) for c, t, raw in reader.messages()]
+        qos = {c.topic: c.ext.offered_qos_profiles[0] for c in reader.connections}
+    assert sorted(got) == sorted(recovered)
+    assert qos["/depot/state"].durability == QosDurability.TRANSIENT_LOCAL
+    assert not list(tmp_path.glob(".run*"))  # no staging left behind
 
 
 def test_bag_without_metadata_yaml_is_read_from_its_files(tmp_path: Path) -> None:

@@ -57,19 +57,38 @@ def fake_summary(name, overrides, fields, seed):
     }
 
 
+def fake_run(job):
+    """A run function for the sweep (module level: executors pickle it)."""
+    return fake_summary(*job)
+
+
 class FakeRunner:
-    """Records every call; raises KeyboardInterrupt after `stop_after` results if set."""
+    """A run function that records every call (in this process: `LocalExecutor(1)`); raises
+    KeyboardInterrupt after `stop_after` results if set, and `fail[name]` for that strategy."""
 
-    def __init__(self, stop_after=None):
-        self.calls, self.done, self.stop_after = [], 0, stop_after
+    def __init__(self, stop_after=None, fail=None):
+        self.calls, self.done, self.stop_after, self.fail = [], 0, stop_after, fail or {}
 
-    def __call__(self, name, overrides, fields, seeds, jobs):
-        self.calls.append((name, tuple(overrides), dict(fields), tuple(seeds), jobs))
-        for seed in seeds:
-            if self.stop_after is not None and self.done >= self.stop_after:
-                raise KeyboardInterrupt
-            self.done += 1
-            yield fake_summary(name, overrides, fields, seed)
+    def __call__(self, job):
+        name, overrides, fields, seed = job
+        if self.stop_after is not None and self.done >= self.stop_after:
+            raise KeyboardInterrupt
+        self.calls.append((name, tuple(overrides), dict(fields), seed))
+        if name in self.fail:
+            raise self.fail[name]
+        self.done += 1
+        return fake_summary(name, overrides, fields, seed)
+
+    def grouped(self):
+        """Calls as (strategy, robots field, seeds) in call order."""
+        out = []
+        for name, _, fields, seed in self.calls:
+            key = (name, fields.get("robots__count"))
+            if out and out[-1][:2] == key:
+                out[-1] = (*key, out[-1][2] + (seed,))
+            else:
+                out.append((*key, (seed,)))
+        return out
 
 
 # --------------------------------------------------------------------------- stars and tests
@@ -272,22 +291,21 @@ def test_sweep_appends_each_run_and_resume_skips_finished_runs(tmp_path):
     path = tmp_path / "results.jsonl"
     plans = [RunPlan("queue_cpfa", 48, (), (("robots__count", 48),)),
              RunPlan("queue_qmt", 48, (), (("robots__count", 48),))]
-    cut = FakeRunner(stop_after=5)
     with pytest.raises(KeyboardInterrupt):
-        run_sweep(plans, range(4), path, jobs=3, runner=cut, log=lambda _: None)
+        run_sweep(plans, range(4), path, run=FakeRunner(stop_after=5), log=lambda _: None)
     kept = read_results(path)
     assert [(r["strategy"], r["seed"]) for r in kept] == [("queue_cpfa", s) for s in range(4)] + [("queue_qmt", 0)]
     assert all("oae_by_robot" not in r and r["settings"] == plans[0].settings for r in kept)
     with pytest.raises(FileExistsError):
-        run_sweep(plans, range(4), path, runner=FakeRunner(), log=lambda _: None)
+        run_sweep(plans, range(4), path, run=FakeRunner(), log=lambda _: None)
     again = FakeRunner()
-    rows = run_sweep(plans, range(4), path, jobs=3, runner=again, resume=True, log=lambda _: None)
-    assert again.calls == [("queue_qmt", (), {"robots__count": 48}, (1, 2, 3), 3)]
-    assert len(rows) == len(read_results(path)) == 8
+    result = run_sweep(plans, range(4), path, run=again, resume=True, log=lambda _: None)
+    assert again.grouped() == [("queue_qmt", 48, (1, 2, 3))]
+    assert len(result.rows) == len(read_results(path)) == 8 and not result.failed
     # other settings are other runs: nothing skipped, and the old rows are not reported
     other = [RunPlan("queue_cpfa", 48, ("sim.duration=5",), (("robots__count", 48),))]
-    rows = run_sweep(other, range(2), path, runner=(r := FakeRunner()), resume=True, log=lambda _: None)
-    assert len(r.calls) == 1 and len(rows) == 2
+    result = run_sweep(other, range(2), path, run=(r := FakeRunner()), resume=True, log=lambda _: None)
+    assert len(r.calls) == 2 and len(result.rows) == 2
 
 
 def test_a_line_cut_short_is_skipped_and_not_glued_to_the_next(tmp_path):
@@ -296,30 +314,29 @@ def test_a_line_cut_short_is_skipped_and_not_glued_to_the_next(tmp_path):
     good = {"strategy": "ddsa", "settings": plan.settings, "seed": 0, "cell": 8}
     path.write_text(json.dumps(good) + "\n" + '{"strategy": "dd')
     assert read_results(path) == [good]
-    run_sweep([plan], range(2), path, runner=(r := FakeRunner()), resume=True, log=lambda _: None)
-    assert r.calls[0][3] == (1,)
+    run_sweep([plan], range(2), path, run=(r := FakeRunner()), resume=True, log=lambda _: None)
+    assert [c[3] for c in r.calls] == [1]
     assert [x["seed"] for x in read_results(path)] == [0, 1]
 
 
 def test_cli_interrupt_then_resume_then_report(tmp_path, capsys):
     argv = ["queue", "--robots", "48", "64", "--seeds", "3", "--strategies", "queue_cpfa", "queue_qmt",
-            "--out", str(tmp_path), "--jobs", "2"]
-    assert main(argv, runner=FakeRunner(stop_after=4)) == 130
+            "--out", str(tmp_path)]
+    assert main(argv, run=FakeRunner(stop_after=4)) == 130
     assert len(read_results(tmp_path / "results.jsonl")) == 4
-    assert main(argv, runner=FakeRunner()) == 2  # refuses to mix into an existing file
+    assert main(argv, run=FakeRunner()) == 2  # refuses to mix into an existing file
     runner = FakeRunner()
-    assert main([*argv, "--resume"], runner=runner) == 0
-    assert [(c[0], c[2]["robots__count"], c[3]) for c in runner.calls] == [
-        ("queue_qmt", 48, (1, 2)), ("queue_cpfa", 64, (0, 1, 2)), ("queue_qmt", 64, (0, 1, 2))]
+    assert main([*argv, "--resume"], run=runner) == 0
+    assert runner.grouped() == [("queue_qmt", 48, (1, 2)), ("queue_cpfa", 64, (0, 1, 2)), ("queue_qmt", 64, (0, 1, 2))]
     assert len(read_results(tmp_path / "results.jsonl")) == 12
     assert (tmp_path / "ttests.md").exists() and (tmp_path / "collision_time.png").exists()
-    assert main([*argv, "--overwrite"], runner=(r := FakeRunner())) == 0 and len(r.calls) == 4
+    assert main([*argv, "--overwrite"], run=(r := FakeRunner())) == 0 and len(r.calls) == 12
     assert len(read_results(tmp_path / "results.jsonl")) == 12
 
 
 def test_cli_refuses_an_unknown_strategy(tmp_path):
     with pytest.raises(SystemExit):
-        main(["queue", "--strategies", "queue_xyz", "--out", str(tmp_path)], runner=FakeRunner())
+        main(["queue", "--strategies", "queue_xyz", "--out", str(tmp_path)], run=FakeRunner())
 
 
 def test_one_tiny_real_run_through_the_cli(tmp_path):
@@ -334,23 +351,21 @@ def test_one_tiny_real_run_through_the_cli(tmp_path):
     assert (tmp_path / "exp2" / "mannwhitney.md").exists()
 
 
-def test_a_failing_strategy_is_reported_and_the_sweep_goes_on(tmp_path, capsys):
-    def runner(name, overrides, fields, seeds, jobs):
-        if name == "queue_qse":
-            yield fake_summary(name, overrides, fields, seeds[0])
-            raise ModuleNotFoundError("no queue behaviour yet")
-        yield from FakeRunner()(name, overrides, fields, seeds, jobs)
-
+def test_a_failing_run_is_recorded_with_its_error_and_the_sweep_goes_on(tmp_path, capsys):
+    runner = FakeRunner(fail={"queue_qse": ModuleNotFoundError("no queue behaviour yet")})
     argv = ["queue", "--robots", "48", "--seeds", "2", "--strategies", "queue_cpfa", "queue_qse",
             "queue_qmt", "--out", str(tmp_path)]
-    assert main(argv, runner=runner) == 1
-    assert "queue_qse (cell 48)" in capsys.readouterr().err
+    assert main(argv, run=runner) == 1
+    assert "failed.jsonl" in capsys.readouterr().err
     kept = [(r["strategy"], r["seed"]) for r in read_results(tmp_path / "results.jsonl")]
-    assert kept == [("queue_cpfa", 0), ("queue_cpfa", 1), ("queue_qse", 0), ("queue_qmt", 0), ("queue_qmt", 1)]
+    assert kept == [("queue_cpfa", 0), ("queue_cpfa", 1), ("queue_qmt", 0), ("queue_qmt", 1)]
+    failed = read_results(tmp_path / "failed.jsonl")
+    assert [(f["strategy"], f["seed"]) for f in failed] == [("queue_qse", 0), ("queue_qse", 1)]
+    assert failed[0]["error"].startswith("ModuleNotFoundError: no queue behaviour yet")
     assert (tmp_path / "table.md").exists()
-    with pytest.raises(ModuleNotFoundError):  # the library call without a handler is strict
-        run_sweep(queue_plans([48], ["queue_qse"]), range(2), tmp_path / "strict.jsonl", runner=runner,
-                  log=lambda _: None)
+    fixed = FakeRunner()  # --resume tries the failed runs again, and only them
+    assert main([*argv, "--resume"], run=fixed) == 0
+    assert fixed.grouped() == [("queue_qse", 48, (0, 1))]
 
 
 # --------------------------------------------------------------------------- comparisons as records
@@ -362,7 +377,7 @@ def test_comparisons_are_keyed_by_their_subcommand_names():
     assert all(name == c.name for name, c in found.items())
     assert found["queue"].strategies == QUEUE_STRATEGIES and found["spiral"].strategies == SPIRAL_STRATEGIES
     sub = next(a for a in build_parser(found)._actions if a.dest == "command")
-    assert list(sub.choices) == list(found)
+    assert list(sub.choices) == [*found, "all"]
 
 
 def test_the_cli_runs_any_comparison_it_is_given(tmp_path):
@@ -382,11 +397,69 @@ def test_the_cli_runs_any_comparison_it_is_given(tmp_path):
         out_dir=lambda args: args.out / f"size{args.size}",
     )
     runner = FakeRunner()
-    assert main(["toy", "--size", "5", "--seeds", "2", "--strategies", "c", "a"], runner=runner,
+    assert main(["toy", "--size", "5", "--seeds", "2", "--strategies", "c", "a"], run=runner,
                 comparisons={"toy": toy}) == 0
-    assert [(c[0], c[3]) for c in runner.calls] == [("a", (0, 1)), ("c", (0, 1))]  # the declared order
+    assert [(c[0], c[3]) for c in runner.calls] == [("a", 0), ("a", 1), ("c", 0), ("c", 1)]  # the declared order
     assert seen["out"] == tmp_path / "toy" / "size5" and seen["strategies"] == ["a", "c"]
     assert [(r["strategy"], r["cell"]) for r in seen["rows"]] == [("a", 5), ("a", 5), ("c", 5), ("c", 5)]
     assert len(read_results(tmp_path / "toy" / "size5" / "results.jsonl")) == 4
     with pytest.raises(SystemExit):
-        main(["queue"], runner=FakeRunner(), comparisons={"toy": toy})
+        main(["queue"], run=FakeRunner(), comparisons={"toy": toy})
+
+
+def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
+    """`swarm-compare all`: each registered comparison's reproduction sweeps (queue, spiral 1-3) and a
+    plugged-in one, into OUT/<name>/, then REPORT.md with the headline claims, tables and plots."""
+    seen = []
+
+    def write_report(rows, out, args, strategies):
+        seen.append((out, len(rows)))
+        (out / "toy.md").write_text("# Toy tables\n\nours 1.0, paper 2.0\n")
+        return [out / "toy.md"]
+
+    toy = Comparison(
+        name="toy", help="a future paper", default_out="results/toy", strategies=("ddsa",),
+        add_arguments=lambda p: None, plans=lambda args, strategies: [RunPlan("ddsa", 1)],
+        write_report=write_report,
+    )
+    found = {**comparisons(), "toy": toy}
+    runner = FakeRunner()
+    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
+    assert main(argv, run=runner, comparisons=found) == 0
+    assert {c[0] for c in runner.calls} == {*QUEUE_STRATEGIES, *SPIRAL_STRATEGIES}
+    assert all(c[2]["sim__duration"] == 5 for c in runner.calls if c[2])  # the toy plans set no fields
+    for sub in ("queue/table.md", "spiral/exp1/tables.md", "spiral/exp2/mannwhitney.md", "spiral/exp3/tables.md",
+                "queue/collected.png"):
+        assert (tmp_path / sub).exists(), sub
+    assert seen == [(tmp_path / "toy", 2)]
+    report = (tmp_path / "REPORT.md").read_text()
+    assert "Rehearsal" in report and "## Headline claims" in report
+    assert "| queue | Q_MT collects the most resources of all strategies |" in report
+    assert "| spiral --experiment 2 |" in report and "| toy | (no headline claims declared) |" in report
+    assert "### Resource collection [%] (Table II layout)" in report  # the tables file, nested
+    assert "![collected](queue/collected.png)" in report and "#### Toy tables" not in report
+    assert "### Toy tables" in report
+    # a finished reproduction resumes to nothing new
+    again = FakeRunner()
+    assert main([*argv, "--resume"], run=again, comparisons=found) == 0 and again.calls == []
+
+
+def test_headlines_follow_the_means_and_the_tests():
+    rows = (rows_for("queue_qse", 48, [10, 11, 12]) + rows_for("queue_qst", 48, [20, 21, 22])
+            + rows_for("queue_qme", 48, [30, 31, 32]) + rows_for("queue_qmt", 48, [60, 61, 62])
+            + rows_for("queue_cpfa", 48, [40, 41, 42]))
+    from swarm_sim.compare.queue_paper import queue_headlines
+    from swarm_sim.compare.spiral_paper import spiral_headlines
+
+    found = {h.claim: h for h in queue_headlines(rows, [48], QUEUE_STRATEGIES)}
+    assert found["Q_MT collects the most resources of all strategies"].holds is True
+    assert found["collection Q_SE < Q_ST < Q_ME < Q_MT"].holds is True
+    assert found["CPFA collects less with more robots"].holds is None  # one size cannot tell
+    assert found["CPFA has the highest collision time"].holds is False  # Q_MT's values are higher
+    spiral = (rows_for("ddsa", None, [10, 11, 12, 10, 11], SPIRAL_KEYS)
+              + rows_for("mdbsa_c", 4, [10, 12, 11, 10, 12], SPIRAL_KEYS)
+              + rows_for("mdbsa_d", 4, [20, 21, 22, 23, 24], SPIRAL_KEYS))
+    claims = spiral_headlines(spiral, 1, [4], SPIRAL_STRATEGIES)
+    similar = next(h for h in claims if h.paper.startswith("similar"))
+    above = next(h for h in claims if h.paper.startswith("≈ +101"))
+    assert similar.holds is True and above.holds is True and "4: +" in above.ours

@@ -749,7 +749,7 @@ def test_server_refusals_grants_history_errors():
         DepotReport(3 * s, "robot_2", ReportKind.UNLOADED),
         DepotReport(3 * s, "robot_2", ReportKind.AT, "entry_line_0", 6),
     ])
-    assert len(srv.errors) == 4 and "ghost" in srv.errors[0] and "teleport" in srv.errors[2]
+    assert srv.rejections.counts == {("DepotReport", "unknown robot"): 1, ("DepotReport", "refused"): 3}
     assert [(g.robot, g.cell) for g in out] == [("robot_2", 6 + LOOKAHEAD), ("robot_5", 5)]
     assert len(srv.history) == 2  # queue lengths unchanged
     # robot_2 all the way through: dock, unloading, exit, gone
@@ -767,7 +767,7 @@ def test_server_refusals_grants_history_errors():
         tick += 1
         assert tick < 100
     assert "robot_2" not in [g.robot for g in out] and adm.snapshot().left == 1
-    assert len(srv.errors) == 4
+    assert srv.rejections.total == 4
     # robot_2 left the queue when it drove off its dock onto the exit line
     assert [h[1] for h in srv.history] == [(1, 1, 0, 0), (2, 1, 0, 0), (1, 1, 0, 0)]
     times = [h[0] for h in srv.history]

@@ -1,4 +1,4 @@
-"""The lockstep barrier's bookkeeping: stale and dead participants, revival on answering."""
+"""The lockstep barrier's bookkeeping: stale and dead participants; death is final."""
 
 from swarm_sim.nodes.lockstep import LockstepBarrier
 
@@ -14,10 +14,10 @@ def test_a_silent_participant_is_stale_every_tick_and_dead_after_n():
         stale, dead = b.close_tick(k)
         assert stale == ["robot_1"]
         deaths += dead
-    assert deaths == ["robot_1"] and b.live() == ["robot_0", "depot"]
-    for who in ("robot_0", "robot_1", "depot"):  # robot_1 answers again: waited for from now on
-        b.answered(who, 5)
-    assert b.close_tick(5) == ([], []) and b.live() == ["robot_0", "robot_1", "depot"]
+    assert deaths == ["robot_1"] and b.live() == ["robot_0", "depot"] and b.dead == {"robot_1"}
+    # robot_1 answers again: refused, still dead and stale (the others have written it off)
+    assert [b.answered(who, 5) for who in ("robot_0", "robot_1", "depot")] == [True, False, True]
+    assert b.close_tick(5) == (["robot_1"], []) and b.live() == ["robot_0", "depot"]
 
 
 def test_an_answer_for_another_tick_does_not_count():

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
@@ -22,14 +21,6 @@ from swarm_sim.types import PheromoneMessage, Pose2D
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")
-
-
-@pytest.fixture
-def context():
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx)
-    yield ctx
-    ctx.try_shutdown()
 
 
 class ScriptedControllers(Node):
@@ -145,6 +136,8 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
             for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
     laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, EVENTS)
+    # robot_1 of the scenario hears pheromones too: robot_0 answers only once every peer is matched
+    peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
     original_step = node.behaviour.step
     node.behaviour.step = lambda obs: (inbox.append(obs.messages), original_step(obs))[1]
     executor = SingleThreadedExecutor(context=context)
@@ -153,8 +146,9 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
     try:
         for _ in range(100):  # let discovery settle
             executor.spin_once(timeout_sec=0.02)
-            if all(p.get_subscription_count() for p in pubs.values()) and laid.get_subscription_count():
+            if all(p.get_subscription_count() for p in pubs.values()) and node.connect():
                 break
+        assert node.connect()
         dt = scenario.dt_ns
         laid.publish(pheromone.encode_pheromone(PheromoneMessage(stamp_ns=0, x=1.0, y=2.0)))
         for k in range(3):

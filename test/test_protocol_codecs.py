@@ -18,7 +18,7 @@ from swarm_msgs_py.cdr import CodecError
 from swarm_msgs_py.center_protocol import CENTER
 from swarm_msgs_py.depot_protocol import DEPOT, RADIO
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
-from swarm_msgs_py.records import post_all, topic_of
+from swarm_msgs_py.records import topic_of
 
 names = st.sampled_from(["robot_0", "robot_7", "robot_111"])
 floats = st.floats(allow_nan=False, allow_infinity=False, width=64)
@@ -95,14 +95,6 @@ def test_malformed_floats_and_bytes_are_refused():
         RADIO.decode(bad)
     with pytest.raises(CodecError):
         DEPOT.decode(b"\x00\x01\x00\x00\x01")
-
-
-def test_post_all_drops_a_malformed_message_with_a_warning():
-    posted, warnings = [], []
-    assert post_all(DEPOT, _grant_with(cell="x"), posted.append, warnings.append) == 0
-    assert posted == [] and "DepotGrant.cell" in warnings[0]
-    assert post_all(DEPOT, _grant_with(), posted.append, warnings.append) == 1
-    assert posted[0].reason is Refusal.NONE and posted[0].last is True
 
 
 @given(st.sampled_from(["center", "depot"]), stamps)

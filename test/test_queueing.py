@@ -135,7 +135,7 @@ def test_replies_and_grants_naming_slots_that_do_not_exist_are_dropped():
            DepotGrant(0, "robot_0", "entry_line_0", 10**6))
     obs = Observation("robot_0", 10**8, Pose2D(1.0, 0.0, 0.0), 0.0, 0.0, ranges, ForagingSense((), True), bad)
     b._handle(obs, [])  # the message handling alone, in the phase that listens to replies
-    assert b.ignored_messages == 3
+    assert b.rejections.counts == {("RadioReply", "refused"): 2, ("DepotGrant", "refused"): 1}
     b.step(obs)  # and a whole step with them does not fail
 
 
@@ -146,4 +146,5 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
 
     server = DepotServer(load_scenario("queue_qmt", ["robots.count=4"]))
     out = server.step(10**9, [DepotReport(0, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])
-    assert out == () and server.admission.robots_inside == () and len(server.errors) == 4
+    assert out == () and server.admission.robots_inside == ()
+    assert server.rejections.counts == {("DepotReport", "unknown robot"): 4}

@@ -42,6 +42,8 @@ def test_overrides_and_fields():
         (["depot.center=[9.0, 0.0]"], "depot"),
         (["resources.count=10"], "resources.count: 10 != clusters"),
         (["sim.dt=0"], "sim.dt"),
+        (["sim.dt=1e-9"], "sim.dt: must be between 0.001 and 10 s"),
+        (["sim.physics_substeps=10000000"], "sim.physics_substeps: must be between 1 and 1000"),
         (["obstacles=[{shape: box, center: [20.0, 0.0]}]"], "obstacles[0].center"),
         (["drop_zones=[{name: depot, center: [1.0, 1.0], radius: 0.2}]"], "drop_zones"),
         (["sensors.scan.rays=0"], "sensors.scan.rays"),

@@ -1,4 +1,8 @@
-"""swarm-analyze: a run's metrics from its bag alone (no ROS running, no rclpy needed)."""
+"""swarm-analyze: a run's metrics (and its replay video) from its bag alone (no ROS running, no rclpy needed).
+
+A path may be a bag directory, or a directory holding exactly one bag (what ``swarm-run --out DIR``
+writes into), which is then used.
+"""
 
 from __future__ import annotations
 
@@ -11,7 +15,23 @@ from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
-from swarm_sim.recording import BagError
+from swarm_sim.analysis.video import render_video
+from swarm_sim.cli import number
+from swarm_sim.recording import BagError, repair_bag
+from swarm_sim.recording.metadata import METADATA_FILE
+
+
+def find_bag(path: Path) -> Path:
+    """`path` if it is a bag; else its only subdirectory that is one (BagError naming what was found)."""
+    if not path.is_dir() or (path / METADATA_FILE).exists() or any(path.glob("*.mcap")):
+        return path
+    bags = sorted(p for p in path.iterdir() if p.is_dir() and ((p / METADATA_FILE).exists() or any(p.glob("*.mcap"))))
+    if len(bags) == 1:
+        return bags[0]
+    if not bags:
+        raise BagError(f"{path}: not a bag, and holds no bag directory")
+    names = ", ".join(p.name for p in bags[:5]) + (" ..." if len(bags) > 5 else "")
+    raise BagError(f"{path}: not a bag, and holds {len(bags)} bags ({names}): name one")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -23,10 +43,26 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trajectories", action="store_true",
                         help="also draw <bag>/trajectories.png (odometry over the planned paths) and the "
                              "algorithm's own figures (caging: <bag>/transport.png)")
+    parser.add_argument("--repair", action="store_true",
+                        help="first finalise a bag whose recorder was killed, in place, so that rosbags "
+                             "and ros2 bag read it too (every recovered message kept)")
+    video = parser.add_argument_group("replay video (one bag)")
+    video.add_argument("--video", type=Path, metavar="OUT.mp4|OUT.gif", help="render the run from the bag")
+    video.add_argument("--speedup", type=number(float, 0, 1e6, open_low=True), default=10.0,
+                       help="sim seconds per video second (default 10)")
+    video.add_argument("--fps", type=number(float, 0, 120, open_low=True), default=10.0,
+                       help="video frames per second (default 10)")
+    video.add_argument("--start", type=number(float, 0), default=0.0, help="first sim second (default 0)")
+    video.add_argument("--end", type=number(float, 0), help="last sim second (default: the end of the run)")
     args = parser.parse_args(argv)
+    if args.video and len(args.bags) != 1:
+        parser.error("--video renders one bag")
     status = 0
-    for bag in args.bags:
+    for given in args.bags:
         try:
+            bag = find_bag(given)
+            if args.repair and repair_bag(bag):
+                print(f"swarm-analyze: {bag}: repaired (its last file was cut off)", file=sys.stderr)
             trace = load_run(bag)
         except (BagError, ValueError) as exc:
             print(f"swarm-analyze: {exc}", file=sys.stderr)
@@ -40,18 +76,29 @@ def main(argv: list[str] | None = None) -> int:
             figures = registry.of(trace.config).figures
             if figures:  # the algorithm's own pictures (caging: the object's path, the cage)
                 summary["figures"] = [str(p) for p in registry.resolve(figures)(trace, bag)]
+        if args.video:
+            try:
+                rendered = render_video(bag, args.video, speedup=args.speedup, fps=args.fps, start=args.start,
+                                        end=args.end)
+            except (BagError, ValueError, OSError) as exc:
+                print(f"swarm-analyze: {exc}", file=sys.stderr)
+                return 1
+            summary["video"] = str(rendered.path)
+            summary["video_frames"] = rendered.frames
         if args.json:
             print(json.dumps(summary))
         else:
             print(f"{bag}:")
             own = [m.name for m in registry.of(trace.config).metrics]
-            for key in dict.fromkeys(("scenario", "seed", "robots", "mode", "sim_seconds", "wall_seconds",
+            for key in dict.fromkeys(("scenario", "seed", "robots", "mode", "run_ended", "dead_nodes", "sim_seconds",
+                        "wall_seconds",
                         "resources_delivered", "total_resources", "collision_time_per_robot_s",
                         "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
                         "resources_collected_pct", "dropoff_time_mean_s", "perimeter_delay_mean_s",
                         "deliveries_outside_docks",
                         "queue_length_mean", "queue_length_max", "resources_per_robot",
-                        "foraging_rate_per_min", "regions", *own, "plot", "trajectories", "figures")):
+                        "foraging_rate_per_min", "regions", "rejected_messages", *own, "plot", "trajectories",
+                        "figures", "video", "video_frames")):
                 if key in summary:
                     print(f"  {key:28s} {summary[key]}")
     return status

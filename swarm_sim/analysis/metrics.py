@@ -14,7 +14,7 @@ import numpy as np
 
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import scenario_docks
-from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent, RobotId, RobotStats
+from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 
 class PerimeterLog:
@@ -70,6 +70,14 @@ class RunTrace:
     """Lockstep ticks each server (by channel) did not acknowledge in time (graph runs)."""
     malformed: dict[str, int] = field(default_factory=dict)
     """Recorded messages that did not decode, by topic (skipped by the analysis)."""
+    rejected: dict[str, dict[tuple[str, str], int]] = field(default_factory=dict)
+    """Per node, the messages it dropped by (topic or message class, reason): its last
+    ``/diagnostics`` counts (`swarm_sim.inbound`)."""
+    down: list[NodeDownEvent] = field(default_factory=list)
+    """Nodes the world declared dead, in order."""
+    ended: str = "complete"
+    """How the run ended: ``complete``, ``interrupted``, ``server <channel> died``, or ``cut off``
+    (the world node died: the bag ends where its last flushed data does)."""
     series: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
     """Servers' time series by name, (t [s], value) whenever it changed: e.g. the depot
     manager's ``queue_lengths`` (robots queued on each entry line); and the world task's state,
@@ -147,6 +155,16 @@ def deliveries_outside_docks(trace: RunTrace) -> int | None:
     )
 
 
+def rejected_messages(trace: RunTrace) -> dict[str, dict[str, int]]:
+    """Messages dropped by every node, summed: {topic or message class: {reason: count}}."""
+    out: dict[str, dict[str, int]] = {}
+    for counts in trace.rejected.values():
+        for (where, reason), n in counts.items():
+            by_reason = out.setdefault(where, {})
+            by_reason[reason] = by_reason.get(reason, 0) + n
+    return {w: dict(sorted(r.items())) for w, r in sorted(out.items())}
+
+
 def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
     return float(np.mean(list(values.values()))) if values else 0.0
 
@@ -176,6 +194,9 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "clamped_commands": sum(s.clamped_commands for s in trace.stats.values()),
         "server_stale_ticks": sum(trace.server_stale.values()),
         "malformed_messages": sum(trace.malformed.values()),
+        "rejected_messages": rejected_messages(trace),
+        "dead_nodes": [e.node for e in trace.down],
+        "run_ended": trace.ended,
         **_registered_metrics(trace),
     }
 

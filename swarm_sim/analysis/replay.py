@@ -20,7 +20,7 @@ from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
 from swarm_sim.messaging import delivery_order
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
-from swarm_sim.types import NS_PER_S, DropEvent, robot_index
+from swarm_sim.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
 
 
 class MalformedMessageWarning(UserWarning):
@@ -66,7 +66,14 @@ def load_run(path: Path | str) -> RunTrace:
                 last_clock = max(last_clock, clock_codec.decode_clock(m.data))
             elif m.topic == topics.WORLD_EVENTS:
                 for event in diagnostics.decode_events(m.data)[1]:
-                    (trace.drops if isinstance(event, DropEvent) else trace.pickups).append(event)
+                    if isinstance(event, DropEvent):
+                        trace.drops.append(event)
+                    elif isinstance(event, PickupEvent):
+                        trace.pickups.append(event)
+                    elif isinstance(event, NodeDownEvent):
+                        trace.down.append(event)
+            elif m.topic == topics.DIAGNOSTICS:
+                trace.rejected.update(diagnostics.decode_rejections(m.data)[1])
             elif m.topic == topics.WORLD_ROBOT_STATS:
                 trace.stats = diagnostics.decode_robot_stats(m.data)[1]
             elif m.topic.endswith("/" + topics.STATUS):
@@ -88,7 +95,10 @@ def load_run(path: Path | str) -> RunTrace:
                 warnings.warn(f"{path}: skipping malformed messages on {m.topic}: {exc}", MalformedMessageWarning,
                               stacklevel=2)
     trace.messages.sort(key=delivery_order)
-    if not trace.sim_seconds:  # the run was cut off before it could write its totals
+    if "ended" in meta:
+        trace.ended = str(meta["ended"])[:200]
+    elif "sim_seconds" not in meta:  # the world died before it wrote its totals: the data ends where it ends
+        trace.ended = "cut off"
         trace.sim_seconds = last_clock / NS_PER_S
     trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
     return trace

@@ -5,8 +5,10 @@ queue_depot_traffic.md: Table II, Figs 8-10, independent two-sample t-tests) and
 ``swarm-compare spiral`` the MDBSA paper's experiments 1-3 (Lu & Luna 2023,
 mdbsa_spiral_search.md: Figs 6-10, two-sided Mann-Whitney U tests).
 
-`sweep` runs the plans and keeps ``results.jsonl`` resumable, `stats` and `report` hold what both
-papers share, `queue_paper` and `spiral_paper` what is one paper's, and `cli` is ``swarm-compare``.
+`sweep` runs the plans on an executor (`swarm_sim.executors`: local pool or Dask) and keeps
+``results.jsonl`` resumable, `stats` and `report` hold what both papers share, `queue_paper` and
+`spiral_paper` what is one paper's, `cli` is ``swarm-compare`` and `reproduce` its ``all``
+subcommand (every registered comparison, then REPORT.md).
 The report functions take plain lists of result dicts, so they work on any results file and tests
 feed them synthetic data.
 """

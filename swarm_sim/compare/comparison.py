@@ -16,6 +16,24 @@ def given_out(args: argparse.Namespace) -> Path:
 
 
 @dataclass(frozen=True)
+class Headline:
+    """One headline claim of a paper and whether our runs bear it out (REPORT.md's summary)."""
+
+    claim: str
+    """The paper's claim, in its words or close to them."""
+    paper: str
+    """The paper's number or statement, short."""
+    ours: str
+    """What our runs give, short."""
+    holds: bool | None
+    """True / False; None when our runs cannot tell (a strategy or cell missing)."""
+
+
+def no_headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
+    return []
+
+
+@dataclass(frozen=True)
 class Comparison:
     """One ``swarm-compare`` subcommand: its own options, the runs to make and the report to write.
 
@@ -40,3 +58,9 @@ class Comparison:
     """(rows, output directory, args, chosen strategies) -> the files written."""
     out_dir: Callable[[argparse.Namespace], Path] = given_out
     """args -> the directory for results.jsonl and the report (e.g. one per experiment)."""
+    reproduce: tuple[tuple[str, ...], ...] = ((),)
+    """The subcommand's own options, one tuple per sweep, that together reproduce the paper
+    (``swarm-compare all`` runs each; e.g. one per experiment). Default: one sweep with the
+    defaults."""
+    headlines: Callable[[Sequence[dict], argparse.Namespace, list[str]], list[Headline]] = no_headlines
+    """(rows, args, strategies) -> the paper's headline claims checked on one sweep's rows."""

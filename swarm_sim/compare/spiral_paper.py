@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table
-from swarm_sim.compare.stats import cells_of, describe, pairwise_tests, pct_change, stars, values_of
+from swarm_sim.compare.stats import cells_of, describe, pair_test, pairwise_tests, pct_change, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 SPIRAL_STRATEGIES: tuple[str, ...] = ("ddsa", "mdbsa_c", "mdbsa_d")
@@ -75,6 +75,8 @@ class PaperClaim:
     """The cells the claim is about; None: every cell."""
     min_cell: int | None = None
     """Alternatively: every cell >= this."""
+    sign: int = 1
+    """The direction the paper reports: +1 (B above A), -1 (below) or 0 (no difference)."""
 
     def covers(self, cell: int) -> bool:
         if self.cells is not None:
@@ -92,10 +94,10 @@ PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
     # ---- experiment 1 (Fig. 6, Fig. 7)
     PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_c", "similar (≈ 0 %)",
                f"When using 4 and 16 regions, {_C} achieved similar performance to DDSA regarding "
-               "the number of collected resources.", cells=(4, 16)),
+               "the number of collected resources.", cells=(4, 16), sign=0),
     PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −25 %",
                "However, we observed a decrease of approximately 25% in the number of collected "
-               "resources using 64 regions. [baseline not stated; compared here with DDSA]", cells=(64,)),
+               "resources using 64 regions. [baseline not stated; compared here with DDSA]", cells=(64,), sign=-1),
     PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_d", "≈ +101 % (average)",
                f"On average, {_D} collected around 101% more resources than DDSA and around 112% "
                f"more resources than {_C}."),
@@ -104,10 +106,10 @@ PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
                f"more resources than {_C}."),
     PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −33 %",
                f"When using 4 and 64 regions, {_D} has approximately 33% less time in collisions "
-               "than DDSA, and around 72% less time when using 16 regions.", cells=(4, 64)),
+               "than DDSA, and around 72% less time when using 16 regions.", cells=(4, 64), sign=-1),
     PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −72 %",
                f"When using 4 and 64 regions, {_D} has approximately 33% less time in collisions "
-               "than DDSA, and around 72% less time when using 16 regions.", cells=(16,)),
+               "than DDSA, and around 72% less time when using 16 regions.", cells=(16,), sign=-1),
     PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0, highest, grows with regions",
                f"The collision time in {_C} increased as the number of regions increased, with both "
                "collision time and standard deviation being the highest among all algorithms."),
@@ -121,20 +123,20 @@ PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
                "resources collected per robot as the number of robots increases."),
     PaperClaim(2, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −44 %",
                f"On the other hand, {_C} collects ≈44% fewer resources than DDSA as the number of "
-               "robots increases from 14 to 32.", min_cell=14),
+               "robots increases from 14 to 32.", min_cell=14, sign=-1),
     PaperClaim(2, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −21 % … −58 %",
                f"As the number of robots increases, {_D} spends the least amount of time in "
-               "collisions, achieving ≈21% to ≈58% less collision time than DDSA."),
+               "collisions, achieving ≈21% to ≈58% less collision time than DDSA.", sign=-1),
     PaperClaim(2, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0, rising sharply with robots",
                f"Increasing the number of robots has a significant effect on the collision times for "
                f"{_C}, with the collision time increasing sharply compared to DDSA."),
     PaperClaim(2, "foraging_rate_per_min", "ddsa", "mdbsa_c", "≈ −24 % (Fig. 9)",
                f"In simulations with 16 or more robots, robots collect ≈24% fewer resources than DDSA "
-               f"in {_C}.", min_cell=16),
+               f"in {_C}.", min_cell=16, sign=-1),
     # ---- experiment 3 (Fig. 10)
     PaperClaim(3, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −30.4 %",
                f"Lastly, Fig. 10 displays the results for Experiment 3. {_C} collects ≈30.4% fewer "
-               "resources than DDSA."),
+               "resources than DDSA.", sign=-1),
     PaperClaim(3, "resources_per_robot", "ddsa", "mdbsa_d", "≈ +60 % … +350 %", _EXP3_COLLECTION_QUOTE),
     PaperClaim(3, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0 (highest of the three)",
                f"{_C} displays an upward trend with decreasing momentum in the collision time as the "
@@ -286,6 +288,38 @@ def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells:
     return written
 
 
+def spiral_headlines(rows: Sequence[dict], experiment: int, cells: Sequence[int],
+                     strategies: Sequence[str]) -> list[Headline]:
+    """The paper's reported differences for `experiment`, each checked in every cell it covers
+    with the paper's own test (two-sided Mann-Whitney U, p < 0.05): a claimed rise or fall holds
+    when every covered cell moves that way significantly, "similar" when no cell differs."""
+    out = []
+    for c in PAPER_SPIRAL_CLAIMS:
+        if c.experiment != experiment:
+            continue
+        claim = (f"{SPIRAL_METRICS.get(c.metric, c.metric)}: {label(c.b, SPIRAL_LABELS)} vs "
+                 f"{label(c.a, SPIRAL_LABELS)}")
+        covered = [cell for cell in cells if c.covers(cell)]
+        if c.a not in strategies or c.b not in strategies or not covered:
+            out.append(Headline(claim, c.paper, "not run", None))
+            continue
+        parts, verdicts = [], []
+        for cell in covered:
+            va, vb = values_of(rows, c.a, cell, c.metric), values_of(rows, c.b, cell, c.metric)
+            _, p = pair_test(va, vb, "u")
+            diff = pct_change(describe(va).mean, describe(vb).mean)
+            parts.append(f"{cell}: {fmt_pct(diff)} {stars(p, ns='-')}")
+            if not (math.isfinite(p) and math.isfinite(diff)):
+                verdicts.append(None)
+            elif c.sign == 0:
+                verdicts.append(p >= 0.05)
+            else:
+                verdicts.append(p < 0.05 and diff * c.sign > 0)
+        holds = None if None in verdicts else all(verdicts)
+        out.append(Headline(claim, c.paper, f"({SPIRAL_EXPERIMENTS[experiment].vary}) " + ", ".join(parts), holds))
+    return out
+
+
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--experiment", type=int, choices=sorted(SPIRAL_EXPERIMENTS), required=True)
     parser.add_argument("--values", type=int, nargs="+",
@@ -309,6 +343,11 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_spiral_report(rows, out, args.experiment, args.values or exp.values, strategies)
 
 
+def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
+    exp = SPIRAL_EXPERIMENTS[args.experiment]
+    return spiral_headlines(rows, args.experiment, args.values or exp.values, strategies)
+
+
 SPIRAL_COMPARISON = Comparison(
     name="spiral",
     help="MDBSA paper: experiments 1-3, Figs 6-10, Mann-Whitney U",
@@ -318,4 +357,6 @@ SPIRAL_COMPARISON = Comparison(
     plans=_plans,
     write_report=_write_report,
     out_dir=_out_dir,
+    reproduce=tuple(("--experiment", str(n)) for n in sorted(SPIRAL_EXPERIMENTS)),
+    headlines=_headlines,
 )

@@ -1,25 +1,32 @@
 """The resumable sweep: run plans for every seed and append each result to ``results.jsonl`` at once.
 
-An interrupted sweep keeps what it finished and ``--resume`` runs only what is missing. A run is
-identified by its strategy (scenario name), its settings (the overrides and fields it was loaded
-with) and its seed. The sweep takes its runner as an argument so tests can feed it fake summaries.
+An interrupted sweep keeps what it finished and ``--resume`` runs only what is missing, whatever
+executed the runs (`swarm_sim.executors`: local pool or Dask), since the bookkeeping happens here,
+as each run's outcome arrives. A run is identified by its strategy (scenario name), its settings
+(the overrides and fields it was loaded with) and its seed. A run that raises is appended to
+``failed.jsonl`` with its error and the sweep goes on; ``--resume`` tries it again. The per-run
+function is an argument so tests can feed the sweep fake summaries.
 """
 
 from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from swarm_sim.compare.report import fmt
+from swarm_sim.executors import Executor, LocalExecutor, Progress
 
-Runner = Callable[[str, list[str], dict, list[int], int], Iterable[dict]]
-"""`swarm_sim.batch.run_many`'s signature: (scenario, overrides, fields, seeds, jobs) -> summaries."""
+RunFunction = Callable[[tuple[str, tuple[str, ...], dict, int]], dict]
+"""`swarm_sim.batch.run_one`'s signature: (scenario, overrides, fields, seed) -> summary; a
+module-level function, since executors pickle it."""
 
 RESULTS = "results.jsonl"
+FAILED = "failed.jsonl"
+"""Next to the results: one line per failed run (strategy, cell, settings, seed, error)."""
 
 
 def frozen_fields(fields: dict[str, Any]) -> tuple[tuple[str, Any], ...]:
@@ -72,10 +79,18 @@ def read_results(path: Path) -> list[dict[str, Any]]:
     return rows
 
 
-def _default_runner(name: str, overrides: list[str], fields: dict, seeds: list[int], jobs: int):
-    from swarm_sim.batch import run_many  # heavy (pybullet, controllers): only when running
+def _default_run(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
+    from swarm_sim.batch import run_one  # heavy (pybullet, controllers): only when running
 
-    return run_many(name, overrides, fields, seeds, jobs)
+    return run_one(job)
+
+
+@dataclass
+class SweepResult:
+    rows: list[dict[str, Any]]
+    """This sweep's rows (old and new), in plan order then seed order."""
+    failed: list[dict[str, Any]] = field(default_factory=list)
+    """The runs that raised in this sweep: their plan keys, seed and ``error``."""
 
 
 def run_sweep(
@@ -83,57 +98,61 @@ def run_sweep(
     seeds: Sequence[int],
     path: Path,
     *,
-    jobs: int = 1,
-    runner: Runner | None = None,
+    executor: Executor | None = None,
+    run: RunFunction | None = None,
     resume: bool = False,
     log: Callable[[str], None] = print,
-    on_error: Callable[[RunPlan, Exception], None] | None = None,
-) -> list[dict[str, Any]]:
-    """Run every plan for every seed, appending each result to `path` as it arrives.
+) -> SweepResult:
+    """Run every plan for every seed on `executor`, appending each result to `path` as it arrives.
 
     With `resume`, runs already in `path` (same strategy, settings and seed) are skipped; without
-    it `path` must not hold results yet. A plan whose runner raises is reported to `on_error` and
-    the sweep goes on with the next plan (without `on_error` the exception propagates).
-    Returns the rows of these plans (old and new).
+    it `path` must not hold results yet. Failed runs go to ``failed.jsonl`` beside `path` and the
+    sweep goes on. An interrupt (KeyboardInterrupt) propagates; every finished run is on disk.
     """
-    runner = runner or _default_runner
+    executor = executor or LocalExecutor(1)
+    run = run or _default_run
     old = read_results(path)
     if old and not resume:
         raise FileExistsError(f"{path} already holds {len(old)} runs; use --resume or --overwrite")
-    keys = {(p.strategy, p.settings) for p in plans}
+    order = {(p.strategy, p.settings): i for i, p in enumerate(plans)}
     done = {(r.get("strategy"), r.get("settings"), r.get("seed")) for r in old}
-    rows = [r for r in old if (r.get("strategy"), r.get("settings")) in keys]
-    todo = [(p, [s for s in seeds if (p.strategy, p.settings, s) not in done]) for p in plans]
-    total = sum(len(s) for _, s in todo)
+    rows = [r for r in old if (r.get("strategy"), r.get("settings")) in order]
+    todo = [(p, s) for p in plans for s in seeds if (p.strategy, p.settings, s) not in done]
     if resume and old:
-        log(f"resume: {len(rows)} runs of this sweep already in {path}, {total} to go")
+        log(f"resume: {len(rows)} runs of this sweep already in {path}, {len(todo)} to go")
     path.parent.mkdir(parents=True, exist_ok=True)
+    _end_line(path)
+    _end_line(path.parent / FAILED)
+    failed: list[dict[str, Any]] = []
+    jobs = [(p.strategy, tuple(p.overrides), dict(p.fields), s) for p, s in todo]
+    with Progress(len(jobs), f"sweep ({executor.name}, {executor.workers} workers)") as bar:
+        for outcome in executor.map(run, jobs):
+            plan, seed = todo[outcome.index]
+            ours = {"strategy": plan.strategy, "cell": plan.cell, **dict(plan.extra), "settings": plan.settings}
+            if outcome.ok:
+                row = {**ours, **slim(outcome.value), **ours}  # ours first in the line, and ours win
+                _append(path, row)
+                rows.append(row)
+                bar.write(f"{plan.strategy} cell={plan.cell} seed={row.get('seed')}: delivered "
+                          f"{row.get('resources_delivered')}/{row.get('total_resources')}, collision "
+                          f"{fmt(row.get('collision_time_per_robot_s'))} s/robot", log)
+            else:
+                failure = {**ours, "seed": seed, "error": outcome.error}
+                _append(path.parent / FAILED, failure)
+                failed.append(failure)
+                bar.write(f"FAILED {plan.strategy} cell={plan.cell} seed={seed}: {outcome.error}", log)
+            bar.update(ok=outcome.ok)
+    rows.sort(key=lambda r: (order[(r.get("strategy"), r.get("settings"))], r.get("seed", 0)))
+    return SweepResult(rows, failed)
+
+
+def _end_line(path: Path) -> None:
+    """A line cut short by an interrupted write must not swallow the next one."""
     if path.exists() and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
         with path.open("a") as f:
-            f.write("\n")  # a line cut short must not swallow the next one
-    start = len(rows)
-    for plan, plan_seeds in todo:
-        if not plan_seeds:
-            continue
-        try:
-            _run_plan(plan, plan_seeds, path, jobs, runner, rows, start, total, log)
-        except Exception as exc:
-            if on_error is None:
-                raise
-            on_error(plan, exc)
-    return rows
+            f.write("\n")
 
 
-def _run_plan(plan: RunPlan, seeds: list[int], path: Path, jobs: int, runner: Runner,
-              rows: list[dict], start: int, total: int, log: Callable[[str], None]) -> None:
-    """Run one plan, appending each row to `path` and to `rows` (which held `start` before the sweep)."""
-    results = runner(plan.strategy, list(plan.overrides), dict(plan.fields), list(seeds), jobs)
-    for summary in results:
-        ours = {"strategy": plan.strategy, "cell": plan.cell, **dict(plan.extra), "settings": plan.settings}
-        row = {**ours, **slim(summary), **ours}  # ours first in the line, and ours win
-        with path.open("a") as f:
-            f.write(json.dumps(row) + "\n")
-        rows.append(row)
-        log(f"[{len(rows) - start}/{total}] {plan.strategy} cell={plan.cell} seed={row.get('seed')}: "
-            f"delivered {row.get('resources_delivered')}/{row.get('total_resources')}, "
-            f"collision {fmt(row.get('collision_time_per_robot_s'))} s/robot")
+def _append(path: Path, row: dict[str, Any]) -> None:
+    with path.open("a") as f:
+        f.write(json.dumps(row) + "\n")

@@ -4,7 +4,8 @@ Like ``ros2 bag record -a``: the world writes what it publishes (and the command
 receives) as the very bytes on the wire, and `discover` subscribes to every topic other nodes
 publish, recording each message stamped with the sim time at which it arrives. Latched topics
 (servers' state and markers) are subscribed transient-local, so their last message is recorded
-even if it was published before the recorder subscribed.
+even if it was published before the recorder subscribed. With a `LiveView` every topic and
+message also goes to the Foxglove clients, as the same bytes.
 """
 
 from __future__ import annotations
@@ -16,28 +17,45 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 
 from swarm_msgs_py import topics
-from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED
+from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_profile
+from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.recording import BagWriter
 
 
 class Recorder:
-    """Records into one bag directory; `now_ns` gives the sim time to stamp messages with."""
+    """Records into one bag directory (None: no bag) and feeds `live` (None: no live view);
+    `now_ns` gives the sim time to stamp messages with."""
 
-    def __init__(self, node: Node, path: Path, metadata: dict[str, str], now_ns: Callable[[], int]) -> None:
+    def __init__(self, node: Node, path: Path | None, metadata: dict[str, str], now_ns: Callable[[], int],
+                 live: LiveView | None = None) -> None:
         self._node = node
         self._now_ns = now_ns
-        self.bag = BagWriter(path, metadata=metadata)
+        self.bag = BagWriter(path, metadata=metadata) if path is not None else None
+        self.live = live
         self.known: set[str] = set()
         """Topics recorded already (by the world itself or by discovery)."""
+        self._latched: set[str] = set()
         self.closed = False
 
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
         """A topic the world writes itself."""
         self.known.add(topic)
-        self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
+        self._add(topic, type_name, latched)
+
+    def _add(self, topic: str, type_name: str, latched: bool) -> None:
+        if latched:
+            self._latched.add(topic)
+        if self.bag is not None:
+            self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
+        if self.live is not None:
+            self.live.add(topic, type_name, latched)
 
     def write(self, topic: str, data: bytes) -> None:
-        self.bag.write(topic, self._now_ns(), data)
+        now = self._now_ns()
+        if self.bag is not None:
+            self.bag.write(topic, now, data)
+        if self.live is not None:
+            self.live.write(topic, now, data)
 
     def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
         """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
@@ -54,19 +72,45 @@ class Recorder:
                 info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
                 for info in node.get_publishers_info_by_topic(topic)
             )
-            self.bag.add_topic(topic, types[0], "latched" if latched else "reliable")
+            self._add(topic, types[0], latched)
             node.create_subscription(
                 msg_type, topic, lambda data, t=topic: self.write(t, data),
                 RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
+    def record_offered_qos(self) -> None:
+        """Write each topic's offered QoS (one profile per publisher, as the graph reports it) and
+        type description hash into the bag, as ``ros2 bag record`` does; topics without a
+        publisher left keep the profile they were added with."""
+        if self.bag is None:
+            return
+        for topic in sorted(self.known):
+            try:
+                infos = self._node.get_publishers_info_by_topic(topic)
+            except Exception:  # noqa: BLE001 - the graph is gone (shutdown): keep the defaults
+                return
+            if not infos:
+                continue
+            depth = published_depth(topic, topic in self._latched)
+            profiles = []
+            for info in infos:
+                profile = rosbag2_profile(info.qos_profile, depth)
+                if profile not in profiles:
+                    profiles.append(profile)
+            self.bag.set_offered_qos(topic, profiles, str(infos[0].topic_type_hash))
+
     def poll(self) -> None:
         """Flush and split on time (call it while spinning, even when the run is stalled)."""
-        self.bag.poll()
+        if self.bag is not None:
+            self.bag.poll()
 
     def close(self, **metadata: str) -> None:
         """Write the run's totals into the metadata and finish the bag (idempotent)."""
         if not self.closed:
             self.closed = True
-            self.bag.set_metadata(**metadata)
-            self.bag.close()
+            if self.live is not None:
+                self.live.close()
+            if self.bag is not None:
+                self.record_offered_qos()
+                self.bag.set_metadata(**metadata)
+                self.bag.close()

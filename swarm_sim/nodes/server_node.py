@@ -7,6 +7,11 @@ world's lockstep barrier knows the answers are out. A repeated tick (the world r
 ``/clock`` when an ack is late) is only acknowledged again. This is exactly what the batch
 runner does in process, so graph and batch runs agree.
 
+Inbound messages are untrusted (`swarm_sim.inbound`); what is dropped, here or by the core, is
+counted on ``/diagnostics``. The node also hears the world's ``node_down`` events and, at the
+next tick, tells its core which robots were declared dead (`Server.robot_lost`), so a dead
+robot's dock, slots or region go to others.
+
 The node creates its ack publisher only once it has matched every robot on its topics, so
 the world, which waits for that publisher before the first tick, cannot start too early.
 """
@@ -24,16 +29,17 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, topics
+from swarm_msgs_py import ack, diagnostics, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
-from swarm_msgs_py.records import post_all
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim import registry
+from swarm_sim.inbound import Inbound, Reason, Rejections, merged
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import Server
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
+from swarm_sim.types import NodeDownEvent
 
 
 @dataclass(frozen=True)
@@ -55,8 +61,7 @@ class ServerNode(Node):
 
     def __init__(self, name: str, config: ServerNodeConfig | None = None, **kwargs) -> None:
         super().__init__(
-            name, start_parameter_services=False,
-            parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
+            name, parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
         )
         self.config = cfg = declare_config(self, ServerNodeConfig, config)
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
@@ -65,11 +70,18 @@ class ServerNode(Node):
             raise ValueError(f"{self.scenario.controller.behaviour} registers no {self.CHANNEL!r} server")
         self.server: Server = registry.resolve(specs[0].core)(self.scenario)
         self.mailbox = Mailbox()
+        self.rejections = Rejections()
+        self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
+                               self.get_logger().warning)
+        self._published_rejections: dict = {}
+        self.lost: list[str] = []
+        """Robots the world declared dead, not yet told to the core."""
         self._done = -1
         inbound, outbound = registry.server_topics(specs[0])
         self._inbound = [
             self.create_subscription(
-                topics.import_type(f.type_name), t, lambda data, f=f: self._on_message(f, data), EVENTS, raw=True
+                topics.import_type(f.type_name), t,
+                lambda data, t=t, f=f: self.inbound.post_all(t, f, data, self.mailbox.post), EVENTS, raw=True,
             )
             for t, f in inbound.items()
         ]
@@ -78,6 +90,10 @@ class ServerNode(Node):
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,
                                  SENSOR_LOCKSTEP, raw=True)
+        self.create_subscription(topics.type_of(topics.WORLD_EVENTS), topics.WORLD_EVENTS, self._on_world_events,
+                                 EVENTS, raw=True)
+        self._diagnostics_pub = self.create_publisher(
+            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
         self._ack_pub = None
 
     def publish_state(self, stamp_ns: int) -> None:
@@ -97,14 +113,34 @@ class ServerNode(Node):
             topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP
         )
 
-    def _on_message(self, family, data: bytes) -> None:
-        post_all(family, data, self.mailbox.post, self.get_logger().warning)
+    def _on_world_events(self, data: bytes) -> None:
+        try:
+            _, events = diagnostics.decode_events(data)
+        except ValueError as exc:
+            self.inbound.reject(topics.WORLD_EVENTS, Reason.MALFORMED, str(exc)[:200])
+            return
+        for e in events:
+            if isinstance(e, NodeDownEvent) and e.kind == "robot":
+                if e.node in self.inbound.robots:
+                    self.lost.append(e.node)
+                else:
+                    self.inbound.reject(topics.WORLD_EVENTS, Reason.UNKNOWN_ROBOT, f"node_down for {e.node[:40]!r}")
 
     def _on_clock(self, data: bytes) -> None:
         if self._ack_pub is None:
             return
-        stamp = clock_codec.decode_clock(data)
+        try:
+            stamp = clock_codec.decode_clock(data)
+        except ValueError as exc:
+            self.inbound.reject(topics.CLOCK, Reason.MALFORMED, str(exc)[:200])
+            return
         if stamp > self._done:
+            self.inbound.now_ns = self.inbound.released_ns = stamp
+            for robot in self.lost:
+                if hasattr(self.server, "robot_lost"):
+                    self.server.robot_lost(robot, stamp)
+                self.get_logger().warning(f"{robot} was declared dead: freed what it held")
+            self.lost = []
             out = self.server.step(stamp, self.mailbox.take_before(stamp))
             by_topic: dict[str, list] = defaultdict(list)
             for m in out:
@@ -114,6 +150,11 @@ class ServerNode(Node):
                 for data in family.encode(stamp, messages):
                     pub.publish(data)
             self.publish_state(stamp)
+            counts = merged(self.rejections, getattr(self.server, "rejections", None))
+            if counts != self._published_rejections:
+                self._published_rejections = counts
+                self._diagnostics_pub.publish(
+                    diagnostics.encode_rejections(stamp, self.get_fully_qualified_name(), counts))
             self._done = stamp
         if stamp == self._done:
             self._ack_pub.publish(ack.encode_ack(self.CHANNEL, stamp))

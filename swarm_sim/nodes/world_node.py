@@ -3,9 +3,11 @@
 Lockstep (default): for each tick k it publishes ``/clock`` and every robot's observations
 stamped k, waits until every live controller has answered with a ``cmd_vel`` stamped k and
 every server the scenario needs (center, depot manager) with a ``/lockstep/ack`` stamped k (a
-controller silent for `tick_timeout` wall seconds is counted stale and keeps its last command;
-after `dead_after` stale ticks in a row it is no longer waited for until it answers again),
-then steps the core. Free-running (`realtime`): steps every dt / real_time_factor wall
+controller silent for `tick_timeout` wall seconds is counted stale and keeps its last command),
+then steps the core. A node stale `dead_after` ticks in a row is declared dead for good
+(`swarm_sim.nodes.lockstep`), with a ``node_down`` event on ``/world/events``: a dead robot
+stands still to the end and the servers free what it held; a dead server ends the run there
+(the bag says ``ended: server <channel> died``). Free-running (`realtime`): steps every dt / real_time_factor wall
 seconds with whatever commands have arrived.
 
 Observations (and the world task's state topics, e.g. the caging object's pose) are encoded
@@ -37,11 +39,21 @@ from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import number
+from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.recorder import Recorder
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario, scenario_to_dict
-from swarm_sim.types import NS_PER_S, Command, Observation, RobotId
+from swarm_sim.scenario import (
+    DEFAULT_SCENARIO,
+    Scenario,
+    load_scenario,
+    scenario_to_dict,
+)
+from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
+
+
+_IMPORTED = time.monotonic()
+"""When this module's imports were done (start-up lines count from here)."""
 
 
 class Interrupted(Exception):
@@ -63,7 +75,8 @@ class WorldNodeConfig:
     """Lockstep: wall seconds after which a tick's observations are re-sent to controllers
     that have not answered (they answer a repeated tick with their cached command)."""
     dead_after: int = 3
-    """Lockstep: stale ticks in a row after which a controller is no longer waited for."""
+    """Lockstep: stale ticks in a row after which a node (controller or server) is declared
+    dead: with the default tick timeout, 6 s of silence."""
     real_time_factor: float = 1.0
     """Realtime mode: target sim seconds per wall second."""
     bag: str = ""
@@ -76,6 +89,11 @@ class WorldNodeConfig:
     """Sim seconds between ``/world/robot_stats`` messages."""
     markers_period: float = 5.0
     """Sim seconds between ``/world/markers`` messages."""
+    foxglove_port: int = -1
+    """Serve the run live over the Foxglove WebSocket protocol on this port (0: any free port;
+    -1: no live view), `swarm_sim.nodes.live_view`."""
+    foxglove_host: str = "127.0.0.1"
+    """Address the live view binds (loopback unless asked otherwise)."""
 
 
 class WorldNode(Node):
@@ -87,7 +105,7 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recorder = self._open_recorder(cfg.bag) if cfg.bag else None
+        self.recorder = self._open_recorder(cfg.bag) if cfg.bag or cfg.foxglove_port >= 0 else None
 
         self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
         self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
@@ -117,9 +135,19 @@ class WorldNode(Node):
         """Server channels (center, depot) the barrier waits for besides the robots."""
         self.server_stale_ticks = dict.fromkeys(self.servers, 0)
         """Lockstep ticks each server (by channel) did not acknowledge in time."""
-        self.rejected_commands = 0
-        """Lockstep: commands stamped for a tick other than the current one (ignored)."""
+        self.rejections = Rejections()
+        """Commands and acks dropped: malformed, for another tick, from a dead or unknown node."""
+        self._published_rejections: dict = {}
+        # Latched and not recorded by the world itself: every node publishes its counts here and
+        # the recorder records them all (its own included) through one subscription.
+        self._diagnostics_pub = self.create_publisher(
+            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
         self.barrier = LockstepBarrier((*self.robots, *self.servers), cfg.dead_after)
+        self.down: list[NodeDownEvent] = []
+        """Nodes declared dead, in order."""
+        self._down_events: list[NodeDownEvent] = []
+        self.ended = "complete"
+        """How the run ended: ``complete``, ``interrupted`` or ``server <channel> died``."""
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
@@ -159,28 +187,41 @@ class WorldNode(Node):
             "mode": self.config.mode,
             "robots": str(len(self.world.robots)),
         }
-        return Recorder(self, Path(path), meta, lambda: self.world.t_ns)
+        live = None
+        if self.config.foxglove_port >= 0:
+            from swarm_sim.nodes.live_view import LiveView
+
+            live = LiveView(self.config.foxglove_port, self.config.foxglove_host)
+        return Recorder(self, Path(path) if path else None, meta, lambda: self.world.t_ns, live)
 
     def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
         if send:
             pub.publish(data)
         self._record(topic, data)
 
+    def _reject(self, where: str, reason: Reason, detail: str) -> None:
+        if self.rejections.add(where, reason, detail):
+            self.get_logger().warning(self.rejections.log_line(where, reason))
+
+    @property
+    def rejected_commands(self) -> int:
+        """Commands dropped so far (any reason)."""
+        return sum(n for (where, _), n in self.rejections.counts.items() if where.endswith("/" + topics.CMD_VEL))
+
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        self._record(topics.robot_topic(robot, topics.CMD_VEL), data)
+        topic = topics.robot_topic(robot, topics.CMD_VEL)
+        self._record(topic, data)
         try:
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
-            self.get_logger().warning(f"{robot}: dropping malformed cmd_vel: {exc}")
+            self._reject(topic, Reason.MALFORMED, str(exc))
+            return
+        if robot in self.barrier.dead:
+            self._reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
             # A command for another tick (late, or forged on the bus) would break lockstep.
-            self.rejected_commands += 1
-            if self.rejected_commands == 1 or self.rejected_commands % 1000 == 0:
-                self.get_logger().warning(
-                    f"{robot}: ignoring a cmd_vel stamped {stamp_ns} ns at tick {self.world.t_ns} ns "
-                    f"({self.rejected_commands} so far)"
-                )
+            self._reject(topic, Reason.WRONG_TICK, f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
             return
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
@@ -190,9 +231,14 @@ class WorldNode(Node):
         try:
             channel, stamp_ns = ack_codec.decode_ack(data)
         except ValueError as exc:
-            self.get_logger().warning(f"dropping malformed lockstep ack: {exc}")
+            self._reject(topics.LOCKSTEP_ACK, Reason.MALFORMED, str(exc))
             return
-        self.barrier.answered(channel, stamp_ns)
+        if channel not in self.servers:
+            self._reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
+        elif channel in self.barrier.dead:
+            self._reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
+        else:
+            self.barrier.answered(channel, stamp_ns)
 
     def _discover(self) -> None:
         """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
@@ -231,7 +277,8 @@ class WorldNode(Node):
 
     def _publish_world_state(self, final: bool = False) -> None:
         t_ns = self.world.t_ns
-        events = self.world.drain_events()
+        events = [*self._down_events, *self.world.drain_events()]
+        self._down_events = []
         if events:
             self._publish(self._events_pub, diagnostics.encode_events(t_ns, events), topics.WORLD_EVENTS)
         stats_every = max(1, round(self.config.stats_period / self.scenario.sim.dt))
@@ -244,10 +291,26 @@ class WorldNode(Node):
                 self.scenario, t_ns, self.world.task.placed(), self.world.true_poses()
             )
             self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
+        counts = dict(sorted(self.rejections.counts.items()))
+        if counts != self._published_rejections:
+            self._published_rejections = counts
+            self._diagnostics_pub.publish(diagnostics.encode_rejections(t_ns, self.get_fully_qualified_name(), counts))
+
+    def _start_live_view(self) -> None:
+        """Serve Foxglove clients once the run's topics exist (`swarm_sim.nodes.live_view`)."""
+        live = self.recorder.live if self.recorder is not None else None
+        if live is not None:
+            self._discover()
+            live.start()
+            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
 
     def wait_for_controllers(self, executor: Executor) -> None:
-        deadline = time.monotonic() + self.config.startup_timeout
+        start = time.monotonic()
+        print(f"[world] up ({start - _IMPORTED:.1f} s after its imports to build the world and the topics of "
+              f"{len(self.robots)} robots); waiting for the controllers{' and servers' if self.servers else ''} to connect", flush=True)
+        deadline = start + self.config.startup_timeout
         missing = list(self.robots)
+        said = start
         while missing and time.monotonic() < deadline:
             self._spin(executor, 0.1)
             missing = [
@@ -257,6 +320,11 @@ class WorldNode(Node):
             ]
             if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
                 missing.append("servers (" + ", ".join(self.servers) + ")")
+            if missing and time.monotonic() - said >= self.config.progress_period:
+                said = time.monotonic()
+                self.print_startup(missing, said - start)
+        print(f"[world] {len(self.robots) - len([m for m in missing if m in self._cmd_subs])}/{len(self.robots)} "
+              f"controllers connected after {time.monotonic() - start:.1f} s: starting", flush=True)
         if missing:
             self.get_logger().warning(
                 f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
@@ -310,10 +378,18 @@ class WorldNode(Node):
             else:
                 self.server_stale_ticks[r] += 1
         for r in dead:
-            self.get_logger().warning(f"{r}: no answer for {self.barrier.dead_after} ticks, not waiting for it; "
-                                      "it stands still until it answers again")
-            if r in self._commands:
+            kind = "robot" if r in self.world.stats else "server"
+            event = NodeDownEvent(r, stamp, kind, self.barrier.dead_after)
+            self.down.append(event)
+            self._down_events.append(event)
+            if kind == "robot":
+                self.get_logger().error(f"{r}: no answer for {self.barrier.dead_after} ticks: declared dead; "
+                                        "its robot stands still to the end and the servers free what it held")
                 self._commands[r] = Command()  # a dead controller's robot must not drive on blind
+            else:
+                self.get_logger().error(f"server {r}: no ack for {self.barrier.dead_after} ticks: declared dead; "
+                                        "the run ends here")
+                self.ended = f"server {r} died"
 
     def _await_wall(self, executor: Executor, until: float) -> None:
         while (remaining := until - time.monotonic()) > 0:
@@ -326,6 +402,7 @@ class WorldNode(Node):
         cfg, sim = self.config, self.scenario.sim
         self._discover()
         self.wait_for_controllers(executor)
+        self._start_live_view()
         obs = self.world.reset()
         wall0 = last_progress = time.monotonic()
         self.wall_start = wall0
@@ -344,12 +421,26 @@ class WorldNode(Node):
             if now - last_progress >= cfg.progress_period:
                 last_progress = now
                 self.print_progress(now - wall0)
+            if self.ended != "complete":
+                break
         self._publish_tick(obs, send=False)
         self._publish_world_state(final=True)
         # Let the controllers' last status messages reach the recorder.
         end = time.monotonic() + 0.5
         while time.monotonic() < end:
             self._spin(executor, 0.05)
+
+    def print_startup(self, missing: list[str], waited: float) -> None:
+        """What the start-up is waiting for (nodes starting and discovering each other)."""
+        robots = [m for m in missing if m in self._cmd_subs]
+        others = [m for m in missing if m not in self._cmd_subs]
+        text = f"{len(self.robots) - len(robots)}/{len(self.robots)} controllers connected"
+        if robots:
+            text += f", waiting for {', '.join(robots[:3])}{' ...' if len(robots) > 3 else ''}"
+        if others:
+            text += f"; waiting for {', '.join(others)}"
+        print(f"[world] start-up {waited:5.1f} s: {text} (gives up after {self.config.startup_timeout:.0f} s)",
+              flush=True)
 
     def print_progress(self, wall: float) -> None:
         t = self.world.t_ns / NS_PER_S
@@ -366,6 +457,8 @@ class WorldNode(Node):
                 wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
                 sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
                 server_stale_ticks=json.dumps(self.server_stale_ticks),
+                ended=self.ended,
+                dead_nodes=json.dumps([e.node for e in self.down]),
             )
         self.world.close()
 
@@ -379,10 +472,14 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout)
     parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0)
     parser.add_argument("--bag", default="")
+    parser.add_argument("--foxglove", type=number(int, 0, 65535), default=-1, metavar="PORT",
+                        help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
+    parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host)
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
+        foxglove_port=args.foxglove, foxglove_host=args.foxglove_host,
     )
     return config, ros_args
 
@@ -410,6 +507,8 @@ def main(argv: list[str] | None = None) -> int:
             raise Interrupted
     except (KeyboardInterrupt, ExternalShutdownException, Interrupted):
         print("[world] interrupted: closing the bag", flush=True)
+        if node is not None:
+            node.ended = "interrupted"
     finally:
         if node is not None:
             node.close()

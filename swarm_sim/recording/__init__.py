@@ -20,11 +20,12 @@ A run that is killed must keep almost all of its data, so the writer
 The reader recovers every complete record of a file that was cut off mid-write and reports it
 (`BagInfo.truncated`, a `BagTruncatedWarning` naming the file); a bag without ``metadata.yaml`` is
 read from its ``*.mcap`` files alone. rosbags and ``ros2 bag`` need every file finalised, so they
-read a cleanly closed bag only.
+read a cleanly closed bag only; `repair_bag` (``swarm-analyze --repair``, and ``swarm-run`` itself
+when the world node died) rewrites a cut-off bag into one they read, losing nothing recovered.
 
 Modules: `metadata` (constants, errors, records, metadata.yaml and QoS text), `writer`
 (`BagWriter`), `mcap_file` (one MCAP file, record by record, with truncation recovery),
-`reader` (`read_bag`, `bag_info`).
+`reader` (`read_bag`, `bag_info`), `repair` (`repair_bag`).
 """
 
 from swarm_sim.recording.metadata import (
@@ -38,6 +39,7 @@ from swarm_sim.recording.metadata import (
     flatten_metadata,
 )
 from swarm_sim.recording.reader import bag_info, read_bag
+from swarm_sim.recording.repair import repair_bag
 from swarm_sim.recording.writer import BagWriter
 
 __all__ = [
@@ -52,4 +54,5 @@ __all__ = [
     "bag_info",
     "flatten_metadata",
     "read_bag",
+    "repair_bag",
 ]

@@ -179,17 +179,30 @@ def _load_yaml(text: str) -> Any:
 
 _TYPESTORE: Any = None
 _MSGDEFS: dict[str, str] = {}
+_HASHES: dict[str, str] = {}
+
+
+def _typestore() -> Any:
+    global _TYPESTORE
+    if _TYPESTORE is None:
+        from rosbags.typesys import Stores, get_typestore
+
+        _TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+    return _TYPESTORE
+
+
+def _type_hash(type_name: str) -> str:
+    """The type description hash (``RIHS01_...``, REP 2011) of a Jazzy message type, as the graph
+    reports it for a publisher and ``ros2 bag record`` writes it."""
+    if type_name not in _HASHES:
+        _HASHES[type_name] = _typestore().hash_rihs01(type_name)
+    return _HASHES[type_name]
 
 
 def _msgdef(type_name: str) -> str:
     """rosbag2's "ros2msg" schema text: the type's .msg, then each dependency after a ==== line."""
-    global _TYPESTORE
     if type_name not in _MSGDEFS:
-        if _TYPESTORE is None:
-            from rosbags.typesys import Stores, get_typestore
-
-            _TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
-        _MSGDEFS[type_name] = _TYPESTORE.generate_msgdef(type_name, ros_version=2)[0]
+        _MSGDEFS[type_name] = _typestore().generate_msgdef(type_name, ros_version=2)[0]
     return _MSGDEFS[type_name]
 
 

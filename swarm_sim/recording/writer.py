@@ -36,6 +36,7 @@ from swarm_sim.recording.metadata import (
     _normalize_type,
     _qos_profiles,
     _qos_yaml,
+    _type_hash,
     flatten_metadata,
 )
 
@@ -111,6 +112,10 @@ class BagWriter:
         self._fsync = fsync
         self._custom = flatten_metadata(metadata or {})
         self._topics: dict[str, _Topic] = {}
+        self._offered: dict[str, list[dict[str, Any]]] = {}
+        """Topic -> the offered QoS profiles its publishers reported (`set_offered_qos`)."""
+        self._hashes: dict[str, str] = {}
+        """Topic -> type description hash."""
         self._finished: list[_FileStats] = []
         self._lock = threading.Lock()
         self._closed = False
@@ -146,6 +151,7 @@ class BagWriter:
                 return
             try:
                 _msgdef(type_name)
+                self._hashes[name] = _type_hash(type_name)
             except Exception as exc:  # rosbags TypesysError and friends
                 raise BagError(
                     f"{self.path}: topic {name}: no message definition for {type_name!r} in the "
@@ -153,6 +159,19 @@ class BagWriter:
                 ) from None
             self._topics[name] = topic
             self._register(topic)
+
+    def set_offered_qos(self, name: str, profiles: list[Mapping[str, Any]], type_hash: str | None = None) -> None:
+        """The QoS profiles `name`'s publishers offer (rosbag2's per-policy dicts, one per
+        publisher, as ``ros2 bag record`` writes them) and the type hash the graph reports; they
+        replace the defaults `add_topic`'s `qos` implied in metadata.yaml and in the files opened
+        from now on."""
+        with self._lock:
+            self._check_open()
+            if name not in self._topics:
+                raise BagError(f"{self.path}: topic {name!r} not registered (call add_topic first)")
+            self._offered[name] = [dict(p) for p in profiles]
+            if type_hash:
+                self._hashes[name] = type_hash
 
     def write(self, topic: str, stamp_ns: int, data: bytes) -> None:
         """Append CDR bytes as they are (log time = publish time = stamp_ns [ns, sim time])."""
@@ -255,7 +274,8 @@ class BagWriter:
             topic.name,
             "cdr",
             schema,
-            {"offered_qos_profiles": _qos_yaml(topic.qos)},
+            {"offered_qos_profiles": _dump_yaml(self._offered[topic.name]) if topic.name in self._offered
+             else _qos_yaml(topic.qos)},
         )
         self._file.counts.setdefault(topic.name, 0)
 
@@ -342,8 +362,8 @@ class BagWriter:
                         "name": t.name,
                         "type": t.type_name,
                         "serialization_format": "cdr",
-                        "offered_qos_profiles": _qos_profiles(t.qos),
-                        "type_description_hash": "",
+                        "offered_qos_profiles": self._offered.get(t.name) or _qos_profiles(t.qos),
+                        "type_description_hash": self._hashes.get(t.name, ""),
                     },
                     "message_count": totals[t.name],
                 }

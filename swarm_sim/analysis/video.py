@@ -1,0 +1,291 @@
+"""A run's replay video from its bag alone (``swarm-analyze BAG --video out.mp4|out.gif``).
+
+One pass over the bag in log-time order keeps the state a frame needs and draws a frame whenever
+the sim clock passes the next frame time, so memory stays flat however long the run:
+
+- arena walls, drop zones and obstacles from the scenario in the bag's metadata;
+- the depot's lines, docks and owned slots (``/depot/markers``) and the center's regions and
+  planned spirals (``/center/markers``), as their servers last published them;
+- resources lying on the ground: the world's last ``/world/markers`` set, minus the pick-ups
+  (``/world/events``) since, matched by position;
+- robots at their recorded odometry, true size, with a heading tick, coloured by the behaviour
+  state they last reported (``/<robot>/status``), with a resource drawn on each carrier (between
+  its pick-up and drop events);
+- the sim clock and the deliveries so far.
+
+Frames are taken every ``speedup / fps`` sim seconds between `start` and `end`, rendered with
+matplotlib and encoded with imageio (its ffmpeg plugin for .mp4, Pillow for .gif). Markers are
+decoded with rosbags' Jazzy typestore; our own topics with the `swarm_msgs_py` codecs.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_sim.recording import BagError, bag_info, read_bag
+from swarm_sim.scenario import Scenario, scenario_from_dict
+from swarm_sim.sites import drop_zones
+from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
+
+FORMATS = (".mp4", ".gif")
+SIZE_PX = 720
+"""Frame width and height [px] (a multiple of 16, as H.264 wants)."""
+_DPI = 100
+_PALETTE = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink",
+            "tab:olive", "tab:cyan", "tab:gray")
+_MARKER_TYPES = "visualization_msgs/msg/MarkerArray"
+_LINE_STRIP, _CUBE_LIST, _SPHERE_LIST = 4, 6, 7
+"""visualization_msgs/Marker types drawn from the servers' markers."""
+
+
+@dataclass
+class _State:
+    """What the frame at the current sim time shows."""
+
+    odom: dict[int, bytes] = field(default_factory=dict)
+    """Robot index -> its last odometry message (decoded only when a frame is drawn)."""
+    state: dict[int, str] = field(default_factory=dict)
+    carrying: set[str] = field(default_factory=set)
+    resources: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    delivered: int = 0
+    lines: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    """Servers' line markers by namespace (entry lines, regions, planned paths)."""
+    points: dict[str, np.ndarray] = field(default_factory=dict)
+    """Servers' point markers by namespace (docks, owned slots)."""
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    path: Path
+    frames: int
+    start_s: float
+    end_s: float
+
+
+def _markers(data: bytes) -> list:
+    from rosbags.typesys import Stores, get_typestore
+
+    global _STORE
+    if _STORE is None:
+        _STORE = get_typestore(Stores.ROS2_JAZZY)
+    return _STORE.deserialize_cdr(data, _MARKER_TYPES).markers
+
+
+_STORE = None
+
+
+def _xy(marker) -> np.ndarray:
+    return np.array([(p.x, p.y) for p in marker.points], dtype=float).reshape(-1, 2)
+
+
+def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int]) -> None:
+    """Fold one recorded message into the state."""
+    if topic.endswith("/" + topics.ODOM):
+        i = robots.get(topic[1:].partition("/")[0])
+        if i is not None:
+            state.odom[i] = data
+    elif topic.endswith("/" + topics.STATUS):
+        status = diagnostics.decode_status(data)
+        if status.robot in robots:
+            state.state[robots[status.robot]] = status.state
+    elif topic == topics.WORLD_EVENTS:
+        for event in diagnostics.decode_events(data)[1]:
+            if isinstance(event, PickupEvent):
+                state.carrying.add(event.robot)
+                if len(state.resources):
+                    gone = np.argmin(np.hypot(*(state.resources - (event.x, event.y)).T))
+                    state.resources = np.delete(state.resources, gone, axis=0)
+            elif isinstance(event, DropEvent):
+                state.carrying.discard(event.robot)
+                state.delivered += 1
+    elif topic == topics.WORLD_MARKERS:
+        for m in _markers(data):
+            if m.ns == "resources":
+                state.resources = _xy(m)
+    elif topic in (topics.DEPOT_MARKERS, topics.CENTER_MARKERS):
+        lines: dict[str, list[np.ndarray]] = {}
+        for m in _markers(data):
+            if m.type == _LINE_STRIP:
+                lines.setdefault(m.ns, []).append(_xy(m))
+            elif m.type in (_CUBE_LIST, _SPHERE_LIST):
+                state.points[m.ns] = _xy(m)
+        state.lines.update(lines)
+
+
+class _Canvas:
+    """One matplotlib figure whose artists are updated per frame."""
+
+    _LINE_STYLE = {"entry_lines": ("0.2", 0.8), "exit_lines": ("tab:blue", 0.8), "inner_queues": ("tab:purple", 0.8),
+                   "regions": ("0.6", 0.6), "planned_paths": ("0.8", 0.4)}
+    _POINT_STYLE = {"docks": ("tab:green", 30, "s"), "slots_owned": ("black", 8, "o"),
+                    "entry_points": ("0.2", 10, "o"), "exit_points": ("tab:blue", 10, "o")}
+
+    def __init__(self, scenario: Scenario, robots: int) -> None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from matplotlib.collections import EllipseCollection, LineCollection
+
+        self.scenario = scenario
+        inch = SIZE_PX / _DPI
+        self.fig, ax = plt.subplots(figsize=(inch, inch), dpi=_DPI)
+        self.ax = ax
+        half = scenario.arena.size / 2
+        ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="black", lw=1.5)
+        for zone in drop_zones(scenario):
+            ax.add_patch(plt.Circle(zone.center, zone.radius, color="tab:green", alpha=0.25, lw=0))
+        for ob in scenario.obstacles:
+            w, h = ob.size
+            ax.add_patch(plt.Rectangle((ob.center[0] - w / 2, ob.center[1] - h / 2), w, h, color="tab:brown",
+                                       alpha=0.7))
+        margin = 0.05 * scenario.arena.size
+        ax.set(xlim=(-half - margin, half + margin), ylim=(-half - margin, half + margin), aspect="equal",
+               xticks=[], yticks=[])
+        self.server_lines = LineCollection([], linewidths=0.8, zorder=1)
+        ax.add_collection(self.server_lines)
+        self.server_points = ax.scatter([], [], s=[], zorder=2)
+        self.resources = ax.scatter([], [], s=4, color="goldenrod", zorder=3, lw=0)
+        d = scenario.robots.diameter
+        self.robots = EllipseCollection(np.full(robots, d), np.full(robots, d), np.zeros(robots), units="xy",
+                                        offsets=np.zeros((robots, 2)), offset_transform=ax.transData,
+                                        edgecolors="black", linewidths=0.3, zorder=4)
+        ax.add_collection(self.robots)
+        self.headings = LineCollection([], colors="black", linewidths=0.6, zorder=5)
+        ax.add_collection(self.headings)
+        self.carried = ax.scatter([], [], s=6, color="gold", edgecolors="black", linewidths=0.2, zorder=6)
+        self.title = ax.set_title(f"{scenario.name}  t = 0.0 s", fontsize=10, family="monospace")
+        self.legend_states: list[str] = []
+        self.fig.tight_layout()
+
+    def _colour(self, state: str) -> str:
+        if state not in self.legend_states:
+            self.legend_states.append(state)
+            self._legend()
+        return _PALETTE[self.legend_states.index(state) % len(_PALETTE)]
+
+    def _legend(self) -> None:
+        from matplotlib.patches import Patch
+
+        handles = [Patch(facecolor=_PALETTE[i % len(_PALETTE)], label=s) for i, s in enumerate(self.legend_states)]
+        handles.append(Patch(facecolor="gold", label="carried resource"))
+        self.ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8)
+
+    def draw(self, state: _State, t: float, robot_names: list[str]) -> np.ndarray:
+        segments, colours = [], []
+        for ns, lines in state.lines.items():
+            colour, _ = self._LINE_STYLE.get(ns, ("0.5", 0.5))
+            segments += lines
+            colours += [colour] * len(lines)
+        self.server_lines.set_segments(segments)
+        self.server_lines.set_color(colours)
+        pts = [(ns, p) for ns, p in state.points.items() if len(p)]
+        if pts:
+            style = [self._POINT_STYLE.get(ns, ("0.5", 6, "o")) for ns, _ in pts]
+            self.server_points.set_offsets(np.concatenate([p for _, p in pts]))
+            self.server_points.set_sizes(np.concatenate([[s[1]] * len(p) for s, (_, p) in zip(style, pts)]))
+            self.server_points.set_color(sum(([s[0]] * len(p) for s, (_, p) in zip(style, pts)), []))
+        self.resources.set_offsets(state.resources if len(state.resources) else np.zeros((0, 2)))
+        poses = np.full((len(robot_names), 3), np.nan)
+        for i, data in state.odom.items():
+            _, pose, _, _ = odometry.decode_odometry(data)
+            poses[i] = (pose.x, pose.y, pose.yaw)
+        seen = ~np.isnan(poses[:, 0])
+        xy = np.where(seen[:, None], poses[:, :2], 1e6)  # robots not seen yet: off the canvas
+        self.robots.set_offsets(xy)
+        self.robots.set_facecolor([self._colour(state.state.get(i, "unknown")) for i in range(len(robot_names))])
+        reach = self.scenario.robots.diameter * 0.6
+        tips = xy + reach * np.column_stack([np.cos(np.nan_to_num(poses[:, 2])), np.sin(np.nan_to_num(poses[:, 2]))])
+        self.headings.set_segments([np.array([a, b]) for a, b, s in zip(xy, tips, seen) if s])
+        carriers = [i for i, r in enumerate(robot_names) if r in state.carrying and seen[i]]
+        self.carried.set_offsets(xy[carriers] if carriers else np.zeros((0, 2)))
+        self.title.set_text(f"{self.scenario.name}  t = {t:7.1f} s  delivered {state.delivered}")
+        self.fig.canvas.draw()
+        return np.asarray(self.fig.canvas.buffer_rgba())[..., :3].copy()
+
+    def close(self) -> None:
+        import matplotlib.pyplot as plt
+
+        plt.close(self.fig)
+
+
+def _writer(out: Path, fps: float):
+    import imageio.v2 as imageio
+
+    if out.suffix == ".gif":
+        return imageio.get_writer(out, format="GIF", mode="I", duration=1000.0 / fps, loop=0)
+    return imageio.get_writer(out, format="FFMPEG", fps=fps, codec="libx264", pixelformat="yuv420p",
+                              macro_block_size=16, ffmpeg_log_level="error")
+
+
+def _window(info, start: float, end: float | None, speedup: float, fps: float) -> np.ndarray:
+    last = info.end_ns / NS_PER_S
+    end = last if end is None else min(end, last)
+    if not 0 <= start <= end:
+        raise ValueError(f"time window [{start:g}, {end:g}] s is empty (the bag covers 0-{last:g} s)")
+    step = speedup / fps
+    return start + step * np.arange(int(math.floor((end - start) / step + 1e-9)) + 1)
+
+
+def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
+    """The replay's frame (an RGB array) at each sim time in `times` (ascending) [s]."""
+    bag = Path(bag)
+    info = bag_info(bag)
+    if "scenario" not in info.metadata:
+        raise BagError(f"{bag}: no swarmforage scenario in the bag's metadata (not a swarm-run bag?)")
+    scenario = scenario_from_dict(json.loads(info.metadata["scenario"]))
+    names = list(scenario.robot_names)
+    robots = {r: i for i, r in enumerate(names)}
+    state = _State()
+    canvas = _Canvas(scenario, len(names))
+    done = 0
+    try:
+        for m in read_bag(bag):
+            while done < len(times) and m.stamp_ns > times[done] * NS_PER_S:
+                yield canvas.draw(state, times[done], names)
+                done += 1
+            if done == len(times):
+                return
+            try:
+                _apply(state, m.topic, m.data, robots)
+            except (ValueError, TypeError, AttributeError):
+                continue  # a malformed recorded message: swarm-analyze's metrics count these
+        for t in times[done:]:
+            yield canvas.draw(state, t, names)
+    finally:
+        canvas.close()
+
+
+def render_video(bag: Path | str, out: Path | str, *, speedup: float = 10.0, fps: float = 10.0,
+                 start: float = 0.0, end: float | None = None, max_frames: int | None = None) -> VideoInfo:
+    """Render the run in `bag` to `out` (.mp4 or .gif): `speedup` sim seconds per video second,
+    `fps` frames per video second, sim times [`start`, `end`] [s] (default: the whole run),
+    at most `max_frames` frames. Raises BagError / ValueError naming what is wrong."""
+    bag, out = Path(bag), Path(out)
+    if out.suffix not in FORMATS:
+        raise ValueError(f"--video {out}: expected a file ending in {' or '.join(FORMATS)}")
+    if not (speedup > 0 and fps > 0 and math.isfinite(speedup) and math.isfinite(fps)):
+        raise ValueError("--speedup and --fps must be positive numbers")
+    times = _window(bag_info(bag), start, end, speedup, fps)[:max_frames]
+    count = 0
+    with _writer(out, fps) as writer:
+        for frame in frames(bag, times):
+            writer.append_data(frame)
+            count += 1
+    return VideoInfo(out, count, float(times[0]), float(times[-1]))
+
+
+def save_frame(bag: Path | str, t: float, out: Path | str) -> Path:
+    """One frame of the replay, at sim time `t` [s], as a PNG (the README's picture)."""
+    import imageio.v2 as imageio
+
+    (frame,) = frames(bag, np.array([float(t)]))
+    imageio.imwrite(out, frame)
+    return Path(out)

@@ -1,0 +1,126 @@
+"""What a node accepts from the bus (`swarm_sim.inbound`): robot ids, ticks, malformed bytes,
+counting and rate-limited logging; the /diagnostics codec; the cores' refusals of dead robots."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from depot_manager.protocol import DepotGrant, DepotReport, RadioReply, ReportKind
+from depot_manager.server import DepotServer
+from swarm_controllers.center import CenterServer
+from swarm_controllers.center_protocol import ProgressReport
+from swarm_msgs_py import diagnostics
+from swarm_msgs_py.depot_protocol import DEPOT, RADIO
+from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+from swarm_sim.inbound import Inbound, Reason, Rejections, merged, robot_fields
+from swarm_sim.scenario import load_scenario
+from swarm_sim.types import NodeDownEvent, PheromoneMessage
+
+DT = 100_000_000
+ROBOTS = ("robot_0", "robot_1")
+
+
+def _inbound(now_ticks: int = 10) -> tuple[Inbound, list[str]]:
+    logged: list[str] = []
+    gate = Inbound(ROBOTS, DT, Rejections(), logged.append)
+    gate.now_ns = gate.released_ns = now_ticks * DT
+    return gate, logged
+
+
+def test_robot_fields_are_found_by_annotation():
+    assert robot_fields(RadioReply) == ("sender", "to")
+    assert robot_fields(DepotGrant) == ("robot",)
+    assert robot_fields(PheromoneMessage) == ()
+
+
+def test_messages_naming_robots_of_no_run_are_dropped_and_counted():
+    gate, logged = _inbound()
+    ok = RadioReply(10 * DT, "robot_1", "robot_0", 0.0, 0.0, "entry_line_0", 3, False)
+    forged = RadioReply(10 * DT, "robot_1", "robot_900", 0.0, 0.0, "entry_line_0", 3, False)
+    assert gate.admit("/radio", ok) and not gate.admit("/radio", forged)
+    assert gate.rejections.counts == {("/radio", "unknown robot"): 1}
+    assert "RadioReply.to = 'robot_900'" in logged[0]
+
+
+@given(st.integers(-5, 15))
+def test_the_tick_window(offset):
+    """Accepted: one tick late (released - dt) up to one tick ahead (now + dt)."""
+    gate, _ = _inbound(now_ticks=10)
+    m = DepotReport((10 + offset) * DT, "robot_0", ReportKind.AT, "l", 1)
+    assert gate.admit("/depot/reports", m) == (-1 <= offset <= 1)
+    if not -1 <= offset <= 1:
+        assert gate.rejections.counts == {("/depot/reports", "wrong tick"): 1}
+
+
+def test_malformed_bytes_are_counted_and_the_rest_of_the_batch_is_kept():
+    gate, logged = _inbound()
+    posted: list[object] = []
+    bad = encode_diagnostics(0, [(OK, "DepotGrant", "", "robot_0", (("cell", "x"),))])
+    assert gate.post_all("/depot/grants", DEPOT, bad, posted.append) == 0
+    assert posted == [] and "malformed" in logged[0]
+    (good,) = RADIO.encode(10 * DT, [RadioReply(10 * DT, "robot_1", "robot_0", 0.0, 0.0, "l", 1, False),
+                                     RadioReply(10 * DT, "robot_1", "ghost", 0.0, 0.0, "l", 1, False)])
+    assert gate.post_all("/radio", RADIO, good, posted.append) == 1 and posted[0].to == "robot_0"
+    assert merged(gate.rejections) == {("/depot/grants", "malformed"): 1, ("/radio", "unknown robot"): 1}
+
+
+def test_logging_is_rate_limited_per_kind():
+    r = Rejections()
+    logged = [n for n in range(1, 2001) if r.add("/radio", Reason.WRONG_TICK)]
+    assert logged == [1, 10, 100, 1000]
+    assert r.add("/radio", Reason.MALFORMED)  # another kind: logged at once
+    assert r.total == 2001
+
+
+def test_rejection_counts_round_trip_on_diagnostics():
+    counts = {("/radio", "unknown robot"): 3, ("DepotReport", "refused"): 1}
+    data = diagnostics.encode_rejections(5, "/robot_0/controller", counts)
+    assert diagnostics.decode_rejections(data) == (5, {"/robot_0/controller": counts})
+
+
+def test_node_down_events_round_trip():
+    events = (NodeDownEvent("robot_3", 7 * DT, "robot", 3), NodeDownEvent("depot", 9 * DT, "server", 3))
+    assert diagnostics.decode_events(diagnostics.encode_events(9 * DT, events)) == (9 * DT, events)
+
+
+def test_a_dead_robot_leaves_the_depot_and_its_reports_are_refused():
+    server = DepotServer(load_scenario("queue_qmt", ["robots.count=4"]))
+    s = 10**9
+    server.step(s, [DepotReport(0, "robot_1", ReportKind.JOIN, "entry_line_0", 0)])
+    server.step(2 * s, [])
+    assert server.admission.robots_inside == ("robot_1",)
+    assert "robot_1" in {o for *_, o in server.admission.snapshot().occupied}
+    server.robot_lost("robot_1", 3 * s)
+    assert server.admission.robots_inside == () and server.admission.snapshot().occupied == ()
+    out = server.step(3 * s, [DepotReport(2 * s, "robot_1", ReportKind.JOIN, "entry_line_0", 0)])
+    assert out == () and server.rejections.counts == {("DepotReport", "declared dead"): 1}
+    # the freed slot 0 is free for another robot
+    server.step(4 * s, [DepotReport(3 * s, "robot_2", ReportKind.JOIN, "entry_line_0", 0)])
+    assert server.admission.robots_inside == ("robot_2",)
+
+
+def test_a_dead_robots_region_goes_to_another_robot():
+    scenario = load_scenario("mdbsa_d", ["robots.count=2", "regions.count=4"])
+    server = CenterServer(scenario)
+    assert server.assigner.current("robot_0").region == 0
+    server.robot_lost("robot_0", 10**9)
+    assert server.assigner.current("robot_0") is None
+    # robot_1 finishes its region 1 and asks: it gets an unassigned region; region 0 is one again
+    (a,) = server.step(10**9, [ProgressReport(0, "robot_1", 0.0, 0.0, -1, 0.0, True)])
+    assert a.region == 1  # its initial walk
+    length = server.assigner.remaining(1)
+    (a,) = server.step(2 * 10**9, [ProgressReport(10**9, "robot_1", 0.0, 0.0, 1, length, True)])
+    assert a.region == 0  # the dead robot's region, unassigned again (lowest id of the longest)
+    out = server.step(3 * 10**9, [ProgressReport(2 * 10**9, "robot_0", 0.0, 0.0, -1, 0.0, True)])
+    assert out == () and ("ProgressReport", "declared dead") in server.rejections.counts
+
+
+def test_core_counts_are_merged_with_the_nodes():
+    node, core = Rejections(), Rejections()
+    node.add("/radio", Reason.MALFORMED)
+    core.add("RadioReply", Reason.REFUSED)
+    core.add("RadioReply", Reason.REFUSED)
+    assert merged(node, core, None) == {("/radio", "malformed"): 1, ("RadioReply", "refused"): 2}
+    assert np.sum(list(merged(node, core).values())) == 3

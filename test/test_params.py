@@ -1,0 +1,50 @@
+"""`ros2 param list/get` on every node: the controller, depot-manager and center nodes serve the
+standard parameter services (as the world does). A client node asks them
+over DDS what ``ros2 param list`` and ``ros2 param get`` ask: ListParameters and GetParameters."""
+
+from __future__ import annotations
+
+import pytest
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter_client import AsyncParameterClient
+
+from depot_manager.node import DepotManagerNode
+from swarm_controllers.center_node import CenterNode
+from swarm_controllers.controller_node import ControllerConfig, ControllerNode
+from swarm_sim.nodes.server_node import ServerNodeConfig
+from test_nodes import SMALL
+
+
+def _spin_until(executor, future, timeout=20.0):
+    executor.spin_until_future_complete(future, timeout_sec=timeout)
+    assert future.done(), "no answer from the parameter service"
+    return future.result()
+
+
+@pytest.mark.parametrize("make, name, seed", [
+    (lambda ctx: ControllerNode("robot_1", ControllerConfig("cpfa", SMALL, 7), context=ctx),
+     "/robot_1/controller", 7),
+    (lambda ctx: DepotManagerNode(ServerNodeConfig("queue_qmt", ("robots.count=2",), 5), context=ctx),
+     "/depot_manager", 5),
+    (lambda ctx: CenterNode(ServerNodeConfig("mdbsa_d", ("robots.count=2",), 3), context=ctx), "/center", 3),
+], ids=["controller", "depot_manager", "center"])
+def test_param_list_and_get_answer_on_every_node(context, make, name, seed):
+    node = make(context)
+    client_node = Node("ros2cli_param", context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(client_node)
+    try:
+        client = AsyncParameterClient(client_node, name)
+        assert client.wait_for_services(timeout_sec=20.0), f"{name}: no parameter services"
+        listed = _spin_until(executor, client.list_parameters()).result.names
+        assert {"scenario", "overrides", "seed", "use_sim_time"} <= set(listed), listed
+        values = _spin_until(executor, client.get_parameters(["seed", "scenario", "use_sim_time"])).values
+        assert values[0].integer_value == seed
+        assert values[1].string_value in ("cpfa", "queue_qmt", "mdbsa_d")
+        assert values[2].bool_value is True
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        client_node.destroy_node()

@@ -1,0 +1,72 @@
+"""Replay video from a real bag (a short Q_MT graph run, written with ``--out DIR``): ``swarm-analyze
+DIR --video`` finds the one bag in DIR and writes an .mp4 that decodes to the expected frames; a .gif
+too; a DIR with two bags or none is refused in one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+
+from swarm_sim.analysis.cli import main as analyze
+from swarm_sim.analysis.video import SIZE_PX, render_video, save_frame
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def out_dir(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("runs")
+    cmd = [sys.executable, "-m", "launch_py.run", "--out", str(out), "--scenario", "queue_qmt", "--robots", "6",
+           "--duration", "20", "--tick-timeout", "20", "--domain-id", os.environ["ROS_DOMAIN_ID"]]
+    result = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+    return out
+
+
+def test_analyze_dir_with_one_bag_renders_an_mp4(out_dir, tmp_path, capsys):
+    video = tmp_path / "run.mp4"
+    assert analyze([str(out_dir), "--json", "--no-plot", "--video", str(video), "--speedup", "4",
+                    "--fps", "5", "--end", "10"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert summary["video"] == str(video) and summary["video_frames"] == 13  # t = 0, 0.8, ..., 9.6
+    frames = imageio.mimread(video, memtest=False)
+    assert len(frames) == 13 and frames[0].shape == (SIZE_PX, SIZE_PX, 3)
+    assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).sum() > 0  # the robots moved
+
+
+def test_gif_frames_show_the_robots_and_the_depot(out_dir, tmp_path):
+    (bag,) = out_dir.iterdir()
+    info = render_video(bag, tmp_path / "run.gif", speedup=10, fps=2, start=5, max_frames=3)
+    assert (info.frames, info.start_s, info.end_s) == (3, 5.0, 15.0)
+    frames = imageio.mimread(tmp_path / "run.gif")
+    assert len(frames) == 3
+    png = save_frame(bag, 12.0, tmp_path / "frame.png")
+    image = imageio.imread(png)[..., :3].reshape(-1, 3).astype(int)
+    tab_blue, tab_green = np.array([31, 119, 180]), np.array([44, 160, 44])  # a robot state; the docks
+    assert (np.abs(image - tab_blue).sum(axis=1) < 10).sum() > 20
+    assert (np.abs(image - tab_green).sum(axis=1) < 10).sum() > 20
+
+
+def test_a_dir_with_two_bags_or_none_is_refused_naming_them(out_dir, tmp_path, capsys):
+    (bag,) = out_dir.iterdir()
+    two = tmp_path / "two"
+    shutil.copytree(bag, two / "a")
+    shutil.copytree(bag, two / "b")
+    (tmp_path / "none").mkdir()
+    assert analyze([str(two), "--no-plot"]) == 1
+    assert analyze([str(tmp_path / "none"), "--no-plot"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"swarm-analyze: {two}: not a bag, and holds 2 bags (a, b): name one",
+                   f"swarm-analyze: {tmp_path / 'none'}: not a bag, and holds no bag directory"]
+    with pytest.raises(ValueError, match="expected a file ending in .mp4 or .gif"):
+        render_video(bag, tmp_path / "x.avi")
+    with pytest.raises(ValueError, match="time window"):
+        render_video(bag, tmp_path / "x.gif", start=1000)
