@@ -426,7 +426,7 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
     runner = FakeRunner()
     argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
     assert main(argv, run=runner, comparisons=found) == 0
-    assert {c[0] for c in runner.calls} == {*QUEUE_STRATEGIES, *SPIRAL_STRATEGIES}
+    assert {c[0] for c in runner.calls} == {s for c in found.values() for s in c.strategies}
     assert all(c[2]["sim__duration"] == 5 for c in runner.calls if c[2])  # the toy plans set no fields
     for sub in ("queue/table.md", "spiral/exp1/tables.md", "spiral/exp2/mannwhitney.md", "spiral/exp3/tables.md",
                 "queue/collected.png"):
