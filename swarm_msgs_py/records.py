@@ -10,7 +10,10 @@ topic per tick, header.stamp = the tick the messages were sent in; one Diagnosti
 message: level OK, name = the message's class (``DepotGrant``), hardware_id = its sender or
 addressee robot, message empty, values = every field in declaration order as (name, text):
 ints with ``str``, floats with ``repr`` (exact round trip), bools as ``true``/``false``, enums
-as their value. ``ros2 topic echo /depot/grants`` therefore reads as the dataclass.
+as their value, ``tuple[X, ...]`` as its items separated by spaces. A class with an int class
+constant ``TYPE`` (a paper's message type number) shows it first, as the value ``type``, and its
+``origin`` as hardware_id when it has no ``robot`` or ``sender``. ``ros2 topic echo
+/depot/grants`` therefore reads as the dataclass.
 
 Decoding is strict: an unknown message name, an unknown or missing field, or a value that is not
 of the field's declared type (int, float, bool, str, an Enum, or ``X | None``) is refused with a
@@ -55,7 +58,10 @@ def topic_of(family: MessageFamily, message: Any) -> str:
         raise TypeError(f"{family.name}: no topic for message type {type(message).__name__}") from None
 
 
-def _text(value: Any) -> str:
+def field_text(value: Any) -> str:
+    """A field's value as record text (what `field_parser` reads back)."""
+    if isinstance(value, tuple):
+        return " ".join(field_text(v) for v in value)
     if isinstance(value, enum.Enum):
         return str(value.value)
     if isinstance(value, bool):
@@ -65,13 +71,20 @@ def _text(value: Any) -> str:
     return str(value)
 
 
-def _parser(tp: Any, key: str) -> Callable[[str], Any]:
-    """The strict text -> value function for a field of type `tp`."""
+def field_parser(tp: Any, key: str) -> Callable[[str], Any]:
+    """The strict text -> value function for a field of type `tp` (``tuple[X, ...]``: items
+    separated by single spaces, "" = empty)."""
+    if typing.get_origin(tp) is tuple:
+        args = typing.get_args(tp)
+        if len(args) != 2 or args[1] is not Ellipsis:
+            raise TypeError(f"{key}: only tuple[X, ...] tuples are supported")
+        item = field_parser(args[0], key)
+        return lambda text: tuple(item(t) for t in text.split(" ")) if text else ()
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(tp) if a is not type(None)]
         if len(args) != 1:
             raise TypeError(f"{key}: only X | None unions are supported")
-        inner = _parser(args[0], key)
+        inner = field_parser(args[0], key)
         return lambda text: None if text == "None" else inner(text)
     if isinstance(tp, type) and issubclass(tp, enum.Enum):
         by_value = {str(m.value): m for m in tp}
@@ -133,7 +146,7 @@ class RecordFamily:
             hints = typing.get_type_hints(cls)
             names = tuple(f.name for f in dataclasses.fields(cls))
             self._fields[cls] = names
-            self._parsers[cls] = tuple(_parser(hints[n], f"{cls.__name__}.{n}") for n in names)
+            self._parsers[cls] = tuple(field_parser(hints[n], f"{cls.__name__}.{n}") for n in names)
 
     def encode(self, stamp_ns: int, messages: Iterable[Any]) -> list[bytes]:
         statuses = []
@@ -141,8 +154,10 @@ class RecordFamily:
             cls = type(m)
             if cls not in self._fields:
                 raise TypeError(f"not a {self.name} message: {cls.__name__}")
-            values = tuple((name, _text(getattr(m, name))) for name in self._fields[cls])
-            addressee = getattr(m, "robot", None) or getattr(m, "sender", "")
+            values = tuple((name, field_text(getattr(m, name))) for name in self._fields[cls])
+            if hasattr(cls, "TYPE"):
+                values = (("type", str(cls.TYPE)), *values)
+            addressee = getattr(m, "robot", None) or getattr(m, "sender", None) or getattr(m, "origin", "")
             statuses.append((OK, cls.__name__, "", addressee, values))
         return [encode_diagnostics(stamp_ns, statuses)]
 
@@ -154,6 +169,10 @@ class RecordFamily:
             if cls is None:
                 raise ValueError(f"unknown {self.name} message {status.name!r} (known: {', '.join(self._classes)})")
             values = dict(status.values)
+            if hasattr(cls, "TYPE"):
+                if values.pop("type", None) != str(cls.TYPE):
+                    raise ValueError(f"{status.name}.type: expected {cls.TYPE}, got {dict(status.values).get('type')!r}")
+                status = status._replace(values=tuple(kv for kv in status.values if kv[0] != "type"))
             names = self._fields[cls]
             unknown = sorted(set(values) - set(names))
             if unknown:

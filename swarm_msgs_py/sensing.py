@@ -1,9 +1,10 @@
-"""How a world task's sense travels: one topic per field, each with its ROS type and codec.
+"""How a world task's data travels: its sense, one topic per field, and its world-level state.
 
 The world node publishes, and a controller node subscribes to, the odometry and the scan of
 every robot plus the topics of its task's `Sensing`; a controller steps once it holds every one
-of them stamped with the same tick. The record is data, so adding a task adds no code to the
-nodes: only its sense type, its codecs and one `Sensing` value.
+of them stamped with the same tick. A task's `StateTopic` values are world-level topics the
+world node publishes every tick (recorded; analysis reads them back as time series). The records
+are data, so adding a task adds no code to the nodes: only its types, its codecs and these values.
 """
 
 from __future__ import annotations
@@ -46,3 +47,21 @@ class Sensing:
     def encode_all(self, stamp_ns: int, sense: Any) -> dict[str, bytes]:
         """Topic name -> the bytes of `sense`'s field on it."""
         return {t.name: t.encode(stamp_ns, getattr(sense, t.field)) for t in self.topics}
+
+
+@dataclass(frozen=True)
+class StateTopic:
+    """One value of a task's ``state()`` on a world-level topic, published every tick."""
+
+    topic: str
+    """Absolute topic name (``/caging/object``)."""
+    type_name: str
+    """ROS type string: standard types only."""
+    field: str
+    """The key of the value in the task's ``state()``; also its series name in the run trace."""
+    encode: Callable[[int, Any], bytes]
+    """(stamp_ns, value) -> CDR bytes."""
+    decode: Callable[[bytes], tuple[int, Any]]
+    """CDR bytes -> (stamp_ns, value) with ``value == state()[field]`` exactly (the task applies
+    the wire's rounding, e.g. yaw through a quaternion), so the batch runner's series equal a
+    bag's; raises CodecError (a ValueError) on malformed bytes."""

@@ -2,8 +2,10 @@
 
 It plays the roles the graph splits over nodes, in the same order: observations of tick k go
 to every behaviour together with the messages stamped before k, the commands come back, the
-servers (center, depot manager) handle their messages stamped before k, the world steps. Same scenario and seed as a lockstep graph run -> same trajectories and metrics
-(tested in test/test_determinism.py).
+servers (center, depot manager) handle their messages stamped before k, the world steps. Same
+scenario and seed as a lockstep graph run -> same trajectories and metrics (tested in
+test/test_determinism.py). With ``sim.stop_when_finished`` a run ends early once every behaviour
+says it is finished (sweeps); the world task's state is kept every tick as the trace's series.
 """
 
 from __future__ import annotations
@@ -21,9 +23,9 @@ from swarm_controllers.api import behaviour_rng
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
-from swarm_sim.messaging import Router
+from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.registry import make_behaviour, make_servers
+from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
@@ -51,8 +53,13 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     )
     perimeter = PerimeterLog(robots, scenario.depot.center, scenario.depot.perimeter_radius)
     poses = np.zeros((scenario.ticks + 1, len(robots), 3)) if record_poses else None
+    algorithm = of(scenario)
+    spec = task(algorithm.task).state
+    state_topics = resolve(spec) if spec else ()
+    keep = tuple(cls for path in algorithm.peers for cls in resolve(path).topics) if algorithm.trace_peers else ()
     try:
         obs = world.reset()
+        _record_state(world, state_topics, trace)
         for k in range(scenario.ticks):
             perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
             if poses is not None:
@@ -65,12 +72,19 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
                 commands[r] = command
                 for message in command.messages:
                     router.post(message)
+                    if keep and isinstance(message, keep):
+                        trace.messages.append(message)
             for channel, server in servers.items():
                 for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
                     router.post(message)
             last_step_ns = world.t_ns
             obs = world.step(commands)
             _collect_events(world, trace)
+            _record_state(world, state_topics, trace)
+            if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):
+                if poses is not None:
+                    poses = poses[:k + 2]
+                break
         perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
@@ -81,10 +95,20 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
         trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
         for server in servers.values():
             trace.series.update(server.series())
+        trace.messages.sort(key=delivery_order)
     finally:
         world.close()
     trace.wall_seconds = time.monotonic() - wall0
     return BatchRun(trace, poses)
+
+
+def _record_state(world: World, state_topics: tuple, trace: RunTrace) -> None:
+    """The task's state of the current tick, as a bag replay reads it back (`StateTopic`)."""
+    if not state_topics:
+        return
+    values, t = world.task.state(), world.t_ns / NS_PER_S
+    for st in state_topics:
+        trace.series.setdefault(st.field, []).append((t, values[st.field]))
 
 
 def _collect_events(world: World, trace: RunTrace) -> None:

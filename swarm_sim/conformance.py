@@ -7,7 +7,8 @@
   package blocked, and a short batch run works that way;
 - **determinism**: two batch runs with the same seed give identical results and trajectories;
 - **codecs**: every message class of its families and its task's sense survive encode/decode
-  unchanged (messages built from their field types, senses taken from a real world);
+  unchanged (messages built from their field types, senses and task states taken from a real
+  world);
 - **graph_equals_batch** (optional): a lockstep run on the ROS graph (``swarm-run``) gives the
   batch run's trajectories and metrics for the same seed.
 
@@ -69,7 +70,7 @@ def core_paths(algorithm: registry.Algorithm) -> list[str]:
              *(s.core for s in algorithm.servers), *(s.family for s in algorithm.servers),
              *(s.replay for s in algorithm.servers if s.replay), *algorithm.peers,
              *(m.function for m in algorithm.metrics), task.core, task.sensing]
-    paths += [p for p in (algorithm.paths, algorithm.comparison, task.metrics) if p]
+    paths += [p for p in (algorithm.paths, algorithm.comparison, algorithm.figures, task.metrics, task.state) if p]
     return paths
 
 
@@ -120,27 +121,29 @@ def check_determinism(scenario: Scenario) -> tuple[dict[str, Any], np.ndarray]:
     return first
 
 
+def _sample(tp: Any, name: str, where: str) -> Any:
+    if typing.get_origin(tp) in (typing.Union, types.UnionType):
+        tp = next(a for a in typing.get_args(tp) if a is not type(None))
+    if typing.get_origin(tp) is tuple and typing.get_args(tp)[1:] == (Ellipsis,):
+        item = _sample(typing.get_args(tp)[0], name, where)
+        return (item, item)
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        return list(tp)[-1]
+    if tp is bool:
+        return True
+    if tp is int:
+        return 1_700_000_003 if name == "stamp_ns" else 3
+    if tp is float:
+        return 1.0 / 3.0  # a float whose text needs every digit
+    if tp is str:
+        return "robot_1"
+    _fail("codecs", f"{where}: no sample for type {tp}")
+
+
 def sample_message(cls: type) -> Any:
     """An instance of message dataclass `cls` with a value of each field's type."""
     hints = typing.get_type_hints(cls)
-    values = {}
-    for f in dataclasses.fields(cls):
-        tp = hints[f.name]
-        if typing.get_origin(tp) in (typing.Union, types.UnionType):
-            tp = next(a for a in typing.get_args(tp) if a is not type(None))
-        if isinstance(tp, type) and issubclass(tp, enum.Enum):
-            values[f.name] = list(tp)[-1]
-        elif tp is bool:
-            values[f.name] = True
-        elif tp is int:
-            values[f.name] = 1_700_000_003 if f.name == "stamp_ns" else 3
-        elif tp is float:
-            values[f.name] = 1.0 / 3.0  # a float whose text needs every digit
-        elif tp is str:
-            values[f.name] = "robot_1"
-        else:
-            _fail("codecs", f"{cls.__name__}.{f.name}: no sample for type {tp}")
-    return cls(**values)
+    return cls(**{f.name: _sample(hints[f.name], f.name, f"{cls.__name__}.{f.name}") for f in dataclasses.fields(cls)})
 
 
 def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
@@ -159,17 +162,27 @@ def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
     sensing = registry.resolve(registry.task(algorithm.task).sensing)
     from swarm_sim.types import Command
 
+    state = registry.task(algorithm.task).state
+    state_topics = registry.resolve(state) if state else ()
     with World(scenario) as world:  # robots drive in circles so that what they sense changes
         observations = [world.reset()]
+        states = [(world.t_ns, world.task.state())] if state_topics else []
         turn = Command(scenario.robots.max_linear_speed, 0.5)
         for _ in range(50):
             observations.append(world.step(dict.fromkeys(world.robots, turn)))
+            if state_topics:
+                states.append((world.t_ns, world.task.state()))
     for obs in (o for step in observations for o in step.values()):
         for topic, data in sensing.encode_all(obs.stamp_ns, obs.sensed).items():
             spec = next(t for t in sensing.topics if t.name == topic)
             stamp, value = spec.decode(data)
             if stamp != obs.stamp_ns or value != getattr(obs.sensed, spec.field):
                 _fail("codecs", f"sense field {spec.field} on {topic} came back as {value!r}")
+    for t_ns, state in states:
+        for st in state_topics:
+            stamp, value = st.decode(st.encode(t_ns, state[st.field]))
+            if stamp != t_ns or value != state[st.field]:
+                _fail("codecs", f"state {st.field} on {st.topic} came back as {value!r}")
 
 
 def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch_summary: dict[str, Any],

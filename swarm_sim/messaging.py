@@ -14,7 +14,8 @@ from typing import Any
 from swarm_sim.protocol import channel_of
 
 
-def _order(message: Any) -> tuple[int, str, str]:
+def delivery_order(message: Any) -> tuple[int, str, str]:
+    """The order receivers get messages in: by stamp, then type name, then content."""
     return (message.stamp_ns, type(message).__name__, repr(message))
 
 
@@ -32,7 +33,7 @@ class Mailbox:
         if not ready:
             return ()
         self._pending = [m for m in self._pending if m.stamp_ns >= stamp_ns]
-        return tuple(sorted(ready, key=_order))
+        return tuple(sorted(ready, key=delivery_order))
 
 
 class Router:

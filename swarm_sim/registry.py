@@ -67,6 +67,10 @@ class TaskSpec:
     ROS type and codec of each of its fields."""
     metrics: str | None = None
     """``module:function`` ``(trace) -> dict`` of the task's JSON result fields."""
+    state: str | None = None
+    """``module:STATE``: a tuple of `swarm_msgs_py.sensing.StateTopic`, the world-level topics
+    the world node publishes from the task's ``state()`` every tick; the batch runner and the
+    bag replay keep each as the time series ``RunTrace.series[field]`` (None: none)."""
 
 
 @dataclass(frozen=True)
@@ -107,6 +111,12 @@ class Algorithm:
     under the recorded trajectories (None: it plans none)."""
     comparison: str | None = None
     """``module:OBJECT`` (`swarm_sim.compare.comparison.Comparison`): its paper's comparison."""
+    trace_peers: bool = False
+    """Keep its robots' peer messages in the run trace (``RunTrace.messages``): from the router
+    in batch runs, from the recorded topics in bag replays (metrics that read the protocol)."""
+    figures: str | None = None
+    """``module:function`` ``(trace, directory) -> [Path]``: its own pictures of a run, drawn
+    by ``swarm-analyze --trajectories`` (None: none)."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

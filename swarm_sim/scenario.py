@@ -44,6 +44,10 @@ class SimConfig:
     """pybullet steps per tick (each of dt / physics_substeps seconds)."""
     duration: float = 1080.0
     """Run length [s of sim time]."""
+    stop_when_finished: bool = False
+    """Batch runner only: end a run as soon as every behaviour says its task is over (a
+    ``finished`` attribute, e.g. the caging robots once the object is delivered); the run's
+    ``sim_seconds`` then says when. For sweeps: a graph run always lasts ``duration``."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +77,8 @@ class RobotConfig:
     """[m/s] (ARGoS CPFA foot-bot forward speed 16 cm/s)."""
     max_angular_speed: float = 2.0
     """[rad/s]."""
+    mass: float = 1.0
+    """[kg]; only the ratio to the bodies robots push matters (the transport task's object)."""
     start_spacing: float = 0.4
     """Robots start on a square grid of this pitch [m] centred on the depot (`start_layout`
     grid); the other layouts keep robot centres at least this far apart."""
@@ -102,6 +108,19 @@ class ScanConfig:
 
 
 @dataclass(frozen=True)
+class ProximityConfig:
+    """Proximity sensors around the robot's body, each reporting whether it detects something
+    and what (the caging paper's ``sensors<detect, id>``). Defaults: the Khepera III's nine
+    infra-red sensors (K-Team user manual, sec. 3.3; directions and 0.02-0.2 m range as in
+    Georgia Tech's Sim.I.am Khepera III model)."""
+
+    angles: tuple[float, ...] = (128.0, 75.0, 42.0, 13.0, -13.0, -42.0, -75.0, -128.0, 180.0)
+    """Sensor directions [deg, robot frame, counter-clockwise from the heading]."""
+    range: float = 0.2
+    """How far beyond the robot's body a sensor sees [m]."""
+
+
+@dataclass(frozen=True)
 class SensorConfig:
     scan: ScanConfig = field(default_factory=ScanConfig)
     resource_detection_radius: float = 0.13
@@ -112,6 +131,12 @@ class SensorConfig:
     light_range: float = 2.0
     """Light sensing (world tasks with a light, e.g. the DRTM nest): a light farther than this
     from the robot's centre is not detected [m]."""
+    proximity: ProximityConfig = field(default_factory=ProximityConfig)
+    """Used by the transport task."""
+    position_range: float = 1.5
+    """Transport task: a robot senses the position of the target object and of other robots
+    whose centres are within this distance of its own [m] (what the caging paper's robots read
+    from CoppeliaSim for D_ell, D_r, theta_ell, theta_r and D_object)."""
 
 
 @dataclass(frozen=True)
@@ -198,6 +223,42 @@ class ObstacleConfig:
 
 
 @dataclass(frozen=True)
+class TargetObjectConfig:
+    """The transport task's cylindrical target object (caging paper sec. 3)."""
+
+    radius: float = 0.3
+    """r_object [m]."""
+    mass: float = 0.3
+    """M [kg]."""
+    floor_friction: float = 0.4
+    """Coulomb friction coefficient mu between the object and the floor: every physics substep
+    the object's planar speed drops by mu g dt and its spin by (4/3) mu g dt / r (a uniformly
+    pressed disc). The paper gives none; 0.4 is a plausible plastic-on-floor value."""
+
+
+@dataclass(frozen=True)
+class LandmarkConfig:
+    """The transport task's landmarks: a square grid centred on the arena (caging paper sec. 3,
+    Alg. 2); a landmark's neighbourhood eta is the up to eight grid neighbours around it."""
+
+    step: float = 0.5
+    """Grid step [m] (the paper's two discretisations: 0.5 and 1 m)."""
+    extent: tuple[float, float] = (8.0, 7.0)
+    """Width and height [m] of the rectangle the grid spans, corner landmarks included. The
+    paper reports 255 landmarks for step 0.5 m and 72 for 1 m in its 10 x 10 m arena; an
+    8 x 7 m grid is the one rectangle of whole metres that gives both (17 x 15 and 9 x 8), and
+    it leaves 1 m to the walls, room for a cage around a landmark on its edge."""
+
+
+@dataclass(frozen=True)
+class TransportConfig:
+    """World facts of the transport task (`swarm_sim.world.tasks.transport`)."""
+
+    object: TargetObjectConfig = field(default_factory=TargetObjectConfig)
+    landmarks: LandmarkConfig = field(default_factory=LandmarkConfig)
+
+
+@dataclass(frozen=True)
 class AvoidanceConfig:
     distance: float = 0.3
     """Obstacles within this range of the robot's centre in the front sector trigger avoidance [m]."""
@@ -265,6 +326,7 @@ class Scenario:
     drop_zones: tuple[DropZoneConfig, ...] = ()
     """Extra drop zones besides the ones ``depot.delivery`` implies (`swarm_sim.sites.drop_zones`)."""
     obstacles: tuple[ObstacleConfig, ...] = ()
+    transport: TransportConfig = field(default_factory=TransportConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
 
     @property
@@ -556,6 +618,7 @@ def validate(s: Scenario) -> None:
     _require(r.diameter > 0, "robots.diameter: must be positive")
     _require(r.max_linear_speed > 0, "robots.max_linear_speed: must be positive")
     _require(r.max_angular_speed > 0, "robots.max_angular_speed: must be positive")
+    _require(r.mass > 0, "robots.mass: must be positive")
     _require(
         r.start_spacing >= r.diameter,
         f"robots.start_spacing: {r.start_spacing} m is less than the robot diameter {r.diameter} m",
@@ -591,6 +654,14 @@ def validate(s: Scenario) -> None:
     _require(sc.range_max > sc.range_min >= 0, "sensors.scan.range_max: must exceed range_min")
     _require(s.sensors.resource_detection_radius > 0, "sensors.resource_detection_radius: must be positive")
     _require(s.sensors.pickup_radius > 0, "sensors.pickup_radius: must be positive")
+    _require(s.sensors.proximity.range > 0, "sensors.proximity.range: must be positive")
+    _require(s.sensors.position_range > 0, "sensors.position_range: must be positive")
+    t = s.transport
+    _require(t.object.radius > 0, "transport.object.radius: must be positive")
+    _require(t.object.mass > 0, "transport.object.mass: must be positive")
+    _require(t.object.floor_friction >= 0, "transport.object.floor_friction: must not be negative")
+    _require(t.landmarks.step > 0, "transport.landmarks.step: must be positive")
+    _require(min(t.landmarks.extent) >= 0, "transport.landmarks.extent: must not be negative")
     res = s.resources
     _require(res.count >= 0, "resources.count: must not be negative")
     _require(res.spacing > 0, "resources.spacing: must be positive")

@@ -26,7 +26,7 @@ def _plugin_env() -> dict[str, str]:
 
 
 def test_shipped_records_and_their_wiring():
-    assert registry.known() == ("cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue")
+    assert {"cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue", "caging"} <= set(registry.known())
     queue = registry.algorithm("queue")
     inbound, outbound = registry.robot_topics(queue)
     assert set(inbound) == {topics.DEPOT_GRANTS, topics.heard(topics.RADIO), topics.heard(topics.PHEROMONES)}
@@ -35,12 +35,16 @@ def test_shipped_records_and_their_wiring():
     assert set(server_in) == {topics.DEPOT_REPORTS} and set(server_out) == {topics.DEPOT_GRANTS}
     assert registry.robot_topics(registry.algorithm("ddsa")) == ({}, {})
     assert set(registry.peer_topics(queue)) == {topics.RADIO, topics.PHEROMONES}  # the world relays these
+    caging_in, caging_out = registry.robot_topics(registry.algorithm("caging"))
+    caging = {f"/caging/type{k}_{name}" for k, name in enumerate(
+        ("recruitment", "summon", "positioned", "oriented", "reached"))}
+    assert set(caging_out) == caging and set(caging_in) == {topics.heard(t) for t in caging}
 
 
 def test_records_are_refused_twice_and_unknown_names_are_named():
     with pytest.raises(ValueError, match="already registered"):
         registry.register(registry.algorithm("cpfa"))
-    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour 'nope' \\(known: cpfa"):
+    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour 'nope' \\(known: .*cpfa"):
         load_scenario("cpfa", ["controller.behaviour=nope"])
     with pytest.raises(ScenarioError, match="unknown key controller.colour"):
         load_scenario("cpfa", ["controller.colour=red"])

@@ -41,7 +41,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--plot", type=Path, help="PNG path (default: <bag>/summary.png)")
     parser.add_argument("--no-plot", action="store_true")
     parser.add_argument("--trajectories", action="store_true",
-                        help="also draw <bag>/trajectories.png: odometry over the planned spirals")
+                        help="also draw <bag>/trajectories.png (odometry over the planned paths) and the "
+                             "algorithm's own figures (caging: <bag>/transport.png)")
     parser.add_argument("--repair", action="store_true",
                         help="first finalise a bag whose recorder was killed, in place, so that rosbags "
                              "and ros2 bag read it too (every recovered message kept)")
@@ -72,6 +73,9 @@ def main(argv: list[str] | None = None) -> int:
             summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
         if args.trajectories:
             summary["trajectories"] = str(plot_trajectories(bag, bag / "trajectories.png"))
+            figures = registry.of(trace.config).figures
+            if figures:  # the algorithm's own pictures (caging: the object's path, the cage)
+                summary["figures"] = [str(p) for p in registry.resolve(figures)(trace, bag)]
         if args.video:
             try:
                 rendered = render_video(bag, args.video, speedup=args.speedup, fps=args.fps, start=args.start,
@@ -85,14 +89,16 @@ def main(argv: list[str] | None = None) -> int:
             print(json.dumps(summary))
         else:
             print(f"{bag}:")
-            for key in ("scenario", "seed", "robots", "mode", "run_ended", "dead_nodes", "sim_seconds", "wall_seconds",
+            own = [m.name for m in registry.of(trace.config).metrics]
+            for key in dict.fromkeys(("scenario", "seed", "robots", "mode", "run_ended", "dead_nodes", "sim_seconds",
+                        "wall_seconds",
                         "resources_delivered", "total_resources", "collision_time_per_robot_s",
                         "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
                         "resources_collected_pct", "dropoff_time_mean_s", "perimeter_delay_mean_s",
                         "deliveries_outside_docks",
                         "queue_length_mean", "queue_length_max", "resources_per_robot",
-                        "foraging_rate_per_min", "regions", "rejected_messages", "plot", "trajectories",
-                        "video", "video_frames"):
+                        "foraging_rate_per_min", "regions", "rejected_messages", *own, "plot", "trajectories",
+                        "figures", "video", "video_frames")):
                 if key in summary:
                     print(f"  {key:28s} {summary[key]}")
             for m in registry.of(trace.config).metrics if trace.config is not None else ():

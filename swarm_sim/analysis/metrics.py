@@ -82,7 +82,11 @@ class RunTrace:
     (the world node died: the bag ends where its last flushed data does)."""
     series: dict[str, list[tuple[float, Any]]] = field(default_factory=dict)
     """Servers' time series by name, (t [s], value) whenever it changed: e.g. the depot
-    manager's ``queue_lengths`` (robots queued on each entry line)."""
+    manager's ``queue_lengths`` (robots queued on each entry line); and the world task's state,
+    (t [s], value) every tick (the transport task's ``object`` position)."""
+    messages: list[Any] = field(default_factory=list)
+    """The robots' peer messages, in delivery order, for algorithms that ask
+    (`swarm_sim.registry.Algorithm.trace_peers`; the caging paper's types 0-4)."""
 
 
 def resources_delivered(trace: RunTrace) -> int:

@@ -22,7 +22,8 @@ def plot_run(trace: RunTrace, out: Path) -> Path:
     import matplotlib.pyplot as plt
 
     summary = summarize(trace)
-    series = sorted(trace.series.items())
+    series = sorted((name, points) for name, points in trace.series.items()
+                    if points and np.ndim(points[0][1]) <= 1)  # not the per-robot poses of a task's state
     fig, axes = plt.subplots(1, 3 + len(series), figsize=(15 + 5 * len(series), 4))
     ax1, ax2, ax3 = axes[:3]
     times, counts = delivered_over_time(trace)

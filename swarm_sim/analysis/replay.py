@@ -17,6 +17,7 @@ from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, topics
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
+from swarm_sim.messaging import delivery_order
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
 from swarm_sim.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
@@ -41,7 +42,14 @@ def load_run(path: Path | str) -> RunTrace:
         total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
     )
     trace.server_stale = _server_stale(path, str(meta.get("server_stale_ticks", "{}")))
-    replayers = [registry.resolve(s.replay) for s in registry.of(scenario).servers if s.replay]
+    algorithm = registry.of(scenario)
+    replayers = [registry.resolve(s.replay) for s in algorithm.servers if s.replay]
+    spec = registry.task(algorithm.task).state
+    state = {st.topic: st for st in (registry.resolve(spec) if spec else ())}
+    peers = {}  # topic -> message family, for algorithms whose metrics read the protocol
+    for name in algorithm.peers if algorithm.trace_peers else ():
+        family = registry.resolve(name)
+        peers.update(dict.fromkeys(family.topics.values(), family))
     index = {r: i for i, r in enumerate(trace.robots)}
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
     last_clock = 0
@@ -71,6 +79,12 @@ def load_run(path: Path | str) -> RunTrace:
             elif m.topic.endswith("/" + topics.STATUS):
                 status = diagnostics.decode_status(m.data)
                 trace.status[status.robot] = status
+            elif m.topic in state:
+                st = state[m.topic]
+                stamp, value = st.decode(m.data)
+                trace.series.setdefault(st.field, []).append((stamp / NS_PER_S, value))
+            elif m.topic in peers:
+                trace.messages.extend(peers[m.topic].decode(m.data))
             elif replayers and not m.topic.startswith("/robot_"):
                 for replay in replayers:  # the servers' recorded state (a few messages per tick)
                     for name, t, value in replay(m.topic, m.data):
@@ -80,6 +94,7 @@ def load_run(path: Path | str) -> RunTrace:
             if trace.malformed[m.topic] == 1:
                 warnings.warn(f"{path}: skipping malformed messages on {m.topic}: {exc}", MalformedMessageWarning,
                               stacklevel=2)
+    trace.messages.sort(key=delivery_order)
     if "ended" in meta:
         trace.ended = str(meta["ended"])[:200]
     elif "sim_seconds" not in meta:  # the world died before it wrote its totals: the data ends where it ends

@@ -10,8 +10,8 @@ stands still to the end and the servers free what it held; a dead server ends th
 (the bag says ``ended: server <channel> died``). Free-running (`realtime`): steps every dt / real_time_factor wall
 seconds with whatever commands have arrived.
 
-Observations are encoded straight to CDR bytes, published raw and written to the bag as the
-same bytes. Topics published by other nodes are discovered and recorded too (like
+Observations (and the world task's state topics, e.g. the caging object's pose) are encoded
+straight to CDR bytes, published raw and written to the bag as the same bytes. Topics published by other nodes are discovered and recorded too (like
 ``ros2 bag record -a``), stamped with the sim time at which they arrive.
 """
 
@@ -117,6 +117,10 @@ class WorldNode(Node):
         obs_types = {topics.ODOM: topics.ROBOT_TOPIC_TYPES[topics.ODOM],
                      topics.SCAN: topics.ROBOT_TOPIC_TYPES[topics.SCAN],
                      **{t.name: t.type_name for t in self.sensing.topics}}
+        state = registry.task(algorithm.task).state
+        self.state_topics = registry.resolve(state) if state else ()
+        """The task's world-level state topics (`swarm_msgs_py.sensing.StateTopic`), every tick."""
+        self._state_pubs = [self._publisher(st.topic, SENSOR_LOCKSTEP, st.type_name) for st in self.state_topics]
         self._obs_pubs = {
             r: {
                 name: self._publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP, type_name)
@@ -299,6 +303,10 @@ class WorldNode(Node):
             for name, data in encoded.items():
                 self._publish(pubs[name], data, topics.robot_topic(r, name), send=send)
             self._sent[r] = encoded
+        if self.state_topics:
+            values = self.world.task.state()
+            for st, pub in zip(self.state_topics, self._state_pubs):
+                self._publish(pub, st.encode(t_ns, values[st.field]), st.topic, send=send)
 
     def _publish_world_state(self, final: bool = False) -> None:
         t_ns = self.world.t_ns

@@ -17,6 +17,12 @@ back. Contact solving leaves a tiny z drift (measured: ~5e-6 m over 100 s of a c
 adds the vz that returns the body to z = height/2. Robot-robot contact is counted every substep
 from pybullet's contact points (distance <= CONTACT_TOLERANCE).
 
+A world task may add bodies of its own after the robots, walls and obstacles (the transport
+task's target object, pushed by the robots) and act after every physics substep through an
+``after_substep(h)`` hook (e.g. the object's floor friction); it may also choose where the
+robots start (`place_robots`, while the world builds tick 0). Robot mass and size come from the
+scenario (``robots.mass``, ``robots.diameter``).
+
 Determinism. Everything random comes from ``numpy.random.SeedSequence(seed)``, split into
 independent streams (start headings, odometry noise, and two for the world task: for foraging
 resources and respawns), so switching odometry noise on does not move the resources. pybullet runs with deterministic overlapping
@@ -51,8 +57,6 @@ from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.world.start import start_positions
 from swarm_sim.world.tasks import TaskFactory, WorldTask
 
-ROBOT_MASS = 1.0
-"""[kg]; only the ratio between robots matters (they all weigh the same)."""
 TILT_INERTIA = 1e6
 """Roll and pitch inertia [kg m^2]: large enough that contacts never tip a robot."""
 CONTACT_TOLERANCE = 1e-3
@@ -244,11 +248,12 @@ class World:
         shape = p.createCollisionShape(
             p.GEOM_CYLINDER, radius=self._radius, height=s.robots.height, physicsClientId=cid
         )
-        izz = 0.5 * ROBOT_MASS * self._radius**2
+        mass = s.robots.mass
+        izz = 0.5 * mass * self._radius**2
         self._bodies: list[int] = []
         for i, (x, y) in enumerate(starts):
             body = p.createMultiBody(
-                ROBOT_MASS, shape, -1, [x, y, self._z0], yaw_to_quaternion(float(yaws[i])),
+                mass, shape, -1, [x, y, self._z0], yaw_to_quaternion(float(yaws[i])),
                 physicsClientId=cid,
             )
             p.changeDynamics(
@@ -420,6 +425,7 @@ class World:
         w = self._w.tolist()
         zeros = [0.0] * n
         touched_any: set[int] = set()
+        after_substep = getattr(self.task, "after_substep", None)
         for j in range(self._substeps):
             yaw = self._yaw + self._w * (j * h) if j else self._yaw
             vx = (self._v * np.cos(yaw)).tolist()
@@ -428,6 +434,8 @@ class World:
             for body, a, b, c, d in zip(bodies, vx, vy, vz, w):
                 reset_velocity(body, (a, b, c), (0.0, 0.0, d), cid)  # positional: cheaper
             step(physicsClientId=cid)
+            if after_substep is not None:
+                after_substep(h)
             touched: set[int] = set()
             for cp in contacts(physicsClientId=cid):
                 a_body, b_body = cp[1], cp[2]
@@ -518,6 +526,13 @@ class World:
 
     def teleport(self, poses: Mapping[RobotId, Pose2D]) -> None:
         """Put robots at `poses` (at rest), for tests and scripted set-ups; odometry follows."""
+        self.place_robots(poses)
+        self._fresh = False
+        self.task.moved()
+
+    def place_robots(self, poses: Mapping[RobotId, Pose2D]) -> None:
+        """Put robots at `poses` (at rest) with their odometry; what a task calls while the
+        world builds tick 0 to choose where robots start (`teleport` does it later)."""
         cid = self._cid
         for robot, pose in poses.items():
             i = self._index[robot]
@@ -526,13 +541,11 @@ class World:
                 physicsClientId=cid,
             )
             p.resetBaseVelocity(self._bodies[i], (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=cid)
-        self._fresh = False
         self._read_state()
         for robot in poses:
             i = self._index[robot]
             self._odo[i] = (self._pos[i, 0], self._pos[i, 1], self._yaw[i])
         self._obs_cache = None
-        self.task.moved()
 
     def close(self) -> None:
         """Disconnect from pybullet (idempotent)."""

@@ -10,12 +10,19 @@ topic per field) is declared next to its codecs in `swarm_msgs_py`.
 
 The hooks, called by the world in this order:
 
-- construction (inside `World` building tick 0, after the robots and walls exist): place things,
-  with two seed sequences of the run's seed that belong to the task;
+- construction (inside `World` building tick 0, after the robots and walls exist): place things
+  (bodies of its own included), with two seed sequences of the run's seed that belong to the
+  task; it may move the robots to where they start (`World.place_robots`);
+- optionally ``after_substep(h)`` after every physics substep of h seconds (forces of its own,
+  e.g. floor friction on a body it added);
 - `post_step(stamp_ns)` after every tick's physics and odometry (ARGoS PostStep);
 - `sense()` when the world builds the observations of the current tick;
 - `moved()` when robots were teleported (scripted set-ups);
-- `drain_events()`, `placed()`, `progress()` for the nodes, the batch runner and markers.
+- `drain_events()`, `placed()`, `progress()` for the nodes, the batch runner and markers;
+- optionally ``state()``: named values of the current tick that the world node publishes on
+  world-level topics and the batch runner keeps as time series (the task's ``state`` record,
+  `swarm_msgs_py.sensing.StateTopic`; the transport task: the object's and the robots' true
+  positions).
 """
 
 from __future__ import annotations
