@@ -112,7 +112,9 @@ class ControllerNode(Node):
                 lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
                 EVENTS, raw=True,
             )
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
+            for topic, family in inbound.items()
+        }
+        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
                           for t, f in outbound.items()}
 
         self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
