@@ -11,16 +11,17 @@ Messages from other nodes are untrusted: they are checked before the behaviour s
 (`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
 and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
 
-The node serves the standard parameter services (``ros2 param list/get``), created with it; with
-the discovery server each process only learns of the endpoints on its own topics, so their twelve
-DDS endpoints per robot cost the start-up little.
+The node serves the standard parameter services (``ros2 param list/get``), created with it:
+twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
+discovery (README, Benchmarks); the discovery server only tells each process of the endpoints on
+its own topics.
 
 ``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process;
 with ``--fork`` it gives every robot its own process instead, forked from this one once the
 imports and the scenario are loaded (one process per robot, as on real hardware, without paying
-a Python start-up per robot: 112 robots reach their first tick in seconds, not minutes). Each
-forked process is named after its robot (``ps -o comm``) and dies with its parent; the parent
-passes Ctrl-C and SIGTERM on, and says which robot's process died and how.
+a Python start-up per robot: 112 robots reached their first tick in 20-32 s on the 2-core
+machine). Each forked process is named after its robot (``ps -o comm``) and dies with its
+parent; the parent passes Ctrl-C and SIGTERM on, and says which robot's process died and how.
 """
 
 from __future__ import annotations

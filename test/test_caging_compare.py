@@ -4,7 +4,7 @@ paper's numbers (synthetic rows; the sweep itself is the batch runner's)."""
 from __future__ import annotations
 
 from swarm_sim.compare import comparisons
-from swarm_sim.compare.caging_paper import CELLS, caging_plans, caging_tables_md, write_caging_report
+from swarm_sim.compare.caging_paper import CELLS, caging_headlines, caging_plans, caging_tables_md, write_caging_report
 from swarm_sim.scenario import load_scenario
 
 
@@ -40,3 +40,20 @@ def test_the_report_puts_our_cells_next_to_the_papers_numbers(tmp_path):
     assert "(paper: about 3.8 %)" in text
     written = write_caging_report(rows, tmp_path)
     assert [p.name for p in written] == ["tables.md", "times.png", "error.png"]
+
+
+def test_headlines_check_the_papers_claims_on_our_cells():
+    rows = [_row(c.number, s) for c in CELLS for s in range(4)]
+    rows += [_row(1, 4 + s, search_time_s=10.0) for s in range(4)]  # the coarse grid searches faster
+    found = {h.claim: h for h in caging_headlines(rows)}
+    recruitment, search, error, delivered = found.values()
+    assert recruitment.holds is True  # 150 s at both steps
+    assert search.holds is True and "vs" in search.ours
+    assert error.holds is False and error.ours.startswith("10.0 %")  # more than twice 3.8 %
+    assert delivered.holds is True and delivered.ours == f"{len(rows)}/{len(rows)} runs"
+    slower = [_row(0, s, recruitment_time_s=100.0 + s) for s in range(6)] + [_row(1, s, recruitment_time_s=300.0 + s)
+                                                                            for s in range(6)]
+    assert caging_headlines(slower)[0].holds is False
+    rows[0] = _row(0, 0, transport_time_s=None, cage_held=False, trajectory_error_pct=None)
+    assert caging_headlines(rows)[3].holds is False
+    assert [h.holds for h in caging_headlines([])] == [None, None, None, None]
