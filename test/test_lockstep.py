@@ -25,3 +25,21 @@ def test_an_answer_for_another_tick_does_not_count():
     b.answered("robot_0", 4)
     assert b.waiting(5, ["robot_0"]) == ["robot_0"]
     assert b.close_tick(5) == (["robot_0"], [])
+
+
+def test_a_late_answer_means_slow_not_dead():
+    """A participant whose answers arrive after their ticks closed stays stale at each tick but
+    is never declared dead; silence counts from its last late answer."""
+    b = LockstepBarrier(["robot_0", "robot_1"], dead_after=2)
+    for k in range(6):
+        b.answered("robot_0", k)
+        if k:
+            b.heard("robot_1")  # its answer to tick k - 1, after that tick closed
+        assert b.close_tick(k) == (["robot_1"], [])
+    assert b.dead == set()
+    # silent from now on: robot_1 had missed tick 5 already (its count restarted before it)
+    assert b.close_tick(6) == (["robot_0", "robot_1"], ["robot_1"])
+    assert b.close_tick(7) == (["robot_0", "robot_1"], ["robot_0"])
+    b.heard("robot_1")  # too late: death is final
+    assert b.dead == {"robot_0", "robot_1"}
+    b.heard("robot_9")  # not a participant: ignored

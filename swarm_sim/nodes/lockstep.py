@@ -2,11 +2,14 @@
 
 ROS-free. The world node waits (spinning) until `waiting(k)` is empty or the tick timeout has
 passed, then calls `close_tick(k)`. Participants are the robots and the servers' channels. One
-that misses `dead_after` ticks in a row is declared dead, for good: it is no longer waited for,
-its later answers are refused (`answered` returns False) and every later tick counts as stale
-for it. Death is final because the others act on it (the servers give a dead robot's dock,
-slots or region to others; a dead server ends the run), so a controller that comes back after
-a long stall must not resume driving on a state the rest of the graph has written off.
+that misses `dead_after` ticks in a row, with nothing heard from it meanwhile, is declared dead,
+for good. Dead means silent, not slow: an answer to a tick already closed (`heard`) restarts the
+count, so robots that fall behind in the start-up storm of a hundred processes on two cores are
+not written off. A dead participant is no longer waited for, its later answers are refused
+(`answered` returns False) and every later tick counts as stale for it. Death is final because
+the others act on it (the servers give a dead robot's dock, slots or region to others; a dead
+server ends the run), so a controller that comes back after a long stall must not resume
+driving on a state the rest of the graph has written off.
 """
 
 from __future__ import annotations
@@ -32,6 +35,12 @@ class LockstepBarrier:
             return False
         self._answered[who] = stamp_ns
         return True
+
+    def heard(self, who: str) -> None:
+        """`who` answered a tick already closed: it is alive, only late; its count of ticks
+        missed in a row restarts (it stays stale at the ticks it missed)."""
+        if who in self.missed and who not in self.dead:
+            self.missed[who] = 0
 
     def has_answered(self, who: str, stamp_ns: int) -> bool:
         return self._answered.get(who) == stamp_ns

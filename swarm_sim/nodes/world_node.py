@@ -233,6 +233,8 @@ class WorldNode(Node):
                 return  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
+            if late:
+                self.barrier.heard(robot)  # slow, not dead
             self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
             return
@@ -250,6 +252,8 @@ class WorldNode(Node):
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
         elif channel in self.barrier.dead:
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
+        elif stamp_ns < self.world.t_ns:
+            self.barrier.heard(channel)  # an ack for a tick already closed: slow, not dead
         else:
             self.barrier.answered(channel, stamp_ns)
 
