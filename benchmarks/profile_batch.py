@@ -1,10 +1,12 @@
 """Where each millisecond of a batch-runner tick goes, phase by phase (issue 14's profile).
 
     python benchmarks/profile_batch.py --robots 112 1000 --scenario cpfa queue_qmt
-    python benchmarks/profile_batch.py --robots 112 --scenario cpfa --duration 60
+    python benchmarks/profile_batch.py --robots 112 --scenario cpfa --duration 60 --repeat 3
+    python benchmarks/profile_batch.py --robots 1000 --warmup 60   # robots spread out first
 
-Each (scenario, robots) pair is run twice with the same seed: once plain (only the tick window
-is marked: the real-time factor) and once instrumented. The instrumented run is `run_batch`
+Each (scenario, robots) pair is run with the same seed plain (only the tick window is marked:
+the real-time factor) and instrumented, alternated ``--repeat`` times; the table is the
+instrumented run of median length, the real-time factor the plain runs' median. The instrumented run is `run_batch`
 itself, untouched: the benchmark swaps the names `swarm_sim.batch` looks up (`World`,
 `make_behaviour`, `make_servers`, `Router`, `PerimeterLog`, ...) and the world's scan functions
 for versions whose methods are wrapped in a `time.perf_counter` timer, and restores them
@@ -14,9 +16,11 @@ collector is timed through ``gc.callbacks`` and taken out of the phase it interr
 phases plus "other" add up to the measured tick exactly. "other" is what no wrapper covers:
 `run_batch`'s own loop (the commands dict, the message loop) and the timers' own cost.
 
-The tick window runs from the end of ``World.reset`` to the last ``PerimeterLog.update`` (the
-statement that opens every tick of `run_batch` and follows its last one): set-up, the final
-status and the trace's wrap-up are not per-tick work and are left out.
+The measured ticks run from the start of the first tick after ``--warmup`` sim seconds to the
+end of the last: tick boundaries are the calls of ``PerimeterLog.update`` (the statement that
+opens every tick of `run_batch` and follows its last one). Set-up, the final status and the
+trace's wrap-up are not per-tick work and are left out. The robots start on a grid around the
+depot, so the first minute's ticks are the crowded ones (more robot pairs within scan range).
 
 Scaled arenas: ``--arena N=SIDE`` gives the runs of N robots a SIDE x SIDE m arena (default
 ``1000=38``, issue 14's 1000 robots on 38 x 38 m); their clustered resources scale with the area
@@ -93,27 +97,30 @@ class Timers:
 
 @dataclass
 class TickWindow:
-    """The per-tick part of a run: from the end of ``World.reset`` to the last tick's end."""
+    """The measured ticks of a run: from the start of tick `skip` to the end of the last."""
 
+    skip: int = 0
     start: float = math.nan
     end: float = math.nan
     marks: int = 0
     seconds: dict[str, float] = field(default_factory=dict)
     calls: dict[str, int] = field(default_factory=dict)
-    world: Any = None
-
-    def open(self, timers: Timers | None) -> None:
-        if timers is not None:
-            timers.reset()
-        self.start = time.perf_counter()
 
     def mark(self, timers: Timers | None) -> None:
-        """A tick boundary (`PerimeterLog.update` entry): the window so far."""
+        """A tick boundary (`PerimeterLog.update` entry): opens the window or extends it."""
         self.end = time.perf_counter()
         self.marks += 1
-        if timers is not None:
+        if self.marks == self.skip + 1:
+            self.start = self.end
+            if timers is not None:
+                timers.reset()
+        elif timers is not None:
             self.seconds = dict(timers.seconds)
             self.calls = dict(timers.calls)
+
+    @property
+    def ticks(self) -> int:
+        return self.marks - 1 - self.skip
 
 
 @dataclass
@@ -158,16 +165,18 @@ def _patched(targets: list[tuple[Any, str, Any]]) -> Iterator[None]:
             setattr(obj, name, value)
 
 
-def profile_run(scenario: Scenario, *, instrument: bool = True, record_poses: bool = False) -> Profile:
-    """One `run_batch` of `scenario`; with `instrument`, the time of every phase."""
+def profile_run(
+    scenario: Scenario, *, instrument: bool = True, warmup_ticks: int = 0, record_poses: bool = False
+) -> Profile:
+    """One `run_batch` of `scenario`; with `instrument`, the time of every phase of the ticks
+    after the first `warmup_ticks`."""
     timers = Timers() if instrument else None
-    window = TickWindow()
+    window = TickWindow(warmup_ticks)
     world_cls, perimeter_cls, router_cls = batch.World, batch.PerimeterLog, batch.Router
     wrap = timers.wrap if timers else (lambda _name, fn: fn)
 
     def make_world(s: Scenario) -> Any:
         world = world_cls(s)
-        window.world = world
         task = world.task
         _instrument_instance(world, timers, {
             "_physics": "world: physics step (pybullet substeps, contacts)",
@@ -181,14 +190,6 @@ def profile_run(scenario: Scenario, *, instrument: bool = True, record_poses: bo
             "sense": f"world: task sense ({type(task).__name__})",
             "post_step": f"world: task post_step ({type(task).__name__}: pick-ups, drops)",
         })
-        reset = world.reset
-
-        def reset_then_open() -> Any:
-            obs = reset()
-            window.open(timers)
-            return obs
-
-        world.reset = reset_then_open
         return world
 
     def make_behaviour(s: Scenario, robot: str, rng: Any) -> Any:
@@ -244,11 +245,12 @@ def profile_run(scenario: Scenario, *, instrument: bool = True, record_poses: bo
         if timers is not None:
             gc.callbacks.remove(timers.gc_callback)
     run_s = time.perf_counter() - t0
-    ticks = window.marks - 1  # the last mark closes the last tick
+    if window.ticks < 1:
+        raise ValueError(f"no tick after the {warmup_ticks} warm-up ticks (the run has {window.marks - 1})")
     window_s = window.end - window.start
     phases = dict(window.seconds)
     phases["other (run_batch loop, timers)"] = window_s - sum(phases.values())
-    return Profile(scenario, ticks, window_s, run_s, phases, dict(window.calls), run)
+    return Profile(scenario, window.ticks, window_s, run_s, phases, dict(window.calls), run)
 
 
 def scaled_fields(scenario: str, robots: int, arena: float | None) -> dict[str, Any]:
@@ -295,13 +297,16 @@ def timer_overhead_s() -> float:
     return sorted(samples)[2]
 
 
-def print_profile(prof: Profile, plain: Profile, overhead_s: float) -> None:
+def print_profile(prof: Profile, plains: list[Profile], overhead_s: float) -> None:
     s = prof.scenario
     n = s.robots.count
     print(f"\n== {s.name}, {n} robots, {s.arena.size:g} x {s.arena.size:g} m, {s.resources.count} resources, "
-          f"{prof.ticks} ticks of {s.sim.dt:g} s, seed {s.seed}")
-    print(f"plain run:        {plain.ms_per_tick:7.2f} ms/tick, real-time factor {plain.real_time_factor:6.1f}x "
-          f"(whole run_batch incl. set-up: {plain.ticks * s.sim.dt / plain.run_s:.1f}x), delivered {len(plain.run.trace.drops)}")
+          f"ticks {s.ticks - prof.ticks}-{s.ticks - 1} of {s.sim.dt:g} s, seed {s.seed}")
+    ms = sorted(p.ms_per_tick for p in plains)
+    plain = sorted(plains, key=lambda p: p.ms_per_tick)[len(plains) // 2]
+    spread = f" (range {ms[0]:.2f}-{ms[-1]:.2f} over {len(ms)} runs)" if len(ms) > 1 else ""
+    print(f"plain run:        {plain.ms_per_tick:7.2f} ms/tick{spread}, real-time factor {plain.real_time_factor:6.1f}x, "
+          f"delivered {len(plain.run.trace.drops)}")
     calls = sum(prof.calls.values())
     print(f"instrumented run: {prof.ms_per_tick:7.2f} ms/tick, real-time factor {prof.real_time_factor:6.1f}x, "
           f"delivered {len(prof.run.trace.drops)}; {calls / max(prof.ticks, 1):.0f} timed calls/tick, "
@@ -337,6 +342,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="sim seconds per run (default: 60 s below 500 robots, 10 s from 500)")
     parser.add_argument("--arena", type=arena_override, nargs="*", default=[(1000, 38.0)], metavar="ROBOTS=SIDE",
                         help="arena side [m] for runs of ROBOTS robots, resources scaled with the area (default 1000=38)")
+    parser.add_argument("--warmup", type=float, default=0.0, help="sim seconds run before the measured ticks")
+    parser.add_argument("--repeat", type=int, default=1, help="plain and instrumented runs, alternated")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     overhead = timer_overhead_s()
@@ -345,10 +352,13 @@ def main(argv: list[str] | None = None) -> int:
         for n in sorted(args.robots):
             duration = args.duration or (60.0 if n < 500 else 10.0)
             fields = scaled_fields(name, n, dict(args.arena).get(n))
-            scenario = load_scenario(name, **fields, sim__duration=duration, seed=args.seed)
-            plain = profile_run(scenario, instrument=False)
-            prof = profile_run(scenario)
-            print_profile(prof, plain, overhead)
+            scenario = load_scenario(name, **fields, sim__duration=args.warmup + duration, seed=args.seed)
+            warmup = round(args.warmup / scenario.sim.dt)
+            plains, profs = [], []
+            for _ in range(max(1, args.repeat)):
+                plains.append(profile_run(scenario, instrument=False, warmup_ticks=warmup))
+                profs.append(profile_run(scenario, warmup_ticks=warmup))
+            print_profile(sorted(profs, key=lambda p: p.window_s)[len(profs) // 2], plains, overhead)
     return 0
 
 

@@ -38,6 +38,7 @@ def test_phases_add_up_and_the_run_is_unchanged():
     np.testing.assert_array_equal(prof.run.poses, plain.poses)
     assert prof.run.trace.status == plain.trace.status
     assert prof.run.trace.stats == plain.trace.stats
+    assert profile_batch.profile_run(scenario, warmup_ticks=10).ticks == scenario.ticks - 10
 
 
 def test_scaled_arena_keeps_the_density_and_the_resource_grid():
