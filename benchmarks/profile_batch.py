@@ -53,6 +53,20 @@ _AVOIDANCE = ("swarm_controllers.avoidance", ("ObstacleAvoidance", "AvoidThenEsc
 """The behaviours' shared obstacle avoidance (the scan's consumer), timed as its own phase."""
 
 
+class _TimedPybullet:
+    """The pybullet module as `swarm_sim.world.core` sees it, with the calls made a few times per
+    tick (not per robot) timed: the physics phase split into pybullet's own work and the
+    per-robot Python around it."""
+
+    def __init__(self, module: Any, timers: Timers) -> None:
+        self._module = module
+        self.stepSimulation = timers.wrap("world: physics: pybullet stepSimulation", module.stepSimulation)
+        self.getContactPoints = timers.wrap("world: physics: pybullet getContactPoints", module.getContactPoints)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._module, name)
+
+
 class Timers:
     """Exclusive time per phase: a stack of the child time of every open timer."""
 
@@ -179,7 +193,7 @@ def profile_run(
         world = world_cls(s)
         task = world.task
         _instrument_instance(world, timers, {
-            "_physics": "world: physics step (pybullet substeps, contacts)",
+            "_physics": "world: physics: per-body velocities + contact loop (Python)",
             "_read_state": "world: pose read-back (pybullet)",
             "_apply_commands": "world: commands + odometry",
             "_odometry": "world: commands + odometry",
@@ -230,6 +244,7 @@ def profile_run(
             (batch, "with_messages", wrap("routing: inbox into observations", batch.with_messages)),
             (batch, "_collect_events", wrap("bookkeeping: events + trace", batch._collect_events)),
             (batch, "_record_state", wrap("bookkeeping: events + trace", batch._record_state)),
+            (world_core, "p", _TimedPybullet(world_core.p, timers)),
             (world_core, "cast_scan", wrap("world: ray casting (scan)", world_core.cast_scan)),
             (world_core, "cast_scan_pybullet", wrap("world: ray casting (scan)", world_core.cast_scan_pybullet)),
         ]

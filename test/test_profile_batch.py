@@ -30,7 +30,7 @@ def test_phases_add_up_and_the_run_is_unchanged():
     assert all(v >= 0.0 for v in prof.phases.values()), prof.phases
     assert abs(sum(prof.phases.values()) - prof.window_s) <= 0.05 * prof.window_s
     assert prof.window_s <= prof.run_s
-    for phase in ("world: physics step", "world: ray casting", "behaviours: QueueBehaviour.step",
+    for phase in ("world: physics: pybullet stepSimulation", "world: ray casting", "behaviours: QueueBehaviour.step",
                   "behaviours: obstacle avoidance", "servers: DepotServer.step", "bookkeeping: perimeter log"):
         assert any(name.startswith(phase) for name in prof.phases), (phase, sorted(prof.phases))
     assert prof.calls["behaviours: QueueBehaviour.step"] == 4 * scenario.ticks
