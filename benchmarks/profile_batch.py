@@ -43,14 +43,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import swarm_sim.batch as batch
+from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance
 import swarm_sim.world.core as world_core
 from swarm_sim.scenario import Scenario, load_scenario
 
 GROUPS = ("world", "behaviours", "routing", "servers", "bookkeeping", "gc")
 """Phase names start with one of these (then ':'); the table prints a subtotal per group."""
 
-_AVOIDANCE = ("swarm_controllers.avoidance", ("ObstacleAvoidance", "AvoidThenEscape"), "update")
-"""The behaviours' shared obstacle avoidance (the scan's consumer), timed as its own phase."""
+AVOIDANCE = (ObstacleAvoidance, AvoidThenEscape)
+"""The behaviours' shared obstacle avoidance (the scan's consumer): its ``update`` is a phase."""
 
 
 class _TimedPybullet:
@@ -152,7 +153,7 @@ class Profile:
 
     @property
     def ms_per_tick(self) -> float:
-        return 1e3 * self.window_s / max(self.ticks, 1)
+        return 1e3 * self.window_s / self.ticks
 
     @property
     def real_time_factor(self) -> float:
@@ -219,7 +220,9 @@ def profile_run(
 
     def make_router() -> Any:
         router = router_cls()
-        _instrument_instance(router, timers, {"post": "routing: Router.post", "take_before": "routing: Router.take_before"})
+        _instrument_instance(router, timers, {
+            "post": "routing: Router.post", "take_before": "routing: Router.take_before",
+        })
         return router
 
     def make_perimeter(*args: Any) -> Any:
@@ -236,7 +239,6 @@ def profile_run(
     batch_make_behaviour, batch_make_servers = batch.make_behaviour, batch.make_servers
     targets: list[tuple[Any, str, Any]] = [(batch, "World", make_world), (batch, "PerimeterLog", make_perimeter)]
     if timers is not None:
-        avoid_module = __import__(_AVOIDANCE[0], fromlist=list(_AVOIDANCE[1]))
         targets += [
             (batch, "make_behaviour", make_behaviour),
             (batch, "make_servers", make_servers),
@@ -248,9 +250,7 @@ def profile_run(
             (world_core, "cast_scan", wrap("world: ray casting (scan)", world_core.cast_scan)),
             (world_core, "cast_scan_pybullet", wrap("world: ray casting (scan)", world_core.cast_scan_pybullet)),
         ]
-        for name in _AVOIDANCE[1]:
-            cls = getattr(avoid_module, name)
-            targets.append((cls, _AVOIDANCE[2], wrap("behaviours: obstacle avoidance", getattr(cls, _AVOIDANCE[2]))))
+        targets += [(cls, "update", wrap("behaviours: obstacle avoidance", cls.update)) for cls in AVOIDANCE]
         gc.callbacks.append(timers.gc_callback)
     t0 = time.perf_counter()
     try:
@@ -320,26 +320,31 @@ def print_profile(prof: Profile, plains: list[Profile], overhead_s: float) -> No
     ms = sorted(p.ms_per_tick for p in plains)
     plain = sorted(plains, key=lambda p: p.ms_per_tick)[len(plains) // 2]
     spread = f" (range {ms[0]:.2f}-{ms[-1]:.2f} over {len(ms)} runs)" if len(ms) > 1 else ""
-    print(f"plain run:        {plain.ms_per_tick:7.2f} ms/tick{spread}, real-time factor {plain.real_time_factor:6.1f}x, "
+    print(f"plain run:        {plain.ms_per_tick:7.2f} ms/tick{spread}, "
+          f"real-time factor {plain.real_time_factor:6.1f}x, "
           f"delivered {len(plain.run.trace.drops)}")
     calls = sum(prof.calls.values())
     print(f"instrumented run: {prof.ms_per_tick:7.2f} ms/tick, real-time factor {prof.real_time_factor:6.1f}x, "
-          f"delivered {len(prof.run.trace.drops)}; {calls / max(prof.ticks, 1):.0f} timed calls/tick, "
-          f"timer cost ~{1e3 * overhead_s * calls / max(prof.ticks, 1):.2f} ms/tick (inside 'other' and the phases)")
+          f"delivered {len(prof.run.trace.drops)}; {calls / prof.ticks:.0f} timed calls/tick, "
+          f"timer cost ~{1e3 * overhead_s * calls / prof.ticks:.2f} ms/tick (inside 'other' and the phases)")
     total = prof.window_s
-    per_tick = 1e3 / max(prof.ticks, 1)
+    per_tick = 1e3 / prof.ticks
     print(f"{'phase':62s} {'ms/tick':>8s} {'%':>6s} {'us/robot':>9s}")
+
+    def row(seconds: float) -> str:
+        return f"{seconds * per_tick:8.3f} {100 * seconds / total:6.1f} {1e3 * seconds * per_tick / n:9.2f}"
+
     rows = sorted(prof.phases.items(), key=lambda kv: (_group_rank(kv[0]), -kv[1]))
     group = None
     for name, sec in rows:
         g = name.split(":")[0] if ":" in name else "other"
         if g != group and g in GROUPS:
             sub = sum(v for k, v in prof.phases.items() if k.startswith(g + ":"))
-            print(f"{g + ' (total)':62s} {sub * per_tick:8.3f} {100 * sub / total:6.1f} {1e3 * sub * per_tick / n:9.2f}")
+            print(f"{g + ' (total)':62s} {row(sub)}")
         group = g
         indent = "  " if g in GROUPS else ""
-        print(f"{indent}{name:{62 - len(indent)}s} {sec * per_tick:8.3f} {100 * sec / total:6.1f} {1e3 * sec * per_tick / n:9.2f}")
-    print(f"{'TOTAL (measured tick)':62s} {total * per_tick:8.3f} {100.0:6.1f} {1e3 * total * per_tick / n:9.2f}")
+        print(f"{indent}{name:{62 - len(indent)}s} {row(sec)}")
+    print(f"{'TOTAL (measured tick)':62s} {row(total)}")
     print(f"sum of phases {sum(prof.phases.values()) * per_tick:.3f} ms/tick; peak RSS so far "
           f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB", flush=True)
 
@@ -356,7 +361,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--duration", type=float, default=None,
                         help="sim seconds per run (default: 60 s below 500 robots, 10 s from 500)")
     parser.add_argument("--arena", type=arena_override, nargs="*", default=[(1000, 38.0)], metavar="ROBOTS=SIDE",
-                        help="arena side [m] for runs of ROBOTS robots, resources scaled with the area (default 1000=38)")
+                        help="arena side [m] for runs of ROBOTS robots, resources scaled with the area "
+                             "(default 1000=38)")
     parser.add_argument("--warmup", type=float, default=0.0, help="sim seconds run before the measured ticks")
     parser.add_argument("--repeat", type=int, default=1, help="plain and instrumented runs, alternated")
     parser.add_argument("--seed", type=int, default=0)
