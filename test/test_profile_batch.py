@@ -23,9 +23,13 @@ _spec.loader.exec_module(profile_batch)
 
 def test_phases_add_up_and_the_run_is_unchanged():
     scenario = load_scenario("queue_qmt", robots__count=4, sim__duration=3.0)
-    names = (batch.World, batch.make_behaviour, batch.Router, world_core.cast_scan, ObstacleAvoidance.update)
+    def patched_names():
+        return (batch.World, batch.make_behaviour, batch.Router, world_core.cast_scan, world_core.p,
+                ObstacleAvoidance.update)
+
+    names = patched_names()
     prof = profile_batch.profile_run(scenario, record_poses=True)
-    assert (batch.World, batch.make_behaviour, batch.Router, world_core.cast_scan, ObstacleAvoidance.update) == names
+    assert patched_names() == names  # every swapped name is restored
     assert prof.ticks == scenario.ticks
     assert all(v >= 0.0 for v in prof.phases.values()), prof.phases
     assert abs(sum(prof.phases.values()) - prof.window_s) <= 0.05 * prof.window_s
@@ -41,7 +45,7 @@ def test_phases_add_up_and_the_run_is_unchanged():
     assert profile_batch.profile_run(scenario, warmup_ticks=10).ticks == scenario.ticks - 10
 
 
-def test_scaled_arena_keeps_the_density_and_the_resource_grid():
+def test_scaled_arena_scales_the_resource_clusters_with_the_area():
     fields = profile_batch.scaled_fields("cpfa", 1000, 38.0)
     assert fields["arena__size"] == 38.0
     assert fields["resources__count"] == fields["resources__clusters"] * 64 == 3200
