@@ -114,6 +114,25 @@ def server_profile(port: int) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def robot_profile() -> str:
+    """The loopback profile for robot controller processes: their ``ros_discovery_info``
+    readers ask for exclusive ownership, which no writer offers, so robots never match each
+    other's (or anyone's) ROS graph announcements. Every process writes that topic and, by
+    default, reads it: with a process per robot that is N x N reliable writer-reader pairs, the
+    bulk of a 112-process start-up. A controller needs no graph (it counts matches, which come
+    from DDS discovery); the world, the servers and a `ros2` CLI still read every process's
+    announcements, so node names and parameter services stay visible."""
+    ns = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
+    ET.register_namespace("", ns)
+    root = ET.parse(PROFILE_PATH).getroot()
+    q = lambda tag: f"{{{ns}}}{tag}"
+    profiles = root.find(q("profiles"))
+    reader = ET.SubElement(profiles, q("data_reader"), profile_name="ros_discovery_info")
+    kind = ET.SubElement(ET.SubElement(ET.SubElement(reader, q("qos")), q("ownership")), q("kind"))
+    kind.text = "EXCLUSIVE"
+    return ET.tostring(root, encoding="unicode")
+
+
 def discovery_server_env(env: Mapping[str, str], profile_path: Path) -> dict[str, str]:
     """`env` (a client's) made the discovery server's: its own profile, no server to call."""
     out = {k: v for k, v in env.items() if k != "ROS_DISCOVERY_SERVER"}

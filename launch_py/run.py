@@ -37,6 +37,7 @@ from launch_py.dds import (
     discovery_server_env,
     loopback_env,
     private_domain_id,
+    robot_profile,
     server_profile,
 )
 from launch_py.lifetime import die_with_parent
@@ -150,11 +151,15 @@ def main(argv: list[str] | None = None) -> int:
     env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ, server_port=port)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
+    profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
     world_env = env
     if port is not None:
-        profile = Path(tempfile.mkdtemp(prefix="swarmforage-")) / "discovery_server.xml"
-        profile.write_text(server_profile(port), encoding="utf-8")
-        world_env = discovery_server_env(env, profile)
+        (profiles / "discovery_server.xml").write_text(server_profile(port), encoding="utf-8")
+        world_env = discovery_server_env(env, profiles / "discovery_server.xml")
+    # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
+    (profiles / "robots.xml").write_text(robot_profile(), encoding="utf-8")
+    robots_env = {**env, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profiles / "robots.xml"),
+                  "FASTDDS_DEFAULT_PROFILES_FILE": str(profiles / "robots.xml")}
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -190,7 +195,7 @@ def main(argv: list[str] | None = None) -> int:
     launched = said = time.monotonic()
     try:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
-        children += [start(label, [*cmd, *common]) for label, cmd in controllers]
+        children += [start(label, [*cmd, *common], robots_env) for label, cmd in controllers]
         children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)
@@ -214,8 +219,7 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
-        if port is not None:
-            shutil.rmtree(profile.parent, ignore_errors=True)
+        shutil.rmtree(profiles, ignore_errors=True)
 
     if world is None:  # interrupted before anything ran
         return 130

@@ -376,3 +376,40 @@ def _parent(pid: int) -> int:
         return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
     except (OSError, IndexError, ValueError):
         return -1
+
+
+def test_robots_do_not_read_graph_announcements_but_everyone_sees_their_nodes(tmp_path) -> None:
+    """With one process per robot, the controllers' `ros_discovery_info` readers match nobody
+    (`dds.robot_profile`: N x N pairs become N), yet a `ros2`-style client of the run's discovery
+    server still sees every robot's node, as `ros2 node list` / `ros2 param` need."""
+    profile = dds.robot_profile()
+    assert 'profile_name="ros_discovery_info"' in profile and "<kind>EXCLUSIVE</kind>" in profile
+    assert "127.0.0.1" in profile and "<useBuiltinTransports>false</useBuiltinTransports>" in profile
+    domain = int(os.environ["ROS_DOMAIN_ID"])
+    cmd = [sys.executable, "-m", "launch_py.run", "--scenario", "cpfa", "--robots", "3", "--duration", "600",
+           "--controller-processes", "0", "--bag", str(tmp_path / "bag"), "--domain-id", str(domain)]
+    launcher = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                start_new_session=True)
+    probe = (
+        "import rclpy, time, json\n"
+        "rclpy.init()\n"
+        "node = rclpy.create_node('graph_probe')\n"
+        "names = set()\n"
+        "end = time.monotonic() + 60\n"
+        "while time.monotonic() < end and not {'/robot_0/controller', '/robot_2/controller'} <= names:\n"
+        "    rclpy.spin_once(node, timeout_sec=0.5)\n"
+        "    names = {ns.rstrip('/') + '/' + n for n, ns in node.get_node_names_and_namespaces()}\n"
+        "print(json.dumps(sorted(names)))\n"
+    )
+    env = {**dds.loopback_env(domain, processes=2, server_port=dds.discovery_port(domain)), "ROS_SUPER_CLIENT": "TRUE"}
+    try:
+        out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120)
+        names = set(json.loads(out.stdout.strip().splitlines()[-1]))
+        assert {"/robot_0/controller", "/robot_1/controller", "/robot_2/controller", "/world"} <= names, names
+    finally:
+        os.killpg(launcher.pid, signal.SIGINT)
+        try:
+            launcher.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(launcher.pid, signal.SIGKILL)
+            launcher.wait()
