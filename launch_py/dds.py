@@ -94,23 +94,34 @@ def discovery_port(domain_id: int) -> int:
     return 7000 + domain_id
 
 
+_PROFILE_NS = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
+
+
+def _loopback_profile() -> ET.Element:
+    """The loopback profile's XML tree, to derive a role's profile from (`_tag` names its tags)."""
+    ET.register_namespace("", _PROFILE_NS)
+    return ET.parse(PROFILE_PATH).getroot()
+
+
+def _tag(tag: str) -> str:
+    """A Fast DDS profile tag with its namespace."""
+    return f"{{{_PROFILE_NS}}}{tag}"
+
+
 def server_profile(port: int) -> str:
     """The loopback profile with discovery-server role: prefix of server id 0, metatraffic on
     127.0.0.1:`port` (everything else, transports and interface allow-list, unchanged)."""
-    ns = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
-    ET.register_namespace("", ns)
-    root = ET.parse(PROFILE_PATH).getroot()
-    q = lambda tag: f"{{{ns}}}{tag}"
-    rtps = root.find(f".//{q('participant')}/{q('rtps')}")
+    root = _loopback_profile()
+    rtps = root.find(f".//{_tag('participant')}/{_tag('rtps')}")
     assert rtps is not None
-    prefix = ET.Element(q("prefix"))
+    prefix = ET.Element(_tag("prefix"))
     prefix.text = SERVER_PREFIX
     rtps.insert(0, prefix)
-    builtin = rtps.find(q("builtin"))
-    builtin.find(f"{q('discovery_config')}/{q('discoveryProtocol')}").text = "SERVER"
-    udp = builtin.find(f"{q('metatrafficUnicastLocatorList')}/{q('locator')}/{q('udpv4')}")
-    ET.SubElement(udp, q("port")).text = str(port)
-    builtin.remove(builtin.find(q("initialPeersList")))
+    builtin = rtps.find(_tag("builtin"))
+    builtin.find(f"{_tag('discovery_config')}/{_tag('discoveryProtocol')}").text = "SERVER"
+    udp = builtin.find(f"{_tag('metatrafficUnicastLocatorList')}/{_tag('locator')}/{_tag('udpv4')}")
+    ET.SubElement(udp, _tag("port")).text = str(port)
+    builtin.remove(builtin.find(_tag("initialPeersList")))
     return ET.tostring(root, encoding="unicode")
 
 
@@ -122,13 +133,10 @@ def robot_profile() -> str:
     bulk of a 112-process start-up. A controller needs no graph (it counts matches, which come
     from DDS discovery); the world, the servers and a `ros2` CLI still read every process's
     announcements, so node names and parameter services stay visible."""
-    ns = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
-    ET.register_namespace("", ns)
-    root = ET.parse(PROFILE_PATH).getroot()
-    q = lambda tag: f"{{{ns}}}{tag}"
-    profiles = root.find(q("profiles"))
-    reader = ET.SubElement(profiles, q("data_reader"), profile_name="ros_discovery_info")
-    kind = ET.SubElement(ET.SubElement(ET.SubElement(reader, q("qos")), q("ownership")), q("kind"))
+    root = _loopback_profile()
+    profiles = root.find(_tag("profiles"))
+    reader = ET.SubElement(profiles, _tag("data_reader"), profile_name="ros_discovery_info")
+    kind = ET.SubElement(ET.SubElement(ET.SubElement(reader, _tag("qos")), _tag("ownership")), _tag("kind"))
     kind.text = "EXCLUSIVE"
     return ET.tostring(root, encoding="unicode")
 
