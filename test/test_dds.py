@@ -361,14 +361,19 @@ def test_a_swarm_run_and_the_test_process_bind_loopback_only(tmp_path) -> None:
         time.sleep(3.0)
         _assert_loopback_only([launcher.pid, *pids, os.getpid()], igmp_before)
     finally:
-        os.killpg(launcher.pid, signal.SIGINT)
-        try:
-            launcher.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            os.killpg(launcher.pid, signal.SIGKILL)
-            launcher.wait()
+        _stop_launcher(launcher)
         node.destroy_node()
         rclpy.try_shutdown(context=context)
+
+
+def _stop_launcher(launcher: subprocess.Popen) -> None:
+    """Ctrl-C to the launcher's process group (it stops its children), SIGKILL after 60 s."""
+    os.killpg(launcher.pid, signal.SIGINT)
+    try:
+        launcher.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(launcher.pid, signal.SIGKILL)
+        launcher.wait()
 
 
 def _parent(pid: int) -> int:
@@ -407,9 +412,4 @@ def test_robots_do_not_read_graph_announcements_but_everyone_sees_their_nodes(tm
         names = set(json.loads(out.stdout.strip().splitlines()[-1]))
         assert {"/robot_0/controller", "/robot_1/controller", "/robot_2/controller", "/world"} <= names, names
     finally:
-        os.killpg(launcher.pid, signal.SIGINT)
-        try:
-            launcher.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            os.killpg(launcher.pid, signal.SIGKILL)
-            launcher.wait()
+        _stop_launcher(launcher)
