@@ -17,7 +17,7 @@ from pathlib import Path
 
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, md_table
-from swarm_sim.compare.stats import describe, pair_test, values_of
+from swarm_sim.compare.stats import Stats, describe, pair_test, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 STRATEGY = "caging"
@@ -98,6 +98,11 @@ def _done(rows: Sequence[dict], number: int) -> str:
     return f"{finished}/{len(runs)} transported, cage held in {held}"
 
 
+def _over_all_runs(rows: Sequence[dict], metric: str) -> Stats:
+    """`metric` described over every run that has it, whatever its cell."""
+    return describe([float(r[metric]) for r in rows if r.get(metric) is not None])
+
+
 def caging_tables_md(rows: Sequence[dict]) -> str:
     lines = ["# Caging paper comparison (Cardoso, Nedjah & Mourelle, sec. 5)", "",
              "Our runs: the `caging` scenario with the cell's settings, seeds 0..n-1, batch runner. "
@@ -126,10 +131,10 @@ def caging_tables_md(rows: Sequence[dict]) -> str:
                          _done(rows, number)])
         lines += md_table([key, *TABLE2_METRICS.values(), "paper length [m]", "paper error [m]",
                            "paper error [%]", "paper time [s]", "runs"], body) + [""]
-    errors = describe([float(r["trajectory_error_pct"]) for r in rows if r.get("trajectory_error_pct") is not None])
+    errors = _over_all_runs(rows, "trajectory_error_pct")
     lines += [f"Normalised error over every run: {cell_text(errors, digits=2)} % "
               f"(paper: about {PAPER_NORMALISED_ERROR_PCT} %).", ""]
-    deviation = describe([float(r["max_path_deviation_m"]) for r in rows if r.get("max_path_deviation_m") is not None])
+    deviation = _over_all_runs(rows, "max_path_deviation_m")
     lines += [f"Largest deviation of the object's centre from the planned path: {cell_text(deviation, digits=3)} m.",
               ""]
     return "\n".join(lines)
@@ -181,7 +186,7 @@ def caging_headlines(rows: Sequence[dict]) -> list[Headline]:
     out.append(Headline("a 1 m landmark step makes the search faster than 0.5 m (Table 1)", "197.5 < 222.2 s",
                         f"{fmt(coarse, 1)} vs {fmt(fine, 1)} s (means)" if known else "—",
                         coarse < fine if known else None))
-    errors = describe([float(r["trajectory_error_pct"]) for r in rows if r.get("trajectory_error_pct") is not None])
+    errors = _over_all_runs(rows, "trajectory_error_pct")
     known = math.isfinite(errors.mean)
     out.append(Headline("the object follows the planned path with an error around 3.8 % (sec. 5)",
                         f"{PAPER_NORMALISED_ERROR_PCT} %", f"{fmt(errors.mean, 1)} % (mean of {errors.n})" if known else "—",
