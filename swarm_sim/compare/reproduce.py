@@ -120,7 +120,8 @@ def write_report(reports: Sequence[SweepReport], args: argparse.Namespace) -> Pa
     command += "".join(f" --set {s}" for s in args.overrides)
     lines = ["# The papers' results, reproduced", "",
              f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, seeds "
-             f"0..{args.seeds - 1} per cell). Every number labelled *paper* is the paper's, hard-coded from its "
+             f"0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held: each "
+             "section gives its run count). Every number labelled *paper* is the paper's, hard-coded from its "
              "text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
     if args.duration is not None:
         lines += [f"> **Rehearsal:** every run was cut to {args.duration:g} s of sim time, so these numbers "
