@@ -20,7 +20,7 @@ from swarm_sim.analysis.metrics import resources_delivered
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
-from swarm_sim.types import Command, Observation, Pose2D
+from swarm_sim.types import STOP, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = load_scenario("ddsa", robots__count=4)
@@ -127,21 +127,52 @@ def test_steers_to_a_seen_resource_then_returns_when_carrying_and_resumes_at_the
     assert b.status().trips == 1 and b.status().state == "SEARCHING"
 
 
-def test_done_at_the_end_returns_to_the_depot_and_parks():
+def test_done_at_the_end_stops_there_and_keeps_avoiding_in_place():
+    """The authors' DDSA stops where its pattern ends (IDLE; Stop()) and still runs its
+    collision avoidance every tick: it turns in place, never drives off (issue 11)."""
     small = load_scenario("ddsa", robots__count=1, arena__size=2.4,
                           resources__clusters=1, resources__count=16)
     b = behaviour(small, "robot_0")
     u = Unicycle(0.0, 0.0, 0.0)
     for _ in range(20000):
         c = u.step(b)
-        if b.state is DdsaState.DONE and c == Command(0.0, 0.0):
+        if b.state is DdsaState.DONE:
             break
     assert b.state is DdsaState.DONE
     assert b.progress == pytest.approx(b.path.length, abs=0.05)
-    assert math.hypot(u.x, u.y) < small.depot.radius
-    # Parked: stays put even with something right in front.
+    end = b.path.end
+    assert math.hypot(u.x - end[0], u.y - end[1]) < 0.06
+    assert math.hypot(u.x, u.y) > small.depot.radius + 0.5
+    for _ in range(50):  # stays put with nothing around
+        assert u.step(b) == STOP
+    assert math.hypot(u.x - end[0], u.y - end[1]) < 0.06
+    events = b.obstacle_avoidance_events
     blocked = np.full_like(CLEAR, 0.1)
-    assert b.step(obs(u.k, u.x, u.y, u.yaw, ranges=blocked, robot="robot_0")) == Command(0.0, 0.0)
+    c = b.step(obs(u.k, u.x, u.y, u.yaw, ranges=blocked, robot="robot_0"))
+    assert c.linear == 0.0 and c.angular != 0.0
+    assert b.obstacle_avoidance_events == events + 1
+    assert b.step(obs(u.k + 1, u.x, u.y, u.yaw, robot="robot_0")) == STOP  # clear: no escape run
+    assert b.state is DdsaState.DONE
+
+
+def test_done_robot_that_picks_something_up_delivers_it_and_returns_to_its_path_end():
+    small = load_scenario("ddsa", robots__count=1, arena__size=2.4,
+                          resources__clusters=1, resources__count=16)
+    b = behaviour(small, "robot_0")
+    u = Unicycle(0.0, 0.0, 0.0)
+    while b.state is not DdsaState.DONE:
+        u.step(b)
+    u.step(b, carrying=True)
+    assert b.state is DdsaState.RETURNING and b.found_at == pytest.approx(b.path.length)
+    carrying = True
+    for _ in range(5000):
+        carrying = carrying and math.hypot(u.x, u.y) > small.depot.radius  # dropped in the disc
+        u.step(b, carrying=carrying)
+        if b.state is DdsaState.DONE:
+            break
+    assert b.state is DdsaState.DONE and b.trips == 1
+    end = b.path.end
+    assert math.hypot(u.x - end[0], u.y - end[1]) < 0.06
 
 
 def circle_ranges(cx: float, cy: float, radius: float = BASE.robots.diameter / 2) -> np.ndarray:
