@@ -141,7 +141,9 @@ class SensorConfig:
 
 @dataclass(frozen=True)
 class ResourceConfig:
-    distribution: Literal["clustered", "uniform", "powerlaw"] = "clustered"
+    distribution: Literal["clustered", "uniform", "powerlaw", "powerlaw_tiers"] = "clustered"
+    """`swarm_sim.world.resources`: square clusters, uniform, Hecker & Moses's power law, or
+    the DDSA/MDBSA authors' power law (tiers from `count`)."""
     count: int = 320
     """Total resources; for `clustered` it must equal clusters * cluster_side**2."""
     clusters: int = 5

@@ -220,14 +220,16 @@ def test_queue_plans_pass_the_swarm_size_as_robots_count_field():
 
 
 @pytest.mark.parametrize("experiment", [1, 2, 3])
-@pytest.mark.parametrize("layout", ["powerlaw", "clustered"])
+@pytest.mark.parametrize("layout", ["tiers", "powerlaw", "clustered"])
 def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
     exp = SPIRAL_EXPERIMENTS[experiment]
     plans = spiral_plans(experiment, layout=layout)
+    distribution = {"tiers": "powerlaw_tiers"}.get(layout, layout)
     for plan in plans:
         # the mdbsa scenarios are written elsewhere; the overrides must hold on the ddsa file
         s = load_scenario("ddsa", plan.overrides, **dict(plan.fields))
-        assert s.arena.size == 8.0 and s.resources.distribution == layout
+        assert s.arena.size == 8.0 and s.resources.distribution == distribution
+        assert (s.depot.radius, s.resources.spacing) == (0.18, 0.15)  # the authors' nest, pitch
         setting = {"regions": s.regions.count, "robots": s.robots.count,
                    "resources": s.resources.count}
         if plan.cell is None:

@@ -33,6 +33,8 @@ SPIRAL_TABLE_EXTRA: dict[str, str] = {"resources_collected_pct": "resources coll
 POWERLAW_LEVELS = 3
 """`powerlaw` layout: piles of 16 (one 4 x 4), 4 (four 2 x 2) and 1 (sixteen), 48 resources in
 piles; the rest of the count is scattered uniformly (see `resource_layout`)."""
+LAYOUTS: tuple[str, ...] = ("tiers", "powerlaw", "clustered")
+"""`resource_layout` names; the first is the default."""
 
 
 @dataclass(frozen=True)
@@ -146,18 +148,24 @@ PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
 """THE PAPER'S reported differences (quoted from mdbsa_spiral_search.md, Sec. VI), not ours."""
 
 
-def resource_layout(count: int, layout: str = "powerlaw") -> tuple[str, ...]:
+def resource_layout(count: int, layout: str = LAYOUTS[0]) -> tuple[str, ...]:
     """``--set`` overrides placing `count` resources in "clusters of different sizes".
 
     The MDBSA paper only says "randomly distributed [...] as clusters of various sizes".
-    `powerlaw` (default): Hecker & Moses piles with `POWERLAW_LEVELS` = 3 (one pile of 16, four of
-    4, sixteen of 1; 48 resources) and the rest scattered uniformly; the same piles for every
-    count, so more resources means a closer-to-random layout, which is how the paper reads its
-    experiment 3 ("the distribution of resources became closer to random"). Level 4 would need
-    256 resources, more than most counts in the paper. `clustered`: equal square clusters with
-    clusters * side^2 == count, the largest side of 5, 4, 3, 2, 1 that divides (5 x 5 for
-    100-300 in steps of 50, ten 4 x 4 for 160): every resource in a cluster, but one size.
+    `tiers` (default): what the authors ran, their ``PowerLawFoodDistribution``
+    (``FoodDistribution = "2"`` in every experiment file of MARSLab-UTRGV/DDSA-Distributed-
+    Deterministic-Spiral-Search-Algorithm and MARSLab-UTRGV/Adaptive-Multiple-Distributed-
+    Spiral-Search-Algorithm, branch luki-dev): `swarm_sim.world.resources.powerlaw_tiers`,
+    e.g. 200 -> 50 each in an 8 x 8 pile, 4 x 4 piles, 2 x 2 piles and singles; 300 takes a
+    fifth tier (16 x 16 down to singles, 60 each). The scenario's pitch and nest clearance
+    apply. The earlier alternatives, kept by name: `powerlaw`, Hecker & Moses piles with
+    `POWERLAW_LEVELS` = 3 (one pile of 16, four of 4, sixteen of 1; 48 resources) and the rest
+    scattered uniformly; `clustered`, equal square clusters with clusters * side^2 == count,
+    the largest side of 5, 4, 3, 2, 1 that divides (5 x 5 for 100-300 in steps of 50, ten
+    4 x 4 for 160).
     """
+    if layout == "tiers":
+        return ("resources.distribution=powerlaw_tiers", f"resources.count={count}")
     if layout == "powerlaw":
         return ("resources.distribution=powerlaw", f"resources.powerlaw_levels={POWERLAW_LEVELS}",
                 f"resources.count={count}")
@@ -165,7 +173,7 @@ def resource_layout(count: int, layout: str = "powerlaw") -> tuple[str, ...]:
         side = next(s for s in (5, 4, 3, 2, 1) if count % (s * s) == 0)
         return ("resources.distribution=clustered", f"resources.clusters={count // (side * side)}",
                 f"resources.cluster_side={side}", f"resources.count={count}")
-    raise ValueError(f"unknown resource layout {layout!r} (powerlaw or clustered)")
+    raise ValueError(f"unknown resource layout {layout!r} ({', '.join(LAYOUTS)})")
 
 
 def spiral_plans(
@@ -173,7 +181,7 @@ def spiral_plans(
     strategies: Sequence[str] = SPIRAL_STRATEGIES,
     *,
     values: Sequence[int] | None = None,
-    layout: str = "powerlaw",
+    layout: str = LAYOUTS[0],
     duration: float | None = None,
     overrides: Sequence[str] = (),
 ) -> list[RunPlan]:
@@ -324,8 +332,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--experiment", type=int, choices=sorted(SPIRAL_EXPERIMENTS), required=True)
     parser.add_argument("--values", type=int, nargs="+",
                         help="the swept setting's values (default: the paper's; regions, robots or resources)")
-    parser.add_argument("--layout", choices=("powerlaw", "clustered"), default="powerlaw",
-                        help="resource layout for 'clusters of different sizes' (default powerlaw)")
+    parser.add_argument("--layout", choices=LAYOUTS, default=LAYOUTS[0],
+                        help="resource layout for 'clusters of different sizes' (default: tiers, "
+                             "the authors' power law)")
 
 
 def _plans(args: argparse.Namespace, strategies: list[str]) -> list[RunPlan]:
