@@ -175,9 +175,15 @@ def test_spiral_report_shows_region_free_ddsa_in_every_cell_and_the_papers_claim
     for cell in (4, 16, 64):
         rows += rows_for("mdbsa_c", cell, [2.0, 2.1, 1.9, 2.2], SPIRAL_KEYS, layout="powerlaw")
         rows += rows_for("mdbsa_d", cell, [4.0, 4.4, 3.6, 4.2], SPIRAL_KEYS, layout="powerlaw")
+    for r in rows:  # per-minute series: DDSA 1.0 then 0.5 per robot, MDBSA twice the seed's value
+        r["resources_per_robot_per_min"] = ([[60.0, 1.0], [120.0, 0.5]] if r["strategy"] == "ddsa"
+                                            else [[60.0, 2.0 * r["seed"]], [120.0, 0.0]])
     written = write_spiral_report(rows, tmp_path, 1, [4, 16, 64])
-    assert {p.name for p in written} == {"tables.md", "mannwhitney.md", "resources_collision.png",
-                                         "foraging_rate.png"}
+    assert {p.name for p in written} == {"tables.md", "mannwhitney.md", "per_minute.md", "resources_collision.png",
+                                         "foraging_rate.png", "foraging_rate_per_minute.png"}
+    per_minute = (tmp_path / "per_minute.md").read_text()
+    assert per_minute.count("| DDSA (n=4) | 1.00 ± 0.00 | 0.50 ± 0.00 |") == 3  # served in every cell
+    assert per_minute.count("| MDBSA-D (n=4) | 3.00 ± 2.58 | 0.00 ± 0.00 |") == 3  # seeds 0-3: 0, 2, 4, 6
     tables = (tmp_path / "tables.md").read_text()
     assert tables.count("2.02 ± 0.17 (median 2.05, n=4)") == 3 * 4  # DDSA, 3 cells, 4 metrics
     mw = (tmp_path / "mannwhitney.md").read_text()

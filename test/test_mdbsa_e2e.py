@@ -77,5 +77,7 @@ def test_mdbsa_d_graph_run_stays_in_assigned_regions(tmp_path):
         assert inside[walk].all(), f"{robot} left region {region}"
 
     batch = summarize(run_batch(load_scenario("mdbsa_d", [f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])).trace)
-    for key in ("resources_delivered", "collision_time_per_robot_s", "resources_per_robot"):
+    for key in ("resources_delivered", "collision_time_per_robot_s", "resources_per_robot",
+                "resources_per_robot_per_min"):
         assert batch[key] == summary[key], key
+    assert len(summary["resources_per_robot_per_min"]) == DURATION // 60  # from the bag alone
