@@ -4,8 +4,8 @@ Every placement draws only from the `numpy.random.Generator` it is given, so the
 the same layout. All positions are [m, world frame]. A position is *valid* when it keeps
 ``resources.margin`` from the walls (``|x|, |y| <= L/2 - margin``) and lies at least
 ``resources.min_depot_clearance`` outside the depot disc, and at least one ``spacing`` outside
-every other drop zone (docks, MDBSA region centres): a resource inside a zone would count as
-delivered the moment it is picked up.
+every other drop zone (docks, extra zones): a resource inside a zone would count as delivered the
+moment it is picked up. MDBSA region centres are the exception, as in the authors' code (`_keep_out`).
 
 Distributions:
 
@@ -51,12 +51,22 @@ Disc = tuple[float, float, float]
 
 def _keep_out(cfg: ResourceConfig, depot: DepotConfig, zones: Sequence[DropZoneConfig]) -> list[Disc]:
     """The depot disc widened by min_depot_clearance, and every other drop zone widened by
-    spacing (the depot's own drop zone keeps min_depot_clearance, as the key says: with a
-    clearance below one spacing the zone's disc would otherwise decide)."""
+    spacing, except:
+
+    - the depot's own drop zone keeps min_depot_clearance, as the key says (with a clearance
+      below one spacing the zone's disc would otherwise decide);
+    - MDBSA region centres keep nothing: the authors keep food off the nest only
+      (``DSA_loop_functions::IsOutOfBounds`` checks ``IsCollidingWithNest``, MARSLab-UTRGV/
+      Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev, Distributed/
+      source/DSA/DSA_loop_functions.cpp), so DDSA, MDBSA-C and MDBSA-D get the same layout
+      for a seed, and a resource lying in a region centre is delivered as soon as it is
+      picked up, as their ``IsInTheRegion`` does. (Keeping 64 such discs clear also left no
+      room for the larger piles.)"""
     cx, cy = float(depot.center[0]), float(depot.center[1])
     discs = [(cx, cy, depot.radius + cfg.min_depot_clearance)]
     discs += [(float(z.center[0]), float(z.center[1]), z.radius + cfg.spacing) for z in zones
-              if not (z.kind == "depot" and (float(z.center[0]), float(z.center[1]), z.radius) == (cx, cy, depot.radius))]
+              if z.kind != "region_center"
+              and not (z.kind == "depot" and (float(z.center[0]), float(z.center[1]), z.radius) == (cx, cy, depot.radius))]
     return discs
 
 
