@@ -42,7 +42,10 @@ Choices where the paper leaves a detail open:
   DSA_controller.cpp), as the lab's older DSA did with its return to the nest commented out
   (BCLab-UNM/iAnt-ARGoS, source/DSA/DSA_controller.cpp, ``ReachSpiralTargets``). Driving
   back into the depot instead parked the finished robots on the drop disc's rim where they
-  walled off the carriers (issue 11: 8 of 32 robots, deliveries stopped after minute 4).
+  walled off the carriers (issue 11, experiment 2 at 32 robots in the issue-4 world, seeds
+  0-4: 8-10 robots parked there, 0-1 deliveries in the last 4 minutes, 1.18 ± 0.24
+  resources per robot; stopping at the path's end: none there, 20-24 deliveries in the last
+  4 minutes, 5.27 ± 0.31 per robot).
   A finished robot keeps obstacle avoidance on every tick as ``BaseController::Move`` does
   (`LaneAvoidance.parked`: it turns in place away from what comes at its front, never
   drives off). A finished robot that still picks something up (pushed onto a resource)
