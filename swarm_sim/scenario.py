@@ -194,7 +194,8 @@ class RegionConfig:
     count: int = 16
     """N_R, a power of 4 (the MDBSA paper's experiment 1 default is 16)."""
     center_radius: float = 0.25
-    """Radius of each region centre's drop zone [m]."""
+    """Radius of each region centre's drop zone [m] (MDBSA-D), within which an idle MDBSA robot
+    stops (the authors' ``RegionRadius``)."""
 
 
 @dataclass(frozen=True)
