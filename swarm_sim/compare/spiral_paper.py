@@ -288,7 +288,8 @@ def per_minute_figure(rows: Sequence[dict], experiment: int, cells: Sequence[int
         ax.set(title=f"{cell} {exp.vary}", xlabel="minute")
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("resources per robot per minute")
-    axes[0][0].legend(fontsize="small")
+    if axes[0][0].get_legend_handles_labels()[0]:
+        axes[0][0].legend(fontsize="small")
     fig.suptitle(f"Experiment {experiment}: foraging rate per minute "
                  f"(cf. MDBSA paper {PER_MINUTE_FIGURES.get(experiment, 'Fig. 10 setting')})")
     fig.tight_layout()
