@@ -62,11 +62,13 @@ def _keep_out(cfg: ResourceConfig, depot: DepotConfig, zones: Sequence[DropZoneC
       for a seed, and a resource lying in a region centre is delivered as soon as it is
       picked up, as their ``IsInTheRegion`` does. (Keeping 64 such discs clear also left no
       room for the larger piles.)"""
-    cx, cy = float(depot.center[0]), float(depot.center[1])
-    discs = [(cx, cy, depot.radius + cfg.min_depot_clearance)]
-    discs += [(float(z.center[0]), float(z.center[1]), z.radius + cfg.spacing) for z in zones
-              if z.kind != "region_center"
-              and not (z.kind == "depot" and (float(z.center[0]), float(z.center[1]), z.radius) == (cx, cy, depot.radius))]
+    disc = (float(depot.center[0]), float(depot.center[1]), depot.radius)
+    discs = [(disc[0], disc[1], depot.radius + cfg.min_depot_clearance)]
+    for z in zones:
+        own = (float(z.center[0]), float(z.center[1]), z.radius)
+        if z.kind == "region_center" or (z.kind == "depot" and own == disc):
+            continue
+        discs.append((own[0], own[1], z.radius + cfg.spacing))
     return discs
 
 
@@ -187,9 +189,8 @@ def powerlaw_tiers(count: int) -> list[list[int]]:
     Deterministic-Spiral-Search-Algorithm, branch luki-dev, and MARSLab-UTRGV/Adaptive-
     Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev, source/DSA/
     DSA_loop_functions.cpp; the same function in both): the rank R = p + 1 for the least p >= 1
-    with 4^p (1 + p) >= count; tier h < R has 4^h piles of side 2^(R-1-h); the first tier
-    takes ``count`` // R resources (less the rounding), every other ceil(count / R); piles are
-    filled in turn and a tier stops at its share (160 resources: 40 in one 8 x 8 pile cut to 5
+    with 4^p (1 + p) >= count; tier h < R has 4^h piles of side 2^(R-1-h); every tier but the
+    first takes ceil(count / R) resources and the first the rest; piles are filled in turn and a tier stops at its share (160 resources: 40 in one 8 x 8 pile cut to 5
     rows, 40 in 4 x 4 piles (16, 16, 8), 40 in ten 2 x 2, 40 singles).
     """
     if count <= 0:
