@@ -60,6 +60,10 @@ Choices where the paper leaves a detail open:
 * **Delivery target**: MDBSA-C the ``depot`` drop zone's centre; MDBSA-D the ``region_<i>``
   drop zone of the walk's region (the world drops as soon as the carrier is inside it). A
   resource picked up outside a walk (driving over it) goes to the nearest region center.
+  A robot picks up whatever it passes, also on its way out (the world's gripper; the authors'
+  robots search while travelling too, ``SetHoldingFood`` in SEARCHING), and an MDBSA-D carrier
+  that then crosses another region's centre drops its load there (the world drops in any zone
+  a carrier enters; the authors' robot would carry it to its own region's centre).
   With ``depot.delivery: region_centers`` the depot disc is not a drop zone, so MDBSA-D
   carriers crossing it keep their load; construction refuses a scenario whose drop zones do
   not match the version.
