@@ -51,8 +51,8 @@ ROS_BLOCKER = textwrap.dedent(
 """Python source that makes importing rclpy or any ``*_msgs`` package fail."""
 
 WALL_FIELDS = ("wall_seconds", "real_time_factor", "mode")
-GRAPH_COMPARED = ("resources_delivered", "collision_time_s_by_robot", "oae_by_robot", "trips_by_robot",
-                  "clamped_commands", "stale_ticks")
+GRAPH_COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
+                  "trips_by_robot", "clamped_commands", "stale_ticks", "dropoff_times_s")
 
 
 class ConformanceError(AssertionError):

@@ -121,6 +121,21 @@ class ProximityConfig:
 
 
 @dataclass(frozen=True)
+class ProximityRingConfig:
+    """The foot-bot's ring of proximity sensors as the ARGoS CPFA reads it for collision
+    detection: what the queue and spiral papers' *collision time* counts (`swarm_sim.world.proximity`).
+    The ring's sensors are the scan's rays; defaults are ARGoS's foot-bot and the CPFA's rule."""
+
+    range: float = 0.1
+    """How far beyond the body a sensor sees [m] (ARGoS ``footbot_entity.cpp``:
+    PROXIMITY_SENSOR_RING_RANGE = 0.1, the ring on the body radius)."""
+    ahead: float = 80.0
+    """Half-angle [deg] around the heading within which the readings' mean vector must point:
+    the CPFA's ``GoStraightAngleRangeInDegrees.Set(-80, 80)`` (``BaseController.cpp`` of
+    Tameem786/Collision_Free_CPFA and BCLab-UNM/CPFA-ARGoS)."""
+
+
+@dataclass(frozen=True)
 class SensorConfig:
     scan: ScanConfig = field(default_factory=ScanConfig)
     resource_detection_radius: float = 0.13
@@ -133,6 +148,8 @@ class SensorConfig:
     from the robot's centre is not detected [m]."""
     proximity: ProximityConfig = field(default_factory=ProximityConfig)
     """Used by the transport task."""
+    proximity_ring: ProximityRingConfig = field(default_factory=ProximityRingConfig)
+    """What the world counts as collision time (``RobotStats.avoidance_time_s``)."""
     position_range: float = 1.5
     """Transport task: a robot senses the position of the target object and of other robots
     whose centres are within this distance of its own [m] (what the caging paper's robots read
@@ -182,6 +199,9 @@ class DepotConfig:
     queue paper gives no value; 5 s is our choice."""
     dock_radius: float = 0.06
     """A robot unloads while its centre is within this distance of the dock stop [m]."""
+    dock_distance: float | None = None
+    """Distance of the dock stops from the depot centre [m]; None: one robot radius outside
+    the depot disc (where the queue layouts end)."""
 
 
 @dataclass(frozen=True)
@@ -655,6 +675,8 @@ def validate(s: Scenario) -> None:
     _require(s.sensors.resource_detection_radius > 0, "sensors.resource_detection_radius: must be positive")
     _require(s.sensors.pickup_radius > 0, "sensors.pickup_radius: must be positive")
     _require(s.sensors.proximity.range > 0, "sensors.proximity.range: must be positive")
+    _require(s.sensors.proximity_ring.range > 0, "sensors.proximity_ring.range: must be positive")
+    _require(0 <= s.sensors.proximity_ring.ahead <= 180, "sensors.proximity_ring.ahead: must be in [0, 180] deg")
     _require(s.sensors.position_range > 0, "sensors.position_range: must be positive")
     t = s.transport
     _require(t.object.radius > 0, "transport.object.radius: must be positive")
@@ -701,10 +723,11 @@ def validate(s: Scenario) -> None:
     _require(d.unload_time >= 0, "depot.unload_time: must not be negative")
     _require(d.dock_radius > 0, "depot.dock_radius: must be positive")
     _require(d.docks >= 1, "depot.docks: need at least one dock")
-    stop = d.radius + r.diameter / 2
+    _require(d.dock_distance is None or d.dock_distance > 0, "depot.dock_distance: must be positive")
+    stop = d.radius + r.diameter / 2 if d.dock_distance is None else d.dock_distance
     _require(
         d.docks == 1 or 2 * stop * math.sin(math.pi / d.docks) >= r.diameter,
-        f"depot.docks: {d.docks} docks do not fit side by side on a depot of radius {d.radius} m",
+        f"depot.docks: {d.docks} docks do not fit side by side {stop} m from the depot centre",
     )
     _require(d.perimeter_radius > d.radius, "depot.perimeter_radius: must exceed depot.radius")
     if d.delivery == "docks":
