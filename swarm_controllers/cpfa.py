@@ -27,7 +27,7 @@ Rules, in the paper's words, and how they are realised here:
   sigma = omega + (4 pi - omega) exp(-lambda_id t), t = time since the informed search began
   [s]. Searches at a remembered site (site fidelity) or at a pheromone waypoint are informed:
   they start almost undirected and relax to the uninformed walk. ARGoS counts t in search
-  steps, CPFA-ROS in seconds; seconds match `CpfaConfig.rate_of_informed_search_decay` [1/s].
+  steps, CPFA-ROS in seconds (`CpfaConfig.informed_search_time` chooses; seconds by default).
 * **Find resource, sense local density** (H&M Algorithm 1: count the resources c near the
   find): the world picks a resource up when an empty robot reaches it; on the tick
   `obs.sensed.carrying` turns True the robot records the site (its own position) and
@@ -215,6 +215,9 @@ class CpfaBehaviour:
         self._leg_y = 0.0
         self._search_t0 = 0.0
         """When the current search began [s]."""
+        self._search_legs = 0
+        """Walk legs drawn since the current search began."""
+        self._search_in_steps = cfg.informed_search_time == "steps"
         self._site: tuple[float, float] | None = None
         """Where the last resource was found, until used for site fidelity or given up."""
         self._site_count = 0
@@ -332,6 +335,7 @@ class CpfaBehaviour:
     def _start_search(self, obs: Observation) -> tuple[float, float]:
         self._state = CpfaState.SEARCHING
         self._search_t0 = obs.t
+        self._search_legs = 0
         self._new_leg(obs)
         return self._walk(obs)
 
@@ -356,7 +360,9 @@ class CpfaBehaviour:
         if self._mode is SearchMode.UNINFORMED:
             sigma = self._omega
         else:
-            sigma = informed_search_sigma(self._omega, self._lambda_id, obs.t - self._search_t0)
+            t = self._search_legs if self._search_in_steps else obs.t - self._search_t0
+            sigma = informed_search_sigma(self._omega, self._lambda_id, t)
+        self._search_legs += 1
         step, bound = self._search_step, self._bound
         normal = self._rng.normal
         for _ in range(_LEG_REDRAWS):

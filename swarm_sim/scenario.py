@@ -82,11 +82,19 @@ class RobotConfig:
     start_spacing: float = 0.4
     """Robots start on a square grid of this pitch [m] centred on the depot (`start_layout`
     grid); the other layouts keep robot centres at least this far apart."""
-    start_layout: Literal["grid", "depot_random", "depot_ring"] = "grid"
+    start_layout: Literal["grid", "depot_random", "depot_ring", "groups"] = "grid"
     """Where robots start (`swarm_sim.world.start`): `grid` on the square grid above;
+    `groups` in `start_groups` (ARGoS ``<distribute>`` blocks with a grid ``layout``);
     `depot_random` uniformly at random inside the depot disc (the DRTM paper's "placed in the
     nest randomly"); `depot_ring` evenly spaced on a circle just inside the depot's edge (the
     DRTM paper's e-puck set-up, "evenly distributed along the perimeter of the nest")."""
+    start_groups: tuple[tuple[float, float], ...] = ()
+    """`groups` layout: the centres of the groups [m, world frame]. The robots are dealt out in
+    order, an equal share per group (the first groups take one more when it does not divide),
+    each group on a grid of `start_group_columns` columns at `start_spacing`, row by row,
+    centred on its point as if the grid had as many rows as columns; all facing +x."""
+    start_group_columns: int = 6
+    """Columns (and nominal rows) of a group's grid (ARGoS ``layout="6, 6, 1"``)."""
     radio_range: float = 0.4
     """gamma: robot-to-robot messages reach only robots within this distance [m] (queue paper
     sec. III; used by tail joining)."""
@@ -651,6 +659,15 @@ def validate(s: Scenario) -> None:
             f"robots.count: {r.count} robots on a {side}x{side} grid of pitch {r.start_spacing} m "
             f"do not fit in the {s.arena.size} m arena",
         )
+    elif r.start_layout == "groups":
+        _require(len(r.start_groups) >= 1, "robots.start_groups: the groups layout needs at least one group")
+        _require(r.start_group_columns >= 1, "robots.start_group_columns: need at least one column")
+        per = math.ceil(r.count / len(r.start_groups))
+        rows = math.ceil(per / r.start_group_columns)
+        extent = max(r.start_group_columns - 1, 2 * rows - 1 - (r.start_group_columns - 1)) * r.start_spacing / 2
+        for i, g in enumerate(r.start_groups):
+            _require(_inside(g, half, extent + r.diameter / 2),
+                     f"robots.start_groups[{i}]: a group of {per} robots at {g} does not fit in the arena")
     else:
         room = s.depot.radius - r.diameter / 2  # robot centres stay this close to the depot centre
         _require(room > 0, f"robots.start_layout: robots of diameter {r.diameter} m do not fit in the "

@@ -247,6 +247,8 @@ class World:
         # Robots first, so their body ids are 0..n-1.
         n = self._n
         yaws = rng_start.uniform(-math.pi, math.pi, size=n)
+        if s.robots.start_layout == "groups":
+            yaws[:] = 0.0  # ARGoS <orientation method="constant" values="0.0, 0.0, 0.0"/>
         starts = start_positions(s, rng_start).tolist()
         shape = p.createCollisionShape(
             p.GEOM_CYLINDER, radius=self._radius, height=s.robots.height, physicsClientId=cid
