@@ -200,10 +200,12 @@ def ordering_checks(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
         for c in sizes:
             va, vb = values_of(rows, a, c, pct), values_of(rows, b, c, pct)
             _, p = pair_test(va, vb, "t")
-            if not math.isfinite(p):
-                cells.append((c, "n/a", None))
-                continue
             ma, mb = describe(va).mean, describe(vb).mean
+            if not math.isfinite(p):
+                order = 'in order' if mb > ma else 'tied' if mb == ma else 'reversed'
+                means = f": means {order}" if va and vb else ""
+                cells.append((c, f"n/a{means}", None))
+                continue
             holds = mb > ma and p < ALPHA
             text = "holds" if holds else "reversed" if ma > mb and p < ALPHA else "ns"
             cells.append((c, f"{text} (p={fmt_p(p)})", holds))
