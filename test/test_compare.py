@@ -479,4 +479,4 @@ def test_table_ii_ordering_checked_pair_by_pair():
     assert ratio[2] is True and ratio[1].startswith("holds: x")
     lines = {h.claim: h for h in queue_headlines(rows, [48], list(means))}
     assert lines["collection Q_ME < Q_MT"].holds is True
-    assert lines["collection CPFA < Q_MT"].holds is False
+    assert lines["collection CPFA < Q_ME"].holds is False
