@@ -198,7 +198,11 @@ def decode_robot_stats(data: bytes) -> tuple[int, dict[RobotId, RobotStats]]:
     stamp_ns, statuses = decode_diagnostics(data)
     out: dict[RobotId, RobotStats] = {}
     for s in statuses:
-        f = _fields(s, _STATS_KEYS, "robot")
+        # Bags recorded before avoidance_time_s existed (issue 11) lack it: 0.0, not a refusal.
+        old = "avoidance_time_s" not in (k for k, _ in s.values)
+        f = _fields(s, _STATS_KEYS[:-1] if old else _STATS_KEYS, "robot")
+        if old:
+            f["avoidance_time_s"] = "0.0"
         if s.name in out:
             raise ValueError(f"robot {s.name!r} appears twice")
         out[s.name] = RobotStats(

@@ -444,6 +444,15 @@ def test_robot_stats_mapping():
     ]  # fmt: skip
 
 
+def test_robot_stats_of_a_bag_recorded_before_avoidance_time_decode():
+    from swarm_msgs_py.diagnostics import OK, Status, encode_diagnostics
+
+    old = encode_diagnostics(5, [Status(OK, "robot_0", "", "robot_0", (
+        ("collision_time_s", "1.5"), ("pickups", "2"), ("deliveries", "1"),
+        ("clamped_commands", "0"), ("stale_ticks", "3")))])
+    assert diagnostics.decode_robot_stats(old) == (5, {"robot_0": RobotStats(1.5, 2, 1, 0, 3, 0.0)})
+
+
 BEHAVIOUR_ST = st.builds(
     BehaviourStatus,
     st.sampled_from(ROBOTS), STAMPS, TEXT, st.integers(0, 10**9), st.integers(0, 10**9),
