@@ -29,6 +29,7 @@ register(Algorithm(
     behaviour="swarm_controllers.cpfa:CpfaBehaviour",
     config=(_CPFA_SECTION,),
     peers=("swarm_msgs_py.pheromone:PHEROMONES",),
+    deliveries=("depot", "docks"),
     comparison="swarm_sim.compare.queue_paper:QUEUE_COMPARISON",
 ))
 

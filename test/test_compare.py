@@ -472,3 +472,19 @@ def test_headlines_follow_the_means_and_the_tests():
     similar = next(h for h in claims if h.paper.startswith("similar"))
     above = next(h for h in claims if h.paper.startswith("≈ +101"))
     assert similar.holds is True and above.holds is True and "4: +" in above.ours
+
+
+def test_table_ii_ordering_checked_pair_by_pair():
+    from swarm_sim.compare.queue_paper import ordering_checks, queue_headlines
+
+    rng = np.random.default_rng(5)
+    means = {"queue_cpfa": 60.0, "queue_qse": 17.0, "queue_qst": 34.0, "queue_qme": 50.0, "queue_qmt": 70.0}
+    rows = [r for s, m in means.items() for r in rows_for(s, 48, rng.normal(m, 1.0, 8))]
+    checks = dict(ordering_checks(rows, [48], list(means)))
+    assert checks["CPFA < Q_SE"][0][1].startswith("reversed") and checks["CPFA < Q_SE"][0][2] is False
+    assert checks["Q_SE < Q_ST"][0][1].startswith("holds") and checks["Q_SE < Q_ST"][0][2] is True
+    ratio = checks["Q_ST = 2 Q_SE (Table II: x1.9-2.4)"][0]
+    assert ratio[2] is True and ratio[1].startswith("holds: x")
+    lines = {h.claim: h for h in queue_headlines(rows, [48], list(means))}
+    assert lines["collection Q_ME < Q_MT"].holds is True
+    assert lines["collection CPFA < Q_ME"].holds is False
