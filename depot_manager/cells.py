@@ -178,6 +178,8 @@ class _Model:
             raise ValueError("the inner entry point conflicts with another line's cells")
 
     def _build_single(self, layout, pitch, diam, add, new_ids, same) -> None:
+        """Entry line -> inner queue k (ring, V to dock k, leg to the inner exit point) -> exit
+        line (`depot_manager.geometry.single_queue_layout`)."""
         (en,), (ex,) = layout.entry_lines, layout.exit_lines
         inner = layout.inner_queues
         if len(inner) != len(layout.docks) or not inner:
@@ -188,52 +190,45 @@ class _Model:
         same(e[-1], e_in, f"{en.name} and the inner entry point")
         ids_e = new_ids(e)
         self.line_ids[en.name] = np.array(ids_e)
+        id_x_in = add(x_in)
 
-        # ring grid: inner entry point -> ring (CCW) -> inner exit point, with no V
+        # ring grid: inner entry point -> ring (CCW) as far as the farthest dock's V, shared by
+        # every inner queue
         q0 = inner[0].points
         r_ring = float(np.linalg.norm(q0[1] - c))
         phi0 = math.atan2(q0[1][1] - c[1], q0[1][0] - c[0])
-        phi1 = phi0 + (_bearing(q0[-2], c) - phi0) % (2 * math.pi)
+        ang = lambda p: phi0 + (_bearing(p, c) - phi0) % (2 * math.pi)  # noqa: E731
+        docks_at = []
+        for k, (q, dock) in enumerate(zip(inner, layout.docks)):
+            v = int(np.argmin(np.linalg.norm(q.points - dock.stop, axis=1)))
+            same(q.points[v], dock.stop, f"{q.name} and dock {k}")
+            if not 1 < v < len(q.points) - 1:
+                raise ValueError(f"{q.name}: dock {k} is not inside the inner queue")
+            docks_at.append(v)
+        phi1 = max(ang(q.points[v - 1]) for q, v in zip(inner, docks_at))
         m = max(1, math.ceil((phi1 - phi0) * r_ring / ARC_STEP))
         phi = np.linspace(phi0, phi1, m + 1)
         arc = c + r_ring * np.stack([np.cos(phi), np.sin(phi)], axis=1)
-        grid = line_cells(np.vstack([e_in, arc, x_in]), pitch, diam)
+        grid = line_cells(np.vstack([e_in, arc]), pitch, diam)
         ids_g = [ids_e[-1]] + new_ids(grid[1:])
         g_ang = np.unwrap([phi0] + [math.atan2(*(p - c)[::-1]) for p in grid[1:]])
-        ids_x_in = ids_g[-1]
 
-        for k, (q, dock) in enumerate(zip(inner, layout.docks)):
+        for k, (q, dock, v) in enumerate(zip(inner, layout.docks, docks_at)):
             pts = q.points
-            v = int(np.argmin(np.linalg.norm(pts - dock.stop, axis=1)))
-            same(pts[v], dock.stop, f"{q.name} and dock {k}")
-            if not 0 < v < len(pts) - 1:
-                raise ValueError(f"{q.name}: dock {k} is not inside the inner queue")
-            ang = lambda p: phi0 + (_bearing(p, c) - phi0) % (2 * math.pi)  # noqa: E731
-            a_out, a_back = ang(pts[v - 1]), ang(pts[v + 1])
-            ia = int(np.nonzero(g_ang <= a_out + 1e-9)[0][-1])
-            ib = int(np.nonzero(g_ang >= a_back - 1e-9)[0][0])
-            vert_ang = np.array([ang(p) for p in pts])
-            down = [grid[ia]] + [
-                p for p, a in zip(pts[1:v], vert_ang[1:v]) if a > g_ang[ia] + 1e-12
-            ] + [dock.stop]
-            up = [dock.stop] + [
-                p for p, a in zip(pts[v + 1 : -1], vert_ang[v + 1 : -1]) if a < g_ang[ib] - 1e-12
-            ] + [grid[ib]]
+            ia = int(np.nonzero(g_ang <= ang(pts[v - 1]) + 1e-9)[0][-1])
+            down = [grid[ia]] + [p for p in pts[1:v] if ang(p) > g_ang[ia] + 1e-12] + [dock.stop]
             down_c = line_cells(np.array(down), pitch, diam)
-            up_c = line_cells(np.array(up), pitch, diam)
-            down_c[-1] = dock.stop
+            leg_c = line_cells(np.array(pts[v:]), pitch, diam)
+            same(leg_c[-1], x_in, f"{q.name} and the inner exit point")
             dock_id = add(dock.stop)
-            ids = (
-                ids_g[: ia + 1] + new_ids(down_c[1:-1]) + [dock_id]
-                + new_ids(up_c[1:-1]) + ids_g[ib:]
-            )
+            ids = ids_g[: ia + 1] + new_ids(down_c[1:-1]) + [dock_id] + new_ids(leg_c[1:-1]) + [id_x_in]
             self.line_ids[q.name] = np.array(ids)
             self.dock_ids.append(dock_id)
             self.routes.append(((en.name, 0), (q.name, 1), (ex.name, 1)))
 
         x = line_cells(ex, pitch, diam)
         same(x[0], x_in, f"{ex.name} and the inner exit point")
-        self.line_ids[ex.name] = np.array([ids_x_in] + new_ids(x[1:]))
+        self.line_ids[ex.name] = np.array([id_x_in] + new_ids(x[1:]))
 
     def _sweep_hits(self, layout: QueueLayout, diam: float) -> set[tuple[int, int, int]]:
         """(c, a, b): a robot driving along a line from cell a to the next cell b passes within a

@@ -7,13 +7,10 @@ to its last waypoint; `Polyline.slots(pitch)` gives robot-sized waiting position
 Choices the paper leaves open (its Figs. 3, 4, 6, 7 are not reproduced in the text we have):
 - Docks sit on the depot boundary, K evenly spaced counter-clockwise from +x (Fig. 2). A robot
   unloads at the dock's *stop*: its centre one robot radius outside the boundary.
-- Single queue (sec. IV-A, Fig. 6): the entry line is an Archimedean spiral (pitch = lane
-  spacing) turning counter-clockwise inwards from the perimeter to the inner region; the exit
-  line is radial (as short as possible), so it necessarily crosses every spiral turn: these are
-  the intersections of sec. IV-D, listed in `QueueLayout.crossings`. The inner region holds a
-  ring lane one lane outside the dock stops; every inner queue runs counter-clockwise along it
-  from the inner entry point, dips to its dock in a V and carries on to the inner exit point,
-  which lies just clockwise of the inner entry point. Inner queues therefore overlap on the ring.
+- Single queue (sec. IV-A, Fig. 6), as the authors built it (`single_queue_layout`): the entry
+  line is concentric arcs a lane apart that leave a gap, the exit line runs out through the gap
+  and crosses nothing, and each inner queue goes from the queue head along a ring lane to its
+  dock, then to the inner exit point near the depot centre. Inner queues overlap on the ring.
 - Multi queue (sec. IV-B, Fig. 7): sector k is the wedge of angular width 2*pi/K centred on
   dock k. Its entry line is a serpentine of concentric arcs (lanes one lane spacing apart,
   alternating direction) from the perimeter down to the dock; its exit line continues along the
@@ -322,72 +319,98 @@ def make_docks(cfg: DepotGeometryConfig) -> tuple[Dock, ...]:
 
 
 def single_queue_layout(cfg: DepotGeometryConfig | None = None) -> QueueLayout:
-    """One spiral entry line, one radial exit line, one inner queue per dock (sec. IV-A)."""
+    """One entry line of concentric arcs that leave a gap, one exit line out through the gap, and
+    one short inner queue per dock (sec. IV-A, as the authors built it).
+
+    The authors' single queue (Tameem786/Collision_Free_CPFA, ``CPFA_loop_functions::
+    SetSpiralPathCoordinates``): six concentric arcs 0.2 m apart inside the red circle, each
+    turning back on itself (alternate arcs run in opposite directions) and stopping short of a
+    20 deg gap, joined by short inward steps; from the queue head at the end of the innermost
+    arc a short path to each nest (``SetNestsPredefinedEntryPathCoordinates``) that a robot is
+    sent down only while no other robot holds it (``GetAvailablePathToNest``,
+    ``AddRobotToPathQueueToNest``; freed once the robot has left its nest), and exit paths from
+    the nests out along the gap's bisector (``SetNestsPredefinedExitPathCoordinates``), so no
+    exit crosses the entry line. Ours, on our docks:
+
+    - Gap bisector: the bearing halfway between docks 0 and 1 (pi / K; the authors' 45 deg).
+      Every arc ends where it is one lane spacing off the bisector, so the exit line (radial
+      along the bisector) is a lane clear of the entry line everywhere.
+    - Arcs from half a lane inside the perimeter down to one lane outside the ring (below),
+      a lane apart; the innermost runs clockwise and ends at the gap's counter-clockwise side:
+      that end is the inner entry point (the queue head). The entry point is on the perimeter
+      half a dock spacing (pi / K) beyond the gap, where the outermost arc begins (the authors'
+      entry at 90 deg, 45 deg from their gap).
+    - Inner queue k: from the head a lane inwards to the ring (one lane outside the dock
+      stops), counter-clockwise along it (away from the gap) to dock k's V, down to the dock
+      stop, then straight to the inner exit point, a lane out from the depot centre on the
+      bisector. The ring never reaches the gap, so the exit line crosses no inner queue; the
+      inner queues' last legs meet only at the inner exit point (FCFS there, sec. IV-D).
+    """
     cfg = cfg or DepotGeometryConfig()
     cfg.validate()
     lane, K = cfg.lane_spacing, cfg.docks
     r_stop = cfg.dock_stop_radius
     r_ring = r_stop + lane  # inner-region lane, one lane outside docked robots
     r_inner = r_ring + lane / 2  # purple circle
-    r_end = r_inner + lane / 2  # innermost spiral turn, one lane outside the ring
-    r0_max = cfg.perimeter_radius - lane / 2  # outermost turn, half a lane inside the perimeter
-    if r0_max - r_end < lane:
+    r_end = r_inner + lane / 2  # innermost arc, one lane outside the ring
+    r_top = cfg.perimeter_radius - lane / 2  # outermost arc, half a lane inside the perimeter
+    n_arcs = int(math.floor((r_top - r_end) / lane + 1e-9)) + 1
+    if r_top < r_end:
         raise ValueError(
-            f"perimeter_radius {cfg.perimeter_radius} m too small for even one spiral lane: "
-            f"need >= {r_end + 1.5 * lane:.3f} m with depot_radius {cfg.depot_radius} m and "
+            f"perimeter_radius {cfg.perimeter_radius} m too small for even one queue arc: "
+            f"need >= {r_end + lane / 2:.3f} m with depot_radius {cfg.depot_radius} m and "
             f"lane_spacing {lane} m"
         )
-    alpha = lane / r_ring  # half-width of a dock's V on the ring [rad]
-    gap = lane / r_ring  # inner exit point one lane clockwise of the inner entry point [rad]
-    phi_in = math.pi / K + gap / 2  # the pair straddles the bisector of docks 0 and 1
-    phi_out = phi_in - gap
-    if K > 1 and phi_out - alpha < lane / (2 * r_ring):
-        raise ValueError(
-            f"docks={K} too many for depot_radius {cfg.depot_radius} m with lane_spacing "
-            f"{lane} m: dock approaches and inner entry/exit points do not fit on the ring"
-        )
+    bisector = math.pi / K
 
-    # Inner queues: E_in -> ring CCW -> V to the dock stop -> ring CCW -> X_in.
-    inner = []
-    e_in = _polar(cfg, r_inner, phi_in)
-    x_in = _polar(cfg, r_inner, phi_out)
+    def off(r: float) -> float:
+        """Bearing offset putting a point at radius r one lane off the bisector."""
+        return math.asin(min(1.0, lane / r))
+
+    def ccw_side(r: float) -> float:
+        return bisector + off(r)
+
+    def cw_side(r: float) -> float:
+        return bisector - off(r) + 2 * math.pi
+
+    alpha = lane / r_ring  # half-width of a dock's V on the ring [rad]
+    ring_start = ccw_side(r_ring)
+    angles = []
     for d in make_docks(cfg):
         th = d.angle
-        while th - alpha <= phi_in:
+        while th - alpha <= ring_start:
             th += 2 * math.pi
-        end = phi_out + 2 * math.pi
-        pts = _join(
-            e_in,
-            _arc(cfg, r_ring, phi_in, th - alpha),
-            d.stop,
-            _arc(cfg, r_ring, th + alpha, end),
-            x_in,
+        angles.append(th)
+    if K > 1 and (max(angles) + alpha > cw_side(r_ring) or min(angles) - alpha - ring_start < lane / (2 * r_ring)
+                  or r_stop * math.sin(bisector) < lane):
+        raise ValueError(
+            f"docks={K} too many for depot_radius {cfg.depot_radius} m with lane_spacing "
+            f"{lane} m: dock approaches and the exit gap do not fit on the ring"
         )
-        inner.append(Polyline(f"inner_queue_{d.index}", pts))
 
-    # Entry spiral: r(phi) = r_end + pitch_r * (phi_in - phi) / 2pi, phi from phi0 up to phi_in.
-    # Pick the number of turns so the outer entry point keeps a lane clear of the exit line.
-    # Radial pitch a touch above the lane spacing, so the distance *normal* to the turns (the
-    # radial one times cos of the spiral's slope) is still a full lane spacing at r_end.
-    pitch_r = lane * math.sqrt(1.0 + (lane / (2 * math.pi * r_end)) ** 2)
-    turns = (r0_max - r_end) / pitch_r
-    min_sep = 1.5 * lane / cfg.perimeter_radius
-    while True:
-        phi0 = phi_in - 2 * math.pi * turns
-        d = (phi0 - phi_out) % (2 * math.pi)
-        if min(d, 2 * math.pi - d) >= min_sep:
-            break
-        turns -= 0.01
-    if turns < 1.0:
-        raise ValueError(f"perimeter_radius {cfg.perimeter_radius} m too small for the spiral")
-    r0 = r_end + pitch_r * turns
-    n = max(2, int(math.ceil(2 * math.pi * turns * (r0 + r_end) / 2 / ARC_STEP)))
-    phi = np.linspace(phi0, phi_in, n + 1)
-    spiral = _polar(cfg, r_end + pitch_r * (phi_in - phi) / (2 * math.pi), phi)
-    entry = Polyline(
-        "entry_line", _join(_polar(cfg, cfg.perimeter_radius, phi0), spiral, e_in)
-    )
-    exit_line = Polyline("exit_line", _join(x_in, _polar(cfg, cfg.perimeter_radius, phi_out)))
+    # Entry line: arcs from the outermost inwards; arc j (0 = innermost) runs clockwise when j
+    # is even, so the innermost ends on the gap's counter-clockwise side.
+    # The entry point is half a dock spacing beyond the gap (the authors' entry at 90 deg, the
+    # gap at 45 deg), so robots coming in keep clear of robots going out.
+    radii = [r_end + j * lane for j in range(n_arcs)]
+    top = n_arcs - 1
+    enter = bisector - math.pi / K + 2 * math.pi if top % 2 == 0 else bisector + math.pi / K
+    parts = [_polar(cfg, cfg.perimeter_radius, enter)]
+    for j in range(top, -1, -1):
+        r = radii[j]
+        if j % 2 == 0:
+            parts.append(_arc(cfg, r, enter if j == top else cw_side(r), ccw_side(r)))
+        else:
+            parts.append(_arc(cfg, r, enter if j == top else ccw_side(r), cw_side(r)))
+    entry = Polyline("entry_line", _join(*parts))
+    e_in = entry.end
+    x_in = _polar(cfg, lane, bisector)
+
+    inner = []
+    for d, th in zip(make_docks(cfg), angles):
+        pts = _join(e_in, _arc(cfg, r_ring, ring_start, th - alpha), d.stop, x_in)
+        inner.append(Polyline(f"inner_queue_{d.index}", pts))
+    exit_line = Polyline("exit_line", _join(x_in, _polar(cfg, cfg.perimeter_radius, bisector)))
     crossings = tuple(
         Crossing(entry.name, exit_line.name, p)
         for p in segment_intersections(entry.points, exit_line.points)

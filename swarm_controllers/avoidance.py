@@ -195,3 +195,15 @@ class AvoidThenEscape:
             self._escape_left -= 1
             return self._escape
         return None
+
+    def turn_only(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
+        """The avoidance turn of a robot that stands still, without the escape run: it turns
+        in place away from what its front sector sees and never drives off. In the authors'
+        ARGoS code an IDLE robot calls ``Stop()`` before ``Move()`` every tick, so the forward
+        step ``BaseController::CollisionDetection`` pushes after its turn is cancelled and only
+        the turn is driven (MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-Search-Algorithm,
+        branch luki-dev, source/Base/BaseController.cpp and source/DSA/DSA_controller.cpp,
+        ``DSA_controller::ControlStep``, state IDLE). Episodes count as in `update`."""
+        self._escape_left = 0
+        self._was_avoiding = False
+        return self.avoidance.update(ranges)

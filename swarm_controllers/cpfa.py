@@ -27,7 +27,7 @@ Rules, in the paper's words, and how they are realised here:
   sigma = omega + (4 pi - omega) exp(-lambda_id t), t = time since the informed search began
   [s]. Searches at a remembered site (site fidelity) or at a pheromone waypoint are informed:
   they start almost undirected and relax to the uninformed walk. ARGoS counts t in search
-  steps, CPFA-ROS in seconds; seconds match `CpfaConfig.rate_of_informed_search_decay` [1/s].
+  steps, CPFA-ROS in seconds (`CpfaConfig.informed_search_time` chooses; seconds by default).
 * **Find resource, sense local density** (H&M Algorithm 1: count the resources c near the
   find): the world picks a resource up when an empty robot reaches it; on the tick
   `obs.sensed.carrying` turns True the robot records the site (its own position) and
@@ -38,6 +38,14 @@ Rules, in the paper's words, and how they are realised here:
 * **Return to nest**: straight for the depot centre. The world drops the resource when the
   carrier enters a drop zone; `obs.sensed.carrying` turning False completes a trip (trips += 1). A
   robot that gave up has arrived when it is inside the depot disc.
+* **Docks** (``depot.delivery: docks``, the queue paper's CPFA baseline, sec. III: "robots are
+  required to unload resources at designated docks", staying T_unload): a carrier heads for the
+  dock stop nearest to it and, once its centre is within ``depot.dock_radius`` of it, stands
+  still until the world has dropped the resource after T_unload. No queue: carriers contend for
+  a dock with their obstacle avoidance. As in the authors' CPFA (Tameem786/Collision_Free_CPFA,
+  ``CPFA_controller::IsInTheNest``: the robot's centre within ``NestRadius`` of one of the
+  ``NestPosition`` docks; ``BaseController::Move`` returns before its collision detection while
+  the robot ``Wait``s 5 s at the nest), an unloading robot does not avoid.
 * **Lay pheromone** (H&M: with probability POIS(c, lambda_lp)): after a delivery the robot
   sends a `PheromoneMessage` (the site, stamped now) with that tick's command. POIS is the
   Poisson CDF e^-lambda sum_{i<=c} lambda^i / i!, as in the paper's equation and ARGoS.
@@ -81,6 +89,7 @@ from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
 from swarm_sim.scenario import Scenario
+from swarm_sim.sites import scenario_docks
 from swarm_sim.types import (
     NS_PER_S,
     BehaviourStatus,
@@ -189,6 +198,10 @@ class CpfaBehaviour:
         self._bound = half - margin if half > margin else half / 2.0
         self._site_clearance2 = (nest_radius + margin) ** 2
         self._keep_out2 = -1.0 if keep_out is None else keep_out**2
+        docks_mode = keep_out is None and scenario.depot.delivery == "docks"
+        self._docks = [(float(k.stop[0]), float(k.stop[1])) for k in scenario_docks(scenario)] if docks_mode else []
+        """Dock stops a carrier returns to [m, world frame] (empty: the depot centre)."""
+        self._dock_r2 = scenario.depot.dock_radius**2
 
         self._state = CpfaState.DEPARTING
         self._mode = SearchMode.UNINFORMED
@@ -202,6 +215,9 @@ class CpfaBehaviour:
         self._leg_y = 0.0
         self._search_t0 = 0.0
         """When the current search began [s]."""
+        self._search_legs = 0
+        """Walk legs drawn since the current search began."""
+        self._search_in_steps = cfg.informed_search_time == "steps"
         self._site: tuple[float, float] | None = None
         """Where the last resource was found, until used for site fidelity or given up."""
         self._site_count = 0
@@ -286,6 +302,9 @@ class CpfaBehaviour:
             else:
                 self._trips += 1
                 out = self._at_nest(obs, delivered=True)
+        if self._docks and self._carrying and self._nearest_dock(obs)[1] < self._dock_r2:
+            self._avoidance.reset()  # unloading at a dock: stand still, no avoidance
+            return Command(0.0, 0.0, out)
         override = self._avoidance.update(obs.ranges)
         state = self._state
         if state is CpfaState.DEPARTING:
@@ -316,6 +335,7 @@ class CpfaBehaviour:
     def _start_search(self, obs: Observation) -> tuple[float, float]:
         self._state = CpfaState.SEARCHING
         self._search_t0 = obs.t
+        self._search_legs = 0
         self._new_leg(obs)
         return self._walk(obs)
 
@@ -340,7 +360,9 @@ class CpfaBehaviour:
         if self._mode is SearchMode.UNINFORMED:
             sigma = self._omega
         else:
-            sigma = informed_search_sigma(self._omega, self._lambda_id, obs.t - self._search_t0)
+            t = self._search_legs if self._search_in_steps else obs.t - self._search_t0
+            sigma = informed_search_sigma(self._omega, self._lambda_id, t)
+        self._search_legs += 1
         step, bound = self._search_step, self._bound
         normal = self._rng.normal
         for _ in range(_LEG_REDRAWS):
@@ -356,9 +378,19 @@ class CpfaBehaviour:
         self._heading = math.remainder(heading, _TWO_PI)
         self._leg_x, self._leg_y = x, y
 
+    def _nearest_dock(self, obs: Observation) -> tuple[tuple[float, float], float]:
+        """The dock stop nearest the robot and its squared distance [m, m^2]."""
+        x, y = obs.pose.x, obs.pose.y
+        d2 = [(dx - x) ** 2 + (dy - y) ** 2 for dx, dy in self._docks]
+        k = min(range(len(d2)), key=d2.__getitem__)
+        return self._docks[k], d2[k]
+
     def _returning(self, obs: Observation) -> tuple[float, float]:
         pose = obs.pose
         x, y = pose.x, pose.y
+        if self._docks and self._carrying:
+            (tx, ty), _ = self._nearest_dock(obs)
+            return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
         nx, ny = self._nest
         d2 = (nx - x) ** 2 + (ny - y) ** 2
         if not self._carrying and d2 < self._nest_r2:

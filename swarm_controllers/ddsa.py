@@ -31,10 +31,25 @@ Choices where the paper leaves a detail open:
   resuming) keeps the old s: the robot delivers it and resumes where it was.
 * **Returning**: straight for the depot centre; the world drops the resource in the depot
   drop zone, and ``obs.sensed.carrying`` turning False completes a trip (trips += 1).
-* **DONE**: the path's last waypoint reached, the robot drives back into the depot disc and
-  stops there (no further instructions exist without a centre). A parked robot sends (0, 0)
-  and no longer runs obstacle avoidance, so other robots' traffic does not count as its
-  avoidance events or push it around.
+* **DONE** (the paper: "If a robot completes the search along its entire spiral path without
+  finding a target, it returns to the center and awaits further instructions until the
+  completion of the foraging task"): the robot stops where its path ends and stays there.
+  DDSA has no centre that could ever send an instruction, so where it waits is the only
+  thing the sentence decides, and the authors' code, which produced the paper's figures,
+  waits where the pattern ends: ``DSA_controller::ReachSpiralTargets`` sets ``DSA = IDLE;
+  Stop();`` once the pattern is empty (MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-
+  Search-Algorithm, branch luki-dev, "The version for the submission", source/DSA/
+  DSA_controller.cpp), as the lab's older DSA did with its return to the nest commented out
+  (BCLab-UNM/iAnt-ARGoS, source/DSA/DSA_controller.cpp, ``ReachSpiralTargets``). Driving
+  back into the depot instead parked the finished robots on the drop disc's rim where they
+  walled off the carriers (issue 11, experiment 2 at 32 robots in the issue-4 world, seeds
+  0-4: 8-10 robots parked there, 0-1 deliveries in the last 4 minutes, 1.18 ± 0.24
+  resources per robot; stopping at the path's end: none there, 20-24 deliveries in the last
+  4 minutes, 5.27 ± 0.31 per robot).
+  A finished robot keeps obstacle avoidance on every tick as ``BaseController::Move`` does
+  (`LaneAvoidance.parked`: it turns in place away from what comes at its front, never
+  drives off). A finished robot that still picks something up (pushed onto a resource)
+  delivers it and comes back to its path's end.
 * **Obstacle avoidance**: `LaneAvoidance` while SEARCHING and on the last
   ``approach_radius`` of RESUMING (the find position may lie on an outer lane, 0.2 m from a
   wall, closer than the general avoidance lets a robot drive), the general scan avoidance with
@@ -56,6 +71,13 @@ falls back to the general avoidance; and it steers back onto its lane (above). D
 a searcher to its own path, 8 robots, 12 min, seeds 0-7 (tested in test_ddsa.py on a shorter
 run): mean 0.051 -> 0.003 m, max 0.72-1.15 -> 0.07-0.20 m (the largest in the first minute,
 when all robots leave the crowded centre).
+
+The general avoidance's trigger is the scenario's (``controller.avoidance``). Since issue 11 the
+spiral scenarios use the authors' foot-bot trigger, 0.185 m from the centre in a +-37.5 deg
+front sector (``BaseController::CollisionDetection``), instead of the default 0.3 m / 2 rad:
+with the authors' 0.18 m nest the default kept carriers ringed around it (experiment 3, 16
+robots, 300 resources, seed 0: 108 deliveries, 8 robots within 0.6 m of the centre in the last
+minute; with the authors' trigger 190 and 1).
 """
 
 from __future__ import annotations
@@ -162,6 +184,16 @@ class LaneAvoidance:
         command = self._general(ranges)
         return STOP if command is None else command
 
+    def parked(self, ranges: np.ndarray | Sequence[float]) -> Command:
+        """The command of a robot that stands still (path finished, waiting at or idle away
+        from the center): a turn in place away from what its front sector sees
+        (`AvoidThenEscape.turn_only`, counted as an avoidance event), else STOP. Called every
+        tick it stands, so avoidance stays on in every state as in the authors' controllers."""
+        self._yield_since = None
+        self._general_on = False
+        command = self.general.turn_only(ranges)
+        return STOP if command is None else command
+
     def _general(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
         command = self.general.update(ranges)
         self._general_on = command is not None
@@ -178,7 +210,7 @@ class DdsaState(Enum):
     RESUMING = "resuming"
     """Driving back to the arc-length position of the last find."""
     DONE = "done"
-    """Spiral finished: back to the depot and stop."""
+    """Spiral finished: stopped where it ends (avoidance turns in place only)."""
 
 
 class DdsaBehaviour:
@@ -205,7 +237,6 @@ class DdsaBehaviour:
         self._carrot = sp.gap
         self._arrival2 = scenario.controller.arrival_tolerance**2
         self._center = center
-        self._depot_r2 = scenario.depot.radius**2
 
         self._state = DdsaState.SEARCHING
         self._next = 0
@@ -215,7 +246,6 @@ class DdsaBehaviour:
         self._found_s: float | None = None
         """Arc length of the last find [m], until resumed."""
         self._carrying = False
-        self._parked = False
         self._trips = 0
         self._stamp_ns = 0
 
@@ -267,17 +297,18 @@ class DdsaBehaviour:
             if carrying:
                 if self._state is DdsaState.SEARCHING:
                     self._found_s = self._progress
-                if self._state is not DdsaState.DONE:
-                    self._state = DdsaState.RETURNING
+                elif self._state is DdsaState.DONE:
+                    self._found_s = self.path.length  # deliver, then back to the path's end
+                self._state = DdsaState.RETURNING
             else:
                 self._trips += 1
                 if self._state is DdsaState.RETURNING:
                     self._state = DdsaState.RESUMING
         if self._state is DdsaState.RESUMING and self._found_s is None:
             self._state = DdsaState.SEARCHING  # picked up on the way out, nothing to resume
-        if self._parked:
-            return Command(0.0, 0.0)
         state = self._state
+        if state is DdsaState.DONE:
+            return self._avoidance.parked(obs.ranges)
         on_lane = state is DdsaState.SEARCHING or (
             state is DdsaState.RESUMING and self._near_resume_point(obs.pose))
         override = self._avoidance.update(obs.ranges, obs.t, on_lane=on_lane)
@@ -287,8 +318,8 @@ class DdsaBehaviour:
             linear, angular = self._resuming(obs)
         else:
             linear, angular = self._to_depot(obs)
-        if self._parked:
-            return Command(0.0, 0.0)
+        if self._state is DdsaState.DONE:  # the path ended this tick
+            return self._avoidance.parked(obs.ranges)
         return override if override is not None else Command(linear, angular)
 
     # ------------------------------------------------------------------ states
@@ -306,7 +337,7 @@ class DdsaBehaviour:
             self._next += 1
         if self._next >= n:
             self._state = DdsaState.DONE
-            return self._to_depot(obs)
+            return 0.0, 0.0
         self._update_progress(x, y)
         if obs.sensed.resources and not self._carrying:
             rx, ry = obs.sensed.resources[0]
@@ -365,14 +396,11 @@ class DdsaBehaviour:
         return go_to_point_twist(pose.x, pose.y, pose.yaw, tx, ty, self._limits)
 
     def _to_depot(self, obs: Observation) -> tuple[float, float]:
-        """RETURNING: to the centre (the world drops the resource); DONE: into the disc, park."""
+        """RETURNING: to the centre (the world drops the resource in the depot disc)."""
         pose = obs.pose
         x, y = pose.x, pose.y
         cx, cy = self._center
         d2 = (cx - x) ** 2 + (cy - y) ** 2
-        if self._state is DdsaState.DONE and not self._carrying and d2 < self._depot_r2:
-            self._parked = True
-            return 0.0, 0.0
         if d2 < self._arrival2:
             return 0.0, 0.0
         return go_to_point_twist(x, y, pose.yaw, cx, cy, self._limits)

@@ -16,7 +16,18 @@ depot centre, and answers two ticks later):
   first. It then waits, parked, for its `RegionAssignment` (messages in ``obs.messages``; only
   those with ``robot == self.robot`` concern it) and re-sends its report if no answer came
   within `ASK_RETRY` seconds.
-* **Idle** (region -1): parked in range; asks again every `IDLE_RETRY` seconds of sim time.
+* **Idle** (region -1; the paper: "If there are no available paths to assign or share, the
+  robot becomes idle"): the robot drives to the center of the region it walked last (a robot
+  that never walked one: the nearest region center) and stops within
+  ``regions.center_radius`` of it, as the authors' controllers do (``DSA = IDLE;
+  SetTarget(regionCenters[PreRegionID])``, ``Stop()`` once within ``RegionRadius``:
+  MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev,
+  c890aa1 "the version for the submission", Centralized/ and Distributed/
+  source/DSA/DSA_controller.cpp, ``ControlStep``). It does not ask again: in the authors'
+  code IDLE is final, and under the paper's rules nothing becomes sharable later (both
+  walkers of a region end together), so "idle until there is a path available" never ends
+  either. Idling at the center instead walled off the drop zone (issue 11). Consequence: a
+  region freed later by a robot declared dead is not taken up by idle robots.
 * **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range), report
   ``done=True`` with the arc length reached, wait for the next walk.
 * **MDBSA-C on each delivery**: the route to the depot passes the center, so the carrier
@@ -42,11 +53,17 @@ Choices where the paper leaves a detail open:
   robot drives back to it (TRAVELING to the walk's start is the same motion); `LaneAvoidance`
   on the lane and on the last ``approach_radius`` to it (a reverse walk starts on the outer
   lane, 0.2 m from the wall, which the general avoidance would never let a robot reach head
-  on), the general avoidance (turning right) elsewhere. Parked robots
-  (waiting, idle) send (0, 0) and run no avoidance.
+  on), the general avoidance (turning right) elsewhere. Avoidance runs every tick in every
+  state, as the authors' ``BaseController::Move`` does: a robot standing still (waiting for
+  the center's answer, idle at its region center) turns in place away from what comes at its
+  front and does not drive off (`LaneAvoidance.parked`).
 * **Delivery target**: MDBSA-C the ``depot`` drop zone's centre; MDBSA-D the ``region_<i>``
   drop zone of the walk's region (the world drops as soon as the carrier is inside it). A
   resource picked up outside a walk (driving over it) goes to the nearest region center.
+  A robot picks up whatever it passes, also on its way out (the world's gripper; the authors'
+  robots search while travelling too, ``SetHoldingFood`` in SEARCHING), and an MDBSA-D carrier
+  that then crosses another region's centre drops its load there (the world drops in any zone
+  a carrier enters; the authors' robot would carry it to its own region's centre).
   With ``depot.delivery: region_centers`` the depot disc is not a drop zone, so MDBSA-D
   carriers crossing it keep their load; construction refuses a scenario whose drop zones do
   not match the version.
@@ -69,12 +86,10 @@ from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral import SpiralPath
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, RobotId
+from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, Pose2D, RobotId
 
 ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""
-IDLE_RETRY = 5.0
-"""An idle robot asks for a region again this often [s, sim time]."""
 ASK_MARGIN = 0.1
 """A robot heading for the center stops this far inside its range [m] before reporting."""
 _EPS = 1e-9
@@ -88,7 +103,7 @@ class MdbsaState(Enum):
     WAITING = "waiting"
     """Parked in range, waiting for the center's answer."""
     IDLE = "idle"
-    """Parked in range: nothing to walk for now (region -1); asks again every IDLE_RETRY."""
+    """Nothing to walk (region -1): to the last region's center and stopped there, for good."""
     TRAVELING = "traveling"
     """Driving to where the assigned walk begins."""
     SEARCHING = "searching"
@@ -148,6 +163,7 @@ class MdbsaBehaviour:
         self._center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
+        self._idle_r2 = float(scenario.regions.center_radius) ** 2
         self._limits = DriveLimits.from_scenario(scenario)
         self._avoidance = LaneAvoidance(scenario)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
@@ -162,7 +178,8 @@ class MdbsaBehaviour:
         self._reported_trip = False
         self._asked_at = -math.inf
         self._asked_ns = -1
-        self._next_ask = -math.inf
+        self._idle_at: tuple[float, float] | None = None
+        """Where an idle robot stops [m, world frame]: its last region's center."""
         self._outbox: list[object] = []
         self._trips = 0
         self._stamp_ns = 0
@@ -222,12 +239,14 @@ class MdbsaBehaviour:
         self._outbox = []
         for m in obs.messages:
             if isinstance(m, RegionAssignment) and m.robot == self.robot:
-                self._on_assignment(m, obs.t)
+                self._on_assignment(m, obs.pose)
         self._on_carrying(bool(obs.sensed.carrying))
         state = self._state
-        if state is MdbsaState.WAITING or state is MdbsaState.IDLE:
-            self._parked(obs)
-            return self._command(0.0, 0.0)
+        if state is MdbsaState.WAITING:
+            self._waiting(obs)
+            return self._standing(obs)
+        if state is MdbsaState.IDLE and self._at_idle_spot(obs):
+            return self._standing(obs)
         override = self._avoidance.update(obs.ranges, obs.t, on_lane=self._on_lane(obs))
         if state is MdbsaState.SEARCHING:
             linear, angular = self._searching(obs)
@@ -235,10 +254,14 @@ class MdbsaBehaviour:
             linear, angular = self._to_walk(obs)
         elif state is MdbsaState.DELIVERING:
             linear, angular = self._delivering(obs)
+        elif state is MdbsaState.IDLE:
+            assert self._idle_at is not None
+            linear, angular = go_to_point_twist(obs.pose.x, obs.pose.y, obs.pose.yaw,
+                                                *self._idle_at, self._limits)
         else:
             linear, angular = self._to_center(obs)
-        if self._state is MdbsaState.WAITING:  # just reported; park from now on
-            return self._command(0.0, 0.0)
+        if self._state is MdbsaState.WAITING:  # just reported; stand from now on
+            return self._standing(obs)
         if override is not None:
             return self._command(override.linear, override.angular)
         return self._command(linear, angular)
@@ -254,6 +277,16 @@ class MdbsaBehaviour:
             return d < self._avoidance.approach_radius
         return False
 
+    def _standing(self, obs: Observation) -> Command:
+        """A robot that stands still: avoidance turns in place only (`LaneAvoidance.parked`)."""
+        c = self._avoidance.parked(obs.ranges)
+        return self._command(c.linear, c.angular)
+
+    def _at_idle_spot(self, obs: Observation) -> bool:
+        assert self._idle_at is not None
+        x, y = self._idle_at
+        return (obs.pose.x - x) ** 2 + (obs.pose.y - y) ** 2 <= self._idle_r2
+
     def _command(self, linear: float, angular: float) -> Command:
         if not self._outbox:
             return Command(linear, angular) if (linear, angular) != (0.0, 0.0) else STOP
@@ -261,12 +294,11 @@ class MdbsaBehaviour:
 
     # ------------------------------------------------------------------ events
 
-    def _on_assignment(self, m: RegionAssignment, t: float) -> None:
+    def _on_assignment(self, m: RegionAssignment, pose: Pose2D) -> None:
         w = self._walk
         # An answer to our last ask is stamped after it; anything older (an update the center
         # sent while we were about to ask) is not the answer.
-        asked = ((self._state is MdbsaState.WAITING or self._state is MdbsaState.IDLE)
-                 and m.stamp_ns > self._asked_ns)
+        asked = self._state is MdbsaState.WAITING and m.stamp_ns > self._asked_ns
         if not asked and w is not None and m.region == w.region and m.direction == w.direction:
             # The center passes on the partner's frontier: the stop only moves toward us.
             w.stop_u = max(w.u, min(w.stop_u, w.to_u(m.stop_s)))
@@ -275,10 +307,9 @@ class MdbsaBehaviour:
             return
         if m.region < 0:
             if asked:
-                self._state = MdbsaState.IDLE
-                self._next_ask = t + IDLE_RETRY
+                self._go_idle(pose)
             return  # an idle answer while walking is stale: keep walking
-        if not 0 <= m.region < len(self.paths):
+        if not 0 <= m.region < len(self.paths) or self._state is MdbsaState.IDLE:
             return
         self._walk = _Walk(m, self.paths[m.region])
         if self._state is MdbsaState.DELIVERING:
@@ -307,6 +338,17 @@ class MdbsaBehaviour:
             if self._state is MdbsaState.DELIVERING:
                 self._state = self._after_delivery
 
+    def _go_idle(self, pose: Pose2D) -> None:
+        """Idle for good: to the center of the region walked last (else the nearest one)."""
+        if self._walk is not None:
+            start = self.paths[self._walk.region].start
+        else:
+            start = min((p.start for p in self.paths),
+                        key=lambda c: (c[0] - pose.x) ** 2 + (c[1] - pose.y) ** 2)
+        self._idle_at = (float(start[0]), float(start[1]))
+        self._walk = None
+        self._state = MdbsaState.IDLE
+
     # ------------------------------------------------------------------ talking to the center
 
     def _report(self, obs: Observation, *, done: bool) -> None:
@@ -326,15 +368,12 @@ class MdbsaBehaviour:
     def _d2_center(self, obs: Observation) -> float:
         return (obs.pose.x - self._center[0]) ** 2 + (obs.pose.y - self._center[1]) ** 2
 
-    def _parked(self, obs: Observation) -> None:
-        """WAITING / IDLE: re-ask when due, from within range (else drive back first)."""
-        due = (self._asked_at + ASK_RETRY if self._state is MdbsaState.WAITING
-               else self._next_ask)
-        if obs.t < due - _EPS:
+    def _waiting(self, obs: Observation) -> None:
+        """WAITING: ask again when no answer came in time, from within range (else drive back
+        first)."""
+        if obs.t < self._asked_at + ASK_RETRY - _EPS:
             return
         if self._d2_center(obs) <= self._range**2:
-            if self._state is MdbsaState.IDLE and self._walk is not None and self._walk.over:
-                self._walk = None  # reported done long ago; ask as a robot without a walk
             self._ask(obs)
         else:
             self._state = MdbsaState.TO_CENTER

@@ -12,7 +12,8 @@ Typed payloads (one status per record, level OK):
   name ``node_down`` (level ERROR), hardware_id = the robot or server channel, values ``kind``
   (``robot``/``server``), ``ticks`` (missed in a row), ``stamp_ns``.
 - `/world/robot_stats` (`encode_robot_stats`): name = hardware_id = robot, values
-  ``collision_time_s``, ``pickups``, ``deliveries``, ``clamped_commands``, ``stale_ticks``.
+  ``collision_time_s`` (body contact), ``pickups``, ``deliveries``, ``clamped_commands``,
+  ``stale_ticks``, ``avoidance_time_s`` (proximity ring saw something ahead).
 - `/<robot>/status` (`encode_status`): one status, name = hardware_id = robot,
   message = state, values ``state``, ``obstacle_avoidance_events``, ``trips``, then the
   behaviour's extra pairs in order.
@@ -165,7 +166,8 @@ def decode_events(data: bytes) -> tuple[int, tuple[WorldEvent, ...]]:
 
 # --------------------------------------------------------------------------- /world/robot_stats
 
-_STATS_KEYS = ("collision_time_s", "pickups", "deliveries", "clamped_commands", "stale_ticks")
+_STATS_KEYS = ("collision_time_s", "pickups", "deliveries", "clamped_commands", "stale_ticks",
+               "avoidance_time_s")
 
 
 @codec(f"{TYPE_NAME} (robot stats)")
@@ -182,6 +184,7 @@ def encode_robot_stats(stamp_ns: int, stats: Mapping[RobotId, RobotStats]) -> by
                     ("deliveries", str(int(s.deliveries))),
                     ("clamped_commands", str(int(s.clamped_commands))),
                     ("stale_ticks", str(int(s.stale_ticks))),
+                    ("avoidance_time_s", repr(float(s.avoidance_time_s))),
                 ),
             )  # fmt: skip
             for robot, s in stats.items()
@@ -195,12 +198,16 @@ def decode_robot_stats(data: bytes) -> tuple[int, dict[RobotId, RobotStats]]:
     stamp_ns, statuses = decode_diagnostics(data)
     out: dict[RobotId, RobotStats] = {}
     for s in statuses:
-        f = _fields(s, _STATS_KEYS, "robot")
+        # Bags recorded before avoidance_time_s existed (issue 11) lack it: 0.0, not a refusal.
+        old = "avoidance_time_s" not in (k for k, _ in s.values)
+        f = _fields(s, _STATS_KEYS[:-1] if old else _STATS_KEYS, "robot")
+        if old:
+            f["avoidance_time_s"] = "0.0"
         if s.name in out:
             raise ValueError(f"robot {s.name!r} appears twice")
         out[s.name] = RobotStats(
             float(f["collision_time_s"]), int(f["pickups"]), int(f["deliveries"]),
-            int(f["clamped_commands"]), int(f["stale_ticks"]),
+            int(f["clamped_commands"]), int(f["stale_ticks"]), float(f["avoidance_time_s"]),
         )  # fmt: skip
     return stamp_ns, out
 

@@ -15,6 +15,8 @@ register_task(TaskSpec(
 
 _CPFA_SECTION = ("cpfa", "swarm_controllers.config:CpfaConfig")
 _SPIRAL_SECTION = ("spiral", "swarm_controllers.config:SpiralConfig")
+_SPIRAL_METRICS = (Metric("resources_per_robot_per_min",
+                          "swarm_controllers.spiral_metrics:resources_per_robot_per_min", None),)
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.center:CenterServer",
     node="swarm_controllers.center_node", script="swarm-center",
@@ -27,6 +29,7 @@ register(Algorithm(
     behaviour="swarm_controllers.cpfa:CpfaBehaviour",
     config=(_CPFA_SECTION,),
     peers=("swarm_msgs_py.pheromone:PHEROMONES",),
+    deliveries=("depot", "docks"),
     comparison="swarm_sim.compare.queue_paper:QUEUE_COMPARISON",
 ))
 
@@ -56,6 +59,7 @@ register(Algorithm(
     behaviour="swarm_controllers.ddsa:DdsaBehaviour",
     config=(_SPIRAL_SECTION,),
     checks=("swarm_controllers.config:check_spiral",),
+    metrics=_SPIRAL_METRICS,
     paths="swarm_controllers.ddsa:planned_paths",
     comparison="swarm_sim.compare.spiral_paper:SPIRAL_COMPARISON",
 ))
@@ -69,7 +73,7 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         checks=("swarm_controllers.config:check_spiral",),
         servers=(_CENTER,),
         deliveries=(_delivery,),
-        metrics=(Metric("regions", "swarm_controllers.center:region_count", None),),
+        metrics=(Metric("regions", "swarm_controllers.center:region_count", None), *_SPIRAL_METRICS),
         paths="swarm_controllers.center:planned_paths",
         comparison="swarm_sim.compare.spiral_paper:SPIRAL_COMPARISON",
     ))

@@ -82,11 +82,19 @@ class RobotConfig:
     start_spacing: float = 0.4
     """Robots start on a square grid of this pitch [m] centred on the depot (`start_layout`
     grid); the other layouts keep robot centres at least this far apart."""
-    start_layout: Literal["grid", "depot_random", "depot_ring"] = "grid"
+    start_layout: Literal["grid", "depot_random", "depot_ring", "groups"] = "grid"
     """Where robots start (`swarm_sim.world.start`): `grid` on the square grid above;
+    `groups` in `start_groups` (ARGoS ``<distribute>`` blocks with a grid ``layout``);
     `depot_random` uniformly at random inside the depot disc (the DRTM paper's "placed in the
     nest randomly"); `depot_ring` evenly spaced on a circle just inside the depot's edge (the
     DRTM paper's e-puck set-up, "evenly distributed along the perimeter of the nest")."""
+    start_groups: tuple[tuple[float, float], ...] = ()
+    """`groups` layout: the centres of the groups [m, world frame]. The robots are dealt out in
+    order, an equal share per group (the first groups take one more when it does not divide),
+    each group on a grid of `start_group_columns` columns at `start_spacing`, row by row,
+    centred on its point as if the grid had as many rows as columns; all facing +x."""
+    start_group_columns: int = 6
+    """Columns (and nominal rows) of a group's grid (ARGoS ``layout="6, 6, 1"``)."""
     radio_range: float = 0.4
     """gamma: robot-to-robot messages reach only robots within this distance [m] (queue paper
     sec. III; used by tail joining)."""
@@ -121,6 +129,21 @@ class ProximityConfig:
 
 
 @dataclass(frozen=True)
+class ProximityRingConfig:
+    """The foot-bot's ring of proximity sensors as the ARGoS CPFA reads it for collision
+    detection: what the queue and spiral papers' *collision time* counts (`swarm_sim.world.proximity`).
+    The ring's sensors are the scan's rays; defaults are ARGoS's foot-bot and the CPFA's rule."""
+
+    range: float = 0.1
+    """How far beyond the body a sensor sees [m] (ARGoS ``footbot_entity.cpp``:
+    PROXIMITY_SENSOR_RING_RANGE = 0.1, the ring on the body radius)."""
+    ahead: float = 80.0
+    """Half-angle [deg] around the heading within which the readings' mean vector must point:
+    the CPFA's ``GoStraightAngleRangeInDegrees.Set(-80, 80)`` (``BaseController.cpp`` of
+    Tameem786/Collision_Free_CPFA and BCLab-UNM/CPFA-ARGoS)."""
+
+
+@dataclass(frozen=True)
 class SensorConfig:
     scan: ScanConfig = field(default_factory=ScanConfig)
     resource_detection_radius: float = 0.13
@@ -133,6 +156,8 @@ class SensorConfig:
     from the robot's centre is not detected [m]."""
     proximity: ProximityConfig = field(default_factory=ProximityConfig)
     """Used by the transport task."""
+    proximity_ring: ProximityRingConfig = field(default_factory=ProximityRingConfig)
+    """What the world counts as collision time (``RobotStats.avoidance_time_s``)."""
     position_range: float = 1.5
     """Transport task: a robot senses the position of the target object and of other robots
     whose centres are within this distance of its own [m] (what the caging paper's robots read
@@ -141,7 +166,9 @@ class SensorConfig:
 
 @dataclass(frozen=True)
 class ResourceConfig:
-    distribution: Literal["clustered", "uniform", "powerlaw"] = "clustered"
+    distribution: Literal["clustered", "uniform", "powerlaw", "powerlaw_tiers"] = "clustered"
+    """`swarm_sim.world.resources`: square clusters, uniform, Hecker & Moses's power law, or
+    the DDSA/MDBSA authors' power law (tiers from `count`)."""
     count: int = 320
     """Total resources; for `clustered` it must equal clusters * cluster_side**2."""
     clusters: int = 5
@@ -182,6 +209,9 @@ class DepotConfig:
     queue paper gives no value; 5 s is our choice."""
     dock_radius: float = 0.06
     """A robot unloads while its centre is within this distance of the dock stop [m]."""
+    dock_distance: float | None = None
+    """Distance of the dock stops from the depot centre [m]; None: one robot radius outside
+    the depot disc (where the queue layouts end)."""
 
 
 @dataclass(frozen=True)
@@ -192,7 +222,8 @@ class RegionConfig:
     count: int = 16
     """N_R, a power of 4 (the MDBSA paper's experiment 1 default is 16)."""
     center_radius: float = 0.25
-    """Radius of each region centre's drop zone [m]."""
+    """Radius of each region centre's drop zone [m] (MDBSA-D), within which an idle MDBSA robot
+    stops (the authors' ``RegionRadius``)."""
 
 
 @dataclass(frozen=True)
@@ -631,6 +662,15 @@ def validate(s: Scenario) -> None:
             f"robots.count: {r.count} robots on a {side}x{side} grid of pitch {r.start_spacing} m "
             f"do not fit in the {s.arena.size} m arena",
         )
+    elif r.start_layout == "groups":
+        _require(len(r.start_groups) >= 1, "robots.start_groups: the groups layout needs at least one group")
+        _require(r.start_group_columns >= 1, "robots.start_group_columns: need at least one column")
+        per = math.ceil(r.count / len(r.start_groups))
+        rows = math.ceil(per / r.start_group_columns)
+        extent = max(r.start_group_columns - 1, 2 * rows - 1 - (r.start_group_columns - 1)) * r.start_spacing / 2
+        for i, g in enumerate(r.start_groups):
+            _require(_inside(g, half, extent + r.diameter / 2),
+                     f"robots.start_groups[{i}]: a group of {per} robots at {g} does not fit in the arena")
     else:
         room = s.depot.radius - r.diameter / 2  # robot centres stay this close to the depot centre
         _require(room > 0, f"robots.start_layout: robots of diameter {r.diameter} m do not fit in the "
@@ -655,6 +695,8 @@ def validate(s: Scenario) -> None:
     _require(s.sensors.resource_detection_radius > 0, "sensors.resource_detection_radius: must be positive")
     _require(s.sensors.pickup_radius > 0, "sensors.pickup_radius: must be positive")
     _require(s.sensors.proximity.range > 0, "sensors.proximity.range: must be positive")
+    _require(s.sensors.proximity_ring.range > 0, "sensors.proximity_ring.range: must be positive")
+    _require(0 <= s.sensors.proximity_ring.ahead <= 180, "sensors.proximity_ring.ahead: must be in [0, 180] deg")
     _require(s.sensors.position_range > 0, "sensors.position_range: must be positive")
     t = s.transport
     _require(t.object.radius > 0, "transport.object.radius: must be positive")
@@ -701,10 +743,11 @@ def validate(s: Scenario) -> None:
     _require(d.unload_time >= 0, "depot.unload_time: must not be negative")
     _require(d.dock_radius > 0, "depot.dock_radius: must be positive")
     _require(d.docks >= 1, "depot.docks: need at least one dock")
-    stop = d.radius + r.diameter / 2
+    _require(d.dock_distance is None or d.dock_distance > 0, "depot.dock_distance: must be positive")
+    stop = d.radius + r.diameter / 2 if d.dock_distance is None else d.dock_distance
     _require(
         d.docks == 1 or 2 * stop * math.sin(math.pi / d.docks) >= r.diameter,
-        f"depot.docks: {d.docks} docks do not fit side by side on a depot of radius {d.radius} m",
+        f"depot.docks: {d.docks} docks do not fit side by side {stop} m from the depot centre",
     )
     _require(d.perimeter_radius > d.radius, "depot.perimeter_radius: must exceed depot.radius")
     if d.delivery == "docks":

@@ -37,11 +37,14 @@ def polar(center: np.ndarray, r: np.ndarray | float, phi: np.ndarray | float) ->
     return pts + center
 
 
-def docks(center: tuple[float, float], depot_radius: float, robot_diameter: float, count: int) -> tuple[Dock, ...]:
+def docks(center: tuple[float, float], depot_radius: float, robot_diameter: float, count: int,
+          stop_radius: float | None = None) -> tuple[Dock, ...]:
     """`count` docks evenly spaced on the depot boundary, CCW from +x (queue paper Fig. 2); a
-    robot unloads with its centre one robot radius outside the boundary."""
+    robot unloads with its centre one robot radius outside the boundary, or `stop_radius` [m]
+    from the centre when given (``depot.dock_distance``)."""
     c = np.asarray(center, dtype=float)
-    stop_radius = depot_radius + robot_diameter / 2.0
+    if stop_radius is None:
+        stop_radius = depot_radius + robot_diameter / 2.0
     out = []
     for k in range(count):
         a = 2 * math.pi * k / count
@@ -52,7 +55,7 @@ def docks(center: tuple[float, float], depot_radius: float, robot_diameter: floa
 def scenario_docks(scenario: Scenario) -> tuple[Dock, ...]:
     """The scenario's docks (``depot.docks`` on the depot disc)."""
     d = scenario.depot
-    return docks(d.center, d.radius, scenario.robots.diameter, d.docks)
+    return docks(d.center, d.radius, scenario.robots.diameter, d.docks, d.dock_distance)
 
 
 def region_centers(n_regions: int, arena_size: float) -> np.ndarray:

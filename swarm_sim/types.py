@@ -171,6 +171,10 @@ class RobotStats:
     """Commands that were NaN/inf or above the speed limits and had to be clamped."""
     stale_ticks: int = 0
     """Lockstep ticks for which the robot's controller did not answer in time."""
+    avoidance_time_s: float = 0.0
+    """Time its proximity ring saw something ahead [s]: the ticks on which an ARGoS foot-bot
+    controller's collision detection fires (the queue and spiral papers' *collision time*; see
+    `swarm_sim.world.proximity`)."""
 
 
 @dataclass(frozen=True, slots=True)

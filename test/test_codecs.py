@@ -422,7 +422,8 @@ def test_events_refuse_unknown_status():
 
 
 STATS_ST = st.builds(
-    RobotStats, st.floats(min_value=0, allow_nan=False), *[st.integers(0, 10**9)] * 4
+    RobotStats, st.floats(min_value=0, allow_nan=False), *[st.integers(0, 10**9)] * 4,
+    st.floats(min_value=0, allow_nan=False),
 )
 
 
@@ -434,13 +435,22 @@ def test_robot_stats_round_trip(ns, stats):
 
 
 def test_robot_stats_mapping():
-    data = diagnostics.encode_robot_stats(5, {"robot_0": RobotStats(1.5, 2, 1, 0, 3)})
+    data = diagnostics.encode_robot_stats(5, {"robot_0": RobotStats(1.5, 2, 1, 0, 3, 4.25)})
     (status,) = deserialize_message(data, DiagnosticArray).status
     assert status.name == "robot_0"
     assert [(kv.key, kv.value) for kv in status.values] == [
         ("collision_time_s", "1.5"), ("pickups", "2"), ("deliveries", "1"),
-        ("clamped_commands", "0"), ("stale_ticks", "3"),
+        ("clamped_commands", "0"), ("stale_ticks", "3"), ("avoidance_time_s", "4.25"),
     ]  # fmt: skip
+
+
+def test_robot_stats_of_a_bag_recorded_before_avoidance_time_decode():
+    from swarm_msgs_py.diagnostics import OK, Status, encode_diagnostics
+
+    old = encode_diagnostics(5, [Status(OK, "robot_0", "", "robot_0", (
+        ("collision_time_s", "1.5"), ("pickups", "2"), ("deliveries", "1"),
+        ("clamped_commands", "0"), ("stale_ticks", "3")))])
+    assert diagnostics.decode_robot_stats(old) == (5, {"robot_0": RobotStats(1.5, 2, 1, 0, 3, 0.0)})
 
 
 BEHAVIOUR_ST = st.builds(

@@ -175,9 +175,15 @@ def test_spiral_report_shows_region_free_ddsa_in_every_cell_and_the_papers_claim
     for cell in (4, 16, 64):
         rows += rows_for("mdbsa_c", cell, [2.0, 2.1, 1.9, 2.2], SPIRAL_KEYS, layout="powerlaw")
         rows += rows_for("mdbsa_d", cell, [4.0, 4.4, 3.6, 4.2], SPIRAL_KEYS, layout="powerlaw")
+    for r in rows:  # per-minute series: DDSA 1.0 then 0.5 per robot, MDBSA twice the seed's value
+        r["resources_per_robot_per_min"] = ([[60.0, 1.0], [120.0, 0.5]] if r["strategy"] == "ddsa"
+                                            else [[60.0, 2.0 * r["seed"]], [120.0, 0.0]])
     written = write_spiral_report(rows, tmp_path, 1, [4, 16, 64])
-    assert {p.name for p in written} == {"tables.md", "mannwhitney.md", "resources_collision.png",
-                                         "foraging_rate.png"}
+    assert {p.name for p in written} == {"tables.md", "mannwhitney.md", "per_minute.md", "resources_collision.png",
+                                         "foraging_rate.png", "foraging_rate_per_minute.png"}
+    per_minute = (tmp_path / "per_minute.md").read_text()
+    assert per_minute.count("| DDSA (n=4) | 1.00 ± 0.00 | 0.50 ± 0.00 |") == 3  # served in every cell
+    assert per_minute.count("| MDBSA-D (n=4) | 3.00 ± 2.58 | 0.00 ± 0.00 |") == 3  # seeds 0-3: 0, 2, 4, 6
     tables = (tmp_path / "tables.md").read_text()
     assert tables.count("2.02 ± 0.17 (median 2.05, n=4)") == 3 * 4  # DDSA, 3 cells, 4 metrics
     mw = (tmp_path / "mannwhitney.md").read_text()
@@ -220,14 +226,16 @@ def test_queue_plans_pass_the_swarm_size_as_robots_count_field():
 
 
 @pytest.mark.parametrize("experiment", [1, 2, 3])
-@pytest.mark.parametrize("layout", ["powerlaw", "clustered"])
+@pytest.mark.parametrize("layout", ["tiers", "powerlaw", "clustered"])
 def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
     exp = SPIRAL_EXPERIMENTS[experiment]
     plans = spiral_plans(experiment, layout=layout)
+    distribution = {"tiers": "powerlaw_tiers"}.get(layout, layout)
     for plan in plans:
         # the mdbsa scenarios are written elsewhere; the overrides must hold on the ddsa file
         s = load_scenario("ddsa", plan.overrides, **dict(plan.fields))
-        assert s.arena.size == 8.0 and s.resources.distribution == layout
+        assert s.arena.size == 8.0 and s.resources.distribution == distribution
+        assert (s.depot.radius, s.resources.spacing) == (0.18, 0.15)  # the authors' nest, pitch
         setting = {"regions": s.regions.count, "robots": s.robots.count,
                    "resources": s.resources.count}
         if plan.cell is None:
@@ -464,3 +472,19 @@ def test_headlines_follow_the_means_and_the_tests():
     similar = next(h for h in claims if h.paper.startswith("similar"))
     above = next(h for h in claims if h.paper.startswith("≈ +101"))
     assert similar.holds is True and above.holds is True and "4: +" in above.ours
+
+
+def test_table_ii_ordering_checked_pair_by_pair():
+    from swarm_sim.compare.queue_paper import ordering_checks, queue_headlines
+
+    rng = np.random.default_rng(5)
+    means = {"queue_cpfa": 60.0, "queue_qse": 17.0, "queue_qst": 34.0, "queue_qme": 50.0, "queue_qmt": 70.0}
+    rows = [r for s, m in means.items() for r in rows_for(s, 48, rng.normal(m, 1.0, 8))]
+    checks = dict(ordering_checks(rows, [48], list(means)))
+    assert checks["CPFA < Q_SE"][0][1].startswith("reversed") and checks["CPFA < Q_SE"][0][2] is False
+    assert checks["Q_SE < Q_ST"][0][1].startswith("holds") and checks["Q_SE < Q_ST"][0][2] is True
+    ratio = checks["Q_ST = 2 Q_SE (Table II: x1.9-2.4)"][0]
+    assert ratio[2] is True and ratio[1].startswith("holds: x")
+    lines = {h.claim: h for h in queue_headlines(rows, [48], list(means))}
+    assert lines["collection Q_ME < Q_MT"].holds is True
+    assert lines["collection CPFA < Q_ME"].holds is False

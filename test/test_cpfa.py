@@ -588,3 +588,32 @@ def test_pheromone_fields_are_plain_python_numbers():
     (m,) = b.step(obs(1, 0.1, 0.0)).messages
     assert type(m.x) is float and type(m.y) is float and type(m.stamp_ns) is int
     assert repr(m) == "PheromoneMessage(stamp_ns=100000000, x=1.25, y=-0.5)"
+
+
+# --------------------------------------------------------------------------- the queue paper's set-up
+
+QUEUE_CPFA = load_scenario("queue_cpfa")
+
+
+def test_queue_cpfa_carrier_heads_for_the_nearest_dock_and_stands_still_there():
+    b = behaviour(QUEUE_CPFA)
+    b.step(obs(0, 3.0, 0.1, math.pi))
+    b.step(obs(1, 3.0, 0.1, math.pi, carrying=True))  # picked up: returning
+    cmd = b.step(obs(2, 3.0, 0.1, math.pi, carrying=True))
+    assert cmd.linear > 0 and abs(cmd.angular) < 0.5  # toward the dock at (0.3, 0), nearly ahead
+    wall = np.full(QUEUE_CPFA.sensors.scan.rays, 0.1, dtype=np.float32)  # crowded all round
+    events = b.obstacle_avoidance_events
+    cmd = b.step(obs(3, 0.32, 0.02, math.pi, carrying=True, ranges=wall))
+    assert (cmd.linear, cmd.angular) == (0.0, 0.0)  # unloading: no avoidance, no motion
+    assert b.obstacle_avoidance_events == events
+
+
+def test_queue_paper_parameter_set():
+    c = CpfaConfig.of(QUEUE_CPFA)
+    assert c.parameter_set == "queue_paper" and c.informed_search_time == "steps"
+    assert c.probability_of_returning_to_nest == pytest.approx(0.0189370369448)
+    assert c.uninformed_search_variation == pytest.approx(math.radians(3.67372660634))
+    bp = load_scenario("queue_cpfa", ["controller.cpfa.parameter_set=beyond_pheromones"])
+    assert CpfaConfig.of(bp).rate_of_site_fidelity == CpfaConfig().rate_of_site_fidelity
+    with pytest.raises(ValueError, match="controller.cpfa.rate_of_site_fidelity"):
+        load_scenario("queue_cpfa", ["controller.cpfa.rate_of_site_fidelity=2.0"])

@@ -412,14 +412,14 @@ def test_conflicts_cover_crossings_but_not_adjacent_lanes(size):
     close = (g.dist < g.thr - 1e-6) & (g.dist > 1e-6) & ~g.adjacent
     assert (g.conf | ~close).all()
     assert g.conf[(g.dist < g.cfg.robot_diameter - 1e-6)].all()  # a fortiori, any overlap
-    # every spiral / exit crossing makes keep-clear cells on both lines
+    # no line crosses the entry line (the exit leaves through the arcs' gap); the inner queues'
+    # last legs merge at the inner exit point, whose approach cells are keep-clear
     lay = layout("single", size)
-    assert len(lay.crossings) >= 2
-    for cr in lay.crossings:
-        for ln in (cr.line_a, cr.line_b):
-            ids = [k for k, lab in enumerate(g.labels) if lab[0] == ln]
-            near = ids[int(np.argmin(np.linalg.norm(g.xy[ids] - cr.point, axis=1)))]
-            assert g.keep_clear[near], (ln, g.labels[near])
+    assert lay.crossings == ()
+    entry = [k for k, lab in enumerate(g.labels) if lab[0] == "entry_line"]
+    assert not any(g.keep_clear[k] for k in entry[:-2])  # only by the head (the step to the ring)
+    ends = [g.index[(q.name, max(c for ln, c in g.labels if ln == q.name))] for q in lay.inner_queues]
+    assert all(g.dist[ends[0], e] < 1e-9 for e in ends)  # one shared inner exit point
     # robots of different inner queues share ring cells: the overlap is not a conflict
     ring = [lab for lab in g.labels if lab[0] == "inner_queue_0"][1:4]
     assert all(g.conf[g.index[lab], g.index[lab]] for lab in ring)
@@ -613,42 +613,29 @@ def drive(adm: DepotAdmission, name: str, t: float, target: tuple[str, int] | No
     raise AssertionError("did not stop")
 
 
-def test_waiting_robot_claims_its_cells_against_later_upstream_robots():
-    """FCFS across steps: a robot waiting for the exit corridor (its cells held by a robot
-    crossing it) keeps a later spiral robot from taking the next free crossing."""
+def test_first_to_finish_unloading_merges_first():
+    """Where the inner queues' last legs merge (sec. IV-D): the robot that finished unloading
+    first is granted through the inner exit point, and one that finishes while it is on its
+    way waits at its dock until the merge is clear."""
     lay, g = layout("single", "default"), geo("single", "default")
-    adm = DepotAdmission(lay)
-    entry = [lab for lab in g.labels if lab[0] == "entry_line"]
-    kc = [bool(g.keep_clear[g.index[lab]]) for lab in entry]
-    runs = [i for i in range(1, len(kc)) if kc[i] and not kc[i - 1]]  # spiral crossings
-    assert len(runs) >= 3
-    # E goes to its dock and unloads
-    assert adm.join("E", "entry_line", len(entry) - 1, 0.0) is Refusal.NONE
-    dock = drive(adm, "E", 0.5)
-    assert dock in g.dock
-    adm.unloaded("E", 1.0)
-    # S is granted across the second crossing
-    assert adm.join("S", "entry_line", runs[1] - 1, 2.0) is Refusal.NONE
+    adm = DepotAdmission(lay, inner_rule="own")
+    e_end = len([lab for lab in g.labels if lab[0] == "entry_line"]) - 1
+    assert adm.join("A", "entry_line", e_end, 0.0) is Refusal.NONE
+    dock_a = drive(adm, "A", 0.5)
+    assert adm.join("B", "entry_line", e_end, 1.0) is Refusal.NONE
+    dock_b = drive(adm, "B", 1.5)
+    assert dock_a in g.dock and dock_b in g.dock and dock_a[0] != dock_b[0]
+    adm.unloaded("B", 2.0)  # B finished first
     adm.step(2.0)
-    assert adm.grant("S")[1] > runs[1]
-    # E drives to the end of the ring and waits there: the exit corridor crosses S's cells
-    ring_end = (dock[0], len(adm.cells(dock[0])) - 2)
-    assert drive(adm, "E", 3.0, ring_end) == ring_end and adm.grant("E") == ring_end
-    # S2 arrives later before the first crossing: free, but E waited first and claims it
-    assert adm.join("S2", "entry_line", runs[0] - 1, 4.0) is Refusal.NONE
-    adm.step(4.0)
-    assert adm.grant("S2") == ("entry_line", runs[0] - 1)
-    owned = [((ln, c), r) for ln, c, r in adm.snapshot().occupied if r != "S2"]
-    assert not any(adm.conflict(("entry_line", runs[0]), lab) for lab, _ in owned)
-    # S clears its crossing: E gets the whole corridor at once, S2 still waits
-    route = adm.route("S")
-    for lab in route[route.index(adm.position("S")) + 1 : route.index(adm.grant("S")) + 1]:
-        adm.arrived("S", *lab, 5.0)
+    adm.unloaded("A", 3.0)
+    adm.step(3.0)
+    route_b = adm.route("B")
+    assert route_b.index(adm.grant("B")) > route_b.index(dock_b)  # B moves on
+    assert adm.grant("A") == dock_a  # A waits: the way to the merge is B's
+    assert drive(adm, "B", 4.0) is None  # B has left
     adm.step(5.0)
-    assert adm.grant("E") == ("exit_line", len(adm.cells("exit_line")) - 1)
-    assert adm.grant("S2") == ("entry_line", runs[0] - 1)
-    assert drive(adm, "E", 6.0) is None  # E has left
-    assert adm.grant("S2")[1] > runs[0]
+    route_a = adm.route("A")
+    assert route_a.index(adm.grant("A")) > route_a.index(dock_a)
 
 
 # ------------------------------------------------------------------ simulation properties
@@ -695,14 +682,13 @@ def test_everyone_at_once_from_one_direction_default_layout(kind):
     assert all(b.left >= 0 for b in run.bots)
     if kind == "single":
         assert run.max_inner == 2  # the inner queues were used to the limit
-        assert run.contests > 0  # the FCFS check was exercised
 
 
 @pytest.mark.parametrize("inner_rule", ["any", "own"])
 def test_heavy_single_queue_six_docks(inner_rule):
     arrivals = [(i // 2, 0, i % 3 == 0) for i in range(14)]
     run = simulate("single", "six_docks", arrivals, seed=11, inner_rule=inner_rule)
-    assert run.max_inner == 2 and run.contests > 0
+    assert run.max_inner == 2
 
 
 # ------------------------------------------------------------------ server

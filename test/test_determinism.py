@@ -12,7 +12,7 @@ from swarm_sim.scenario import load_scenario
 
 ROBOTS, DURATION, SEED = 8, 30.0, 11
 
-COMPARED = ("resources_delivered", "collision_time_s_by_robot", "oae_by_robot", "trips_by_robot",
+COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot", "trips_by_robot",
             "clamped_commands", "stale_ticks")
 
 

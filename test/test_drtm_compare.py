@@ -12,9 +12,9 @@ from swarm_sim.compare.drtm_paper import (
     condition_overrides,
     drtm_headlines,
     drtm_plans,
-    mean_series,
     write_drtm_report,
 )
+from swarm_sim.compare.stats import mean_series
 from swarm_sim.scenario import load_scenario, scenario_to_dict
 
 

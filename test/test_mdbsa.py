@@ -24,7 +24,7 @@ from swarm_controllers.center import (
 )
 from swarm_controllers.center_protocol import CENTER, ProgressReport, RegionAssignment
 from swarm_controllers.config import SpiralConfig
-from swarm_controllers.mdbsa import ASK_MARGIN, ASK_RETRY, IDLE_RETRY, MdbsaBehaviour, MdbsaState
+from swarm_controllers.mdbsa import ASK_MARGIN, ASK_RETRY, MdbsaBehaviour, MdbsaState
 from swarm_controllers.spiral import (
     mdbsa_path,
     region_centers,
@@ -224,8 +224,8 @@ def test_server_answers_a_robot_once_per_tick_and_is_deterministic():
 # ---------------------------------------------------------------- the behaviour, alone
 
 
-def obs(robot, k, x, y, yaw=0.0, messages=(), carrying=False, resources=()):
-    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, CLEAR, ForagingSense(resources, carrying),
+def obs(robot, k, x, y, yaw=0.0, messages=(), carrying=False, resources=(), ranges=CLEAR):
+    return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, ranges, ForagingSense(resources, carrying),
                        tuple(messages))
 
 
@@ -235,8 +235,8 @@ class Unicycle:
     def __init__(self, b, x, y, yaw=0.0):
         self.b, self.x, self.y, self.yaw, self.k = b, x, y, yaw, 0
 
-    def step(self, messages=()):
-        c = self.b.step(obs(self.b.robot, self.k, self.x, self.y, self.yaw, messages))
+    def step(self, messages=(), ranges=CLEAR):
+        c = self.b.step(obs(self.b.robot, self.k, self.x, self.y, self.yaw, messages, ranges=ranges))
         self.yaw = math.remainder(self.yaw + c.angular * DT, 2 * math.pi)
         self.x += c.linear * math.cos(self.yaw) * DT
         self.y += c.linear * math.sin(self.yaw) * DT
@@ -269,18 +269,38 @@ def test_drives_into_range_before_asking():
     assert math.hypot(m.x, m.y) > SpiralConfig.of(C).center_range - ASK_MARGIN - 0.05
 
 
-def test_idle_robots_wait_and_ask_again_every_idle_retry():
+def test_idle_robots_stop_at_a_region_center_for_good_and_keep_avoiding_in_place():
+    """The authors' idle robot drives to its (last) region's center, stops within
+    RegionRadius and never asks again; it keeps avoiding every tick (issue 11)."""
     b = MdbsaBehaviour(C, "robot_2", None)
-    b.step(obs("robot_2", 0, 0.4, 0.0))
+    u = Unicycle(b, 0.4, 0.0, 0.0)
+    u.step()
     mine = RegionAssignment(DT_NS, "robot_2", -1, 0, 0.0, 0.0, False)
     other = RegionAssignment(DT_NS, "robot_3", 5, FORWARD, 0.0, 20.0, False)
-    c = b.step(obs("robot_2", 2, 0.4, 0.0, messages=[other, mine]))
+    c = u.step(messages=[other, mine])
     assert b.state is MdbsaState.IDLE and b.region == -1 and c.messages == ()
-    wait = round(IDLE_RETRY / DT)
-    assert all(b.step(obs("robot_2", 2 + k, 0.4, 0.0)).messages == () for k in range(1, wait))
-    (m,) = b.step(obs("robot_2", 2 + wait, 0.4, 0.0)).messages
-    assert (m.region, m.done) == (-1, True) and b.state is MdbsaState.WAITING
     assert b.status().extra == (("region", "-1"),)
+    centers = [p.start for p in region_paths(C)]
+    spot = min(centers, key=lambda c: math.hypot(c[0] - 0.4, c[1]))  # never walked: the nearest
+    for _ in range(600):
+        c = u.step()
+        assert c.messages == ()
+    assert b.state is MdbsaState.IDLE
+    assert math.hypot(u.x - spot[0], u.y - spot[1]) <= C.regions.center_radius
+    assert math.hypot(u.x, u.y) > SpiralConfig.of(C).center_range
+    events = b.obstacle_avoidance_events
+    c = u.step(ranges=np.full_like(CLEAR, 0.1))
+    assert c.linear == 0.0 and c.angular != 0.0 and b.obstacle_avoidance_events == events + 1
+    assert (u.step().linear, u.step().angular) == (0.0, 0.0)
+
+
+def test_a_waiting_robot_keeps_avoiding_in_place():
+    b = MdbsaBehaviour(C, "robot_1", None)
+    b.step(obs("robot_1", 0, 0.0, -0.4))
+    assert b.state is MdbsaState.WAITING
+    c = b.step(obs("robot_1", 1, 0.0, -0.4, ranges=np.full_like(CLEAR, 0.1)))
+    assert c.linear == 0.0 and c.angular != 0.0 and b.obstacle_avoidance_events == 1
+    assert b.state is MdbsaState.WAITING
 
 
 def test_a_waiting_robot_takes_only_an_answer_stamped_after_its_ask():
@@ -378,7 +398,11 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
     assert all(r.finished for r in snap) and all(not r.walkers for r in snap)
     assert server.ignored == 0
     assert all(b.state is MdbsaState.IDLE for b in bs.values())
-    assert all(math.hypot(x, y) <= SpiralConfig.of(SMALL).center_range for x, y, _ in pose.values())
+    # Idle for good at the center of the region each walked last (the authors' IDLE).
+    last = {r: region for _, r, state, region, _ in log if state is MdbsaState.SEARCHING}
+    for r, (x, y, _) in pose.items():
+        cx, cy = server.paths[last[r]].start
+        assert math.hypot(x - cx, y - cy) <= SMALL.regions.center_radius
     walks = {(r, region, d) for _, r, state, region, d in log
              if state is MdbsaState.SEARCHING}
     assert {region for _, region, _ in walks} == {0, 1, 2, 3}

@@ -37,7 +37,7 @@ def test_deliveries_happen_at_docks_only(run):
     assert summary["deliveries_outside_docks"] == 0
     assert all(d.zone.startswith("dock_") for d in result.trace.drops)
     for d in summary["dropoff_times_s"]:
-        assert scenario.depot.unload_time <= d < DURATION
+        assert 0.0 <= d < DURATION  # perimeter entry to dock arrival (before T_unload)
 
 
 def test_only_carriers_enter_the_perimeter(run):
@@ -148,3 +148,16 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
     out = server.step(10**9, [DepotReport(0, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])
     assert out == () and server.admission.robots_inside == ()
     assert server.rejections.counts == {("DepotReport", "unknown robot"): 4}
+
+
+def test_dropoff_time_stops_at_the_dock_before_t_unload():
+    from swarm_sim.analysis.metrics import RunTrace, dock_arrival_s, dropoff_times
+    from swarm_sim.types import DropEvent
+
+    s = load_scenario("queue_qmt")
+    drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)
+    trace = RunTrace("queue_qmt", 0, ("robot_0",), 120.0, 1.0, 320, "batch", drops=[drop], config=s,
+                     perimeter_entries={"robot_0": [10.0, 40.0]})
+    # the foraging task drops on the first tick the carrier has been inside for T_unload
+    assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - s.depot.unload_time)
+    assert dropoff_times(trace) == [pytest.approx(100.0 - s.depot.unload_time - 40.0)]

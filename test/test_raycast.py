@@ -188,6 +188,23 @@ def test_batched_scan_equals_brute_force(seed, n, crowd, rays, fov):
     np.testing.assert_allclose(got, want.astype(np.float32), rtol=1e-6, atol=1e-6)
 
 
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 60), crowd=st.booleans(),
+       range_max=st.sampled_from([0.3, 1.0, 3.5]))
+def test_kd_tree_pairs_give_the_all_pairs_scan_bit_for_bit(seed, n, crowd, range_max):
+    """Large swarms find robot pairs with a k-d tree, small ones test all pairs: same ranges."""
+    import swarm_sim.world.raycast as raycast
+
+    rng = np.random.default_rng(seed)
+    origins, headings, scene = random_scene(rng, n, crowd)
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(raycast, "KD_TREE_FROM", 10**9)
+        all_pairs = cast_scan(origins, headings, R, scene, 24, FULL, range_max)
+        m.setattr(raycast, "KD_TREE_FROM", 2)
+        tree = cast_scan(origins, headings, R, scene, 24, FULL, range_max)
+    assert all_pairs.tobytes() == tree.tobytes()
+
+
 # --------------------------------------------------------------------------- pybullet
 
 

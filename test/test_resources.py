@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
 from swarm_sim.sites import drop_zones
-from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes
+from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes, powerlaw_tiers
 
 ARENA = ArenaConfig(size=12.0)
 DEPOT = DepotConfig(center=(0.0, 0.0), radius=0.5)
@@ -83,6 +83,56 @@ def test_powerlaw_piles():
         assert np.ptp(pile[:, 0]) == pytest.approx(0.3) and np.ptp(pile[:, 1]) == pytest.approx(0.3)
 
 
+def test_powerlaw_tiers_split_the_count_as_the_authors_loop_functions():
+    """DSA_loop_functions::PowerLawFoodDistribution (MARSLab-UTRGV DDSA/MDBSA, luki-dev)."""
+    def shares(n):
+        return [sum(t) for t in powerlaw_tiers(n)]
+    assert shares(160) == [40] * 4 and shares(200) == [50] * 4 and shares(100) == [25] * 4
+    assert shares(150) == [36, 38, 38, 38] and shares(250) == [61, 63, 63, 63]
+    assert shares(300) == [60] * 5  # 4^3 (1 + 3) = 256 < 300: a fifth tier, 16 x 16 piles first
+    assert powerlaw_tiers(256) == [[64], [16] * 4, [4] * 16, [1] * 64]  # = Hecker & Moses, 4 levels
+    assert powerlaw_tiers(160) == [[40], [16, 16, 8], [4] * 10, [1] * 40]
+    assert powerlaw_tiers(1) == [[], [1]] and powerlaw_tiers(0) == []
+
+
+@given(st.integers(1, 1300))
+def test_powerlaw_tiers_hold_exactly_the_count_in_piles_that_fit(count):
+    tiers = powerlaw_tiers(count)
+    assert sum(map(sum, tiers)) == count
+    for h, tier in enumerate(tiers):
+        side = 2 ** (len(tiers) - 1 - h)
+        assert len(tier) <= 4**h and all(0 < n <= side * side for n in tier)
+
+
+def test_powerlaw_tiers_layout_fills_piles_row_by_row_at_the_pitch():
+    cfg = ResourceConfig(distribution="powerlaw_tiers", count=160, spacing=0.15, min_depot_clearance=0.05)
+    depot = DepotConfig(center=(0.0, 0.0), radius=0.18)
+    xy = place_resources(cfg, ArenaConfig(size=8.0), depot, rng(2), drop_zones_of(depot))
+    assert xy.shape == (160, 2)
+    big = xy[:40]  # the 8 x 8 pile cut to 40: five full rows of eight
+    assert np.ptp(big[:, 0]) == pytest.approx(7 * 0.15) and np.ptp(big[:, 1]) == pytest.approx(4 * 0.15)
+    third = xy[72:80]  # the third 4 x 4 pile cut to 8: two rows of four
+    assert np.ptp(third[:, 0]) == pytest.approx(3 * 0.15) and np.ptp(third[:, 1]) == pytest.approx(0.15)
+    d = np.hypot(*xy.T)
+    assert d.min() >= 0.18 + 0.05 - 1e-9  # min_depot_clearance decides, not the zone's spacing
+    gaps = np.hypot(*(xy[:, None] - xy[None]).transpose(2, 0, 1)) + np.eye(len(xy))
+    assert gaps.min() >= 0.15 - 1e-9
+
+
+def test_the_depot_drop_zone_keeps_only_min_depot_clearance():
+    """The depot's own zone is not widened by `spacing` on top of its clearance (the authors
+    keep food NestRadius + FoodRadius from the nest centre: 0.05 m clear of it)."""
+    cfg = ResourceConfig(distribution="uniform", count=2000, spacing=0.15, min_depot_clearance=0.05)
+    depot = DepotConfig(center=(0.0, 0.0), radius=0.18)
+    d = np.hypot(*place_resources(cfg, ArenaConfig(size=8.0), depot, rng(0), drop_zones_of(depot)).T)
+    assert 0.23 - 1e-9 <= d.min() < 0.18 + 0.15
+
+
+def drop_zones_of(depot: DepotConfig):
+    from swarm_sim.scenario import DropZoneConfig
+    return (DropZoneConfig("depot", depot.center, depot.radius, 0.0, "depot"),)
+
+
 def test_powerlaw_needs_enough_resources():
     cfg = ResourceConfig(distribution="powerlaw", count=100, powerlaw_levels=4)
     with pytest.raises(ScenarioError, match="resources.count"):
@@ -117,7 +167,7 @@ def test_place_one_is_valid_and_keeps_away_from_ground_resources():
 @settings(max_examples=40, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),
-    distribution=st.sampled_from(["clustered", "uniform", "powerlaw"]),
+    distribution=st.sampled_from(["clustered", "uniform", "powerlaw", "powerlaw_tiers"]),
     clusters=st.integers(1, 6),
     side=st.integers(1, 6),
     depot_x=st.floats(-3.0, 3.0),
@@ -143,13 +193,19 @@ def test_every_layout_is_valid(seed, distribution, clusters, side, depot_x, clea
         np.testing.assert_allclose(d.min(axis=1), cfg.spacing, atol=1e-9)
 
 
-@pytest.mark.parametrize("seed", range(12))
-def test_resources_keep_out_of_every_drop_zone(seed):
-    """A resource inside a drop zone would be delivered the moment it is picked up (MDBSA-D's
-    region centres lie in the search area)."""
+@pytest.mark.parametrize("seed", range(6))
+def test_the_spiral_algorithms_share_one_layout_per_seed_and_docks_stay_clear(seed):
+    """The authors keep food off the nest only, so DDSA, MDBSA-C and MDBSA-D (whose region
+    centres are drop zones) get the same resources for a seed, 64 regions included; a queue
+    dock is still kept one spacing clear (a resource in it would be delivered at pick-up)."""
     from swarm_sim.scenario import load_scenario
 
-    s = load_scenario("mdbsa_d", seed=seed)
+    layouts = []
+    for name in ("ddsa", "mdbsa_c", "mdbsa_d"):
+        s = load_scenario(name, ["regions.count=64"], seed=seed)
+        layouts.append(place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), drop_zones(s)))
+    assert np.array_equal(layouts[0], layouts[1]) and np.array_equal(layouts[0], layouts[2])
+    s = load_scenario("queue_qse", seed=seed)
     zones = drop_zones(s)
     xy = place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), zones)
     for z in zones:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from swarm_sim.scenario import (
@@ -134,3 +135,19 @@ def test_swarm_run_never_overwrites_a_recording(tmp_path):
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 2 and "already exists" in out.stderr and out.stdout == ""
     assert (tmp_path / "old" / "metadata.yaml").read_text() == "x"
+
+
+def test_groups_start_layout_is_the_authors_distribute_blocks():
+    from swarm_sim.world.start import start_positions
+
+    s = load_scenario("queue_qmt", ["robots.count=50"])
+    xy = start_positions(s, np.random.default_rng(0))
+    assert xy.shape == (50, 2)
+    for g, (gx, gy) in enumerate(s.robots.start_groups):
+        share = xy[(13 * g if g < 2 else 26 + 12 * (g - 2)):][: 13 if g < 2 else 12]
+        assert np.allclose(share.mean(axis=0)[0], gx, atol=0.3)  # 6 columns around the point
+        assert np.all(np.abs(share[:, 0] - gx) <= 0.75 + 1e-9)
+    d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+    assert d[np.triu_indices(50, 1)].min() >= s.robots.start_spacing - 1e-9
+    with pytest.raises(ScenarioError, match="robots.start_groups"):
+        load_scenario("queue_qmt", ["robots.start_groups=[[5.8, 0.0]]"])

@@ -7,13 +7,14 @@ trace, so a metric is defined once and means the same thing for both kinds of ru
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from swarm_sim.scenario import Scenario
-from swarm_sim.sites import scenario_docks
+from swarm_sim.sites import drop_zones, scenario_docks
 from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 
@@ -102,6 +103,13 @@ def delivered_over_time(trace: RunTrace, bin_s: float = 10.0) -> tuple[np.ndarra
 
 
 def collision_time_by_robot(trace: RunTrace) -> dict[RobotId, float]:
+    """The papers' collision time [s]: time each robot's proximity ring saw something ahead,
+    i.e. spent in collision avoidance (`swarm_sim.world.proximity`)."""
+    return {r: trace.stats[r].avoidance_time_s if r in trace.stats else 0.0 for r in trace.robots}
+
+
+def contact_time_by_robot(trace: RunTrace) -> dict[RobotId, float]:
+    """Time each robot's body touched another robot's [s] (pybullet contacts)."""
     return {r: trace.stats[r].collision_time_s if r in trace.stats else 0.0 for r in trace.robots}
 
 
@@ -120,15 +128,30 @@ def trips_by_robot(trace: RunTrace) -> dict[RobotId, int]:
     return trips
 
 
+def dock_arrival_s(trace: RunTrace, drop: DropEvent) -> float:
+    """When the carrier reached the zone it dropped in [s]: the drop's time less the zone's
+    dwell (T_unload at a dock) rounded up to whole ticks, as the foraging task drops on the
+    first tick the carrier has been inside for the dwell (`swarm_sim.world.tasks.foraging`)."""
+    t = drop.stamp_ns / NS_PER_S
+    if trace.config is None:
+        return t
+    dwell = {z.name: z.dwell for z in drop_zones(trace.config)}.get(drop.zone, 0.0)
+    dt = trace.config.sim.dt
+    return t - math.ceil(dwell / dt - 1e-9) * dt if dwell > 0 else t
+
+
 def dropoff_times(trace: RunTrace) -> list[float]:
-    """Per delivery, the time from the carrier's last entry into the perimeter to the drop [s]
-    (queue paper sec. VII, metric 3); deliveries without a recorded entry are skipped."""
+    """Per delivery, the time from the carrier's last entry into the perimeter to its arrival at
+    the dock, before T_unload (queue paper sec. VII, metric 3: "entering the red circular region"
+    to "dropping off a resource at a designated dock"; the authors' controllers stop this clock
+    on reaching the nest, before their ``Wait(5)``: ``CPFA_controller::FollowingEntryPath`` in
+    Tameem786/Collision_Free_CPFA); deliveries without a recorded entry are skipped [s]."""
     out = []
     for d in trace.drops:
         t = d.stamp_ns / NS_PER_S
         entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
         if entered:
-            out.append(t - entered[-1])
+            out.append(dock_arrival_s(trace, d) - entered[-1])
     return out
 
 
@@ -174,6 +197,7 @@ def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
 def summarize(trace: RunTrace) -> dict[str, Any]:
     """The JSON result of one run (schema documented in the README; fields are only ever added)."""
     collision = collision_time_by_robot(trace)
+    contact = contact_time_by_robot(trace)
     oae = oae_by_robot(trace)
     trips = trips_by_robot(trace)
     return {
@@ -187,9 +211,12 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "total_resources": trace.total_resources,
         "resources_delivered": resources_delivered(trace),
         "collision_time_per_robot_s": round(_mean(collision), 6),
+        "collision_time_total_min": round(sum(collision.values()) / 60.0, 6),
+        "contact_time_per_robot_s": round(_mean(contact), 6),
         "oae_per_robot": round(_mean(oae), 6),
         "trips_per_robot": round(_mean(trips), 6),
         "collision_time_s_by_robot": {r: round(v, 6) for r, v in collision.items()},
+        "contact_time_s_by_robot": {r: round(v, 6) for r, v in contact.items()},
         "oae_by_robot": oae,
         "trips_by_robot": trips,
         "stale_ticks": sum(s.stale_ticks for s in trace.stats.values()),

@@ -22,7 +22,7 @@ import numpy as np
 
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table
-from swarm_sim.compare.stats import describe, pair_test, stars, values_of
+from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
@@ -193,17 +193,6 @@ def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:
     lines += md_table(["Sec.", "compare", "DRTM ours", "ARTM ours", "d.o.f.", "t ours", "p ours", "significant",
                        "t paper", "p paper"], body) + [""]
     return "\n".join(lines)
-
-
-def mean_series(rows: Sequence[dict], strategy: str, cell: int, key: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(t [s], mean, std) of a time series field over the runs, on the times every run has."""
-    series = [r[key] for r in rows if r.get("strategy") == strategy and r.get("cell") == cell and r.get(key)]
-    if not series:
-        return np.zeros(0), np.zeros(0), np.zeros(0)
-    n = min(len(s) for s in series)
-    values = np.array([[v for _, v in s[:n]] for s in series], dtype=float)
-    times = np.array([t for t, _ in series[0][:n]], dtype=float)
-    return times, values.mean(axis=0), values.std(axis=0, ddof=1) if len(series) > 1 else np.zeros(n)
 
 
 def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: Sequence[str], key: str,

@@ -43,11 +43,38 @@ PAPER_QUEUE_QUOTES = (
     "drop-off time across all experiments (see Fig. 10).",
 )
 
+AUTHORS_LOG_COLLISION_MIN: dict[str, dict[int, float]] = {
+    "queue_qse": {48: 0.768, 64: 1.417, 80: 1.903, 96: 2.221, 112: 2.072},
+    "queue_qst": {48: 0.301, 64: 0.380, 80: 0.441, 96: 0.530, 112: 0.565},
+}
+"""THE AUTHORS' run logs, not ours: their printed "Collision Time" (minutes, all robots) divided
+by the swarm size, mean over 20 runs of 18 min (``results_18_mins_<N>_robots.txt`` of
+Tameem786/Collision_Free_CPFA: branch main = the single queue with entry-point joining, whose
+collection matches Table II's Q_SE; branch CPFA-2.0 = tail joining, matching Q_ST).
+``CPFA_loop_functions::PostExperiment`` divides the tick count by 2 x ticks per second, so
+these are half the time their ring saw something ahead."""
+
+COLLISION_MIN = "collision_time_per_robot_min"
+"""Derived from ``collision_time_per_robot_s``: the paper plots collision time in minutes."""
+
 QUEUE_METRICS: dict[str, str] = {
     "resources_collected_pct": "resources collected [%]",
-    "collision_time_per_robot_s": "collision time per robot [s]",
+    COLLISION_MIN: "collision time per robot [min]",
     "dropoff_time_mean_s": "drop-off time (per-run mean over deliveries) [s]",
 }
+
+PAPER_ORDER: tuple[str, ...] = QUEUE_STRATEGIES
+"""Table II's order at every size, least to most collected: CPFA < Q_SE < Q_ST < Q_ME < Q_MT."""
+ALPHA = 0.05
+
+
+def with_minutes(rows: Sequence[dict]) -> list[dict]:
+    """Rows with the collision time per robot in minutes added (`COLLISION_MIN`)."""
+    out = []
+    for r in rows:
+        v = r.get("collision_time_per_robot_s")
+        out.append({**r, COLLISION_MIN: v / 60.0} if v is not None else r)
+    return out
 
 
 def queue_plans(
@@ -67,6 +94,7 @@ def queue_plans(
 
 def queue_table_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> str:
     """table.md: Table II layout (ours next to the paper's), then collision and drop-off times."""
+    rows = with_minutes(rows)
     lines = ["# Queue paper comparison (Zaman et al.): tables", ""]
     n_runs = sorted({describe(values_of(rows, s, c, "resources_collected_pct")).n for s in strategies for c in sizes})
     lines += [f"Runs per cell: {', '.join(map(str, n_runs))} (the paper: 50). Cells: mean ± sample std (n).", ""]
@@ -87,14 +115,23 @@ def queue_table_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Seque
                       [[label(s, QUEUE_LABELS)] + [fmt(PAPER_TABLE_II[s][c]) for c in QUEUE_SIZES]
                        for s in QUEUE_STRATEGIES]) + [""]
     lines += ["The paper's text (quoted):", ""] + [f"> {q}" for q in PAPER_QUEUE_QUOTES] + [""]
-    for metric, title in (("collision_time_per_robot_s", "Collision time per robot [s] (Fig. 9)"),
-                          ("dropoff_time_mean_s", "Resource drop-off time [s] (Fig. 10)")):
-        lines += [f"## {title}", ""]
-        if metric == "dropoff_time_mean_s":
-            lines += ["Per run: the mean over its deliveries of the time from entering the perimeter "
-                      "to the drop; runs without a delivery are left out of n.", ""]
-        else:
-            lines += ["The paper plots this in minutes without a table; ours in seconds.", ""]
+    lines += ["## Collision time per robot [min] (Fig. 9)", "",
+              "Time each robot's proximity ring saw something ahead (what the authors' controllers "
+              "count as collision; `swarm_sim/world/proximity.py`), in minutes as the paper plots it. "
+              "`log` = **the authors' own run logs** (their printed total / robots; their print is half "
+              "the time, see `AUTHORS_LOG_COLLISION_MIN`), where published.", ""]
+    header = ["Algorithm"] + [f"{c} {w}" for c in sizes for w in ("ours", "log")]
+    lines += md_table(header, [[label(s, QUEUE_LABELS)] + [
+        x for c in sizes for x in (cell_text(describe(values_of(rows, s, c, COLLISION_MIN))),
+                                   fmt(AUTHORS_LOG_COLLISION_MIN.get(s, {}).get(c), 3))]
+        for s in strategies]) + [""]
+    for metric, title, note in (
+            ("contact_time_per_robot_s", "Contact time per robot [s]",
+             "Time bodies touched (pybullet contacts); not a metric of the paper."),
+            ("dropoff_time_mean_s", "Resource drop-off time [s] (Fig. 10)",
+             "Per run: the mean over its deliveries of the time from entering the perimeter to "
+             "reaching the dock (before T_unload); runs without a delivery are left out of n.")):
+        lines += [f"## {title}", "", note, ""]
         lines += md_table(["Algorithm"] + [str(c) for c in sizes],
                           [[label(s, QUEUE_LABELS)] + [cell_text(describe(values_of(rows, s, c, metric)))
                                                        for c in sizes] for s in strategies]) + [""]
@@ -106,6 +143,7 @@ def queue_ttests_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
     the ordering of the strategies by mean collection against the paper's."""
     from scipy.stats import kendalltau
 
+    rows = with_minutes(rows)
     lines = ["# Queue paper comparison: independent two-sample t-tests", "",
              "scipy.stats.ttest_ind (default: equal variances, two-sided), as the paper. "
              "Stars: *** p<0.001, ** p<0.01, * p<0.05, ns otherwise; n/a: fewer than two runs "
@@ -137,19 +175,67 @@ def queue_ttests_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
                      " < ".join(label(s, QUEUE_LABELS) for s in paper) or "— (size not in the paper)",
                      same, fmt(tau)])
     lines += md_table(["robots", "ours", "paper", "same order", "Kendall tau"], body) + [""]
+    lines += ["## Table II's ordering, pair by pair", "",
+              f"The paper ranks {' < '.join(label(s, QUEUE_LABELS) for s in PAPER_ORDER)} at every size. "
+              f"A pair holds at a size when our means are in the paper's order and the t-test gives "
+              f"p < {ALPHA}; `reversed` when ours are the other way round with p < {ALPHA}; `ns` "
+              "otherwise. Q_ST = 2 Q_SE: the ratio of our means, and the t-test of Q_ST's runs "
+              f"against twice Q_SE's (holds when p >= {ALPHA}: not distinguishable from twice).", ""]
+    checks = ordering_checks(rows, sizes, strategies)
+    lines += md_table(["pair (paper: A < B)"] + [str(c) for c in sizes],
+                      [[name] + [text for _, text, _ in cells] for name, cells in checks]) + [""]
     return "\n".join(lines)
+
+
+def ordering_checks(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]
+                    ) -> list[tuple[str, list[tuple[int, str, bool | None]]]]:
+    """For every pair of Table II's order (and Q_ST = 2 Q_SE): per size (size, text, holds)."""
+    from swarm_sim.compare.stats import pair_test
+
+    pct = "resources_collected_pct"
+    out = []
+    order = [s for s in PAPER_ORDER if s in strategies]
+    for a, b in all_pairs(order):
+        cells = []
+        for c in sizes:
+            va, vb = values_of(rows, a, c, pct), values_of(rows, b, c, pct)
+            _, p = pair_test(va, vb, "t")
+            ma, mb = describe(va).mean, describe(vb).mean
+            if not math.isfinite(p):
+                order = 'in order' if mb > ma else 'tied' if mb == ma else 'reversed'
+                means = f": means {order}" if va and vb else ""
+                cells.append((c, f"n/a{means}", None))
+                continue
+            holds = mb > ma and p < ALPHA
+            text = "holds" if holds else "reversed" if ma > mb and p < ALPHA else "ns"
+            cells.append((c, f"{text} (p={fmt_p(p)})", holds))
+        out.append((f"{label(a, QUEUE_LABELS)} < {label(b, QUEUE_LABELS)}", cells))
+    if "queue_qse" in strategies and "queue_qst" in strategies:
+        cells = []
+        for c in sizes:
+            va, vb = values_of(rows, "queue_qse", c, pct), values_of(rows, "queue_qst", c, pct)
+            _, p = pair_test(vb, [2.0 * v for v in va], "t")
+            ma, mb = describe(va).mean, describe(vb).mean
+            if not (math.isfinite(p) and ma > 0):
+                cells.append((c, "n/a", None))
+                continue
+            holds = p >= ALPHA
+            cells.append((c, f"{'holds' if holds else 'no'}: x{fmt(mb / ma, 2)} (p={fmt_p(p)})", holds))
+        out.append(("Q_ST = 2 Q_SE (Table II: x1.9-2.4)", cells))
+    return out
 
 
 def write_queue_report(rows: Sequence[dict], out: Path, sizes: Sequence[int] | None = None,
                        strategies: Sequence[str] = QUEUE_STRATEGIES) -> list[Path]:
     """table.md, ttests.md and the Fig. 8-10 box plots from result rows."""
     sizes = list(sizes or cells_of(rows))
+    rows = with_minutes(rows)  # the box plots' too
     out.mkdir(parents=True, exist_ok=True)
     written = [out / "table.md", out / "ttests.md"]
     written[0].write_text(queue_table_md(rows, sizes, strategies))
     written[1].write_text(queue_ttests_md(rows, sizes, strategies))
     for name, metric, fig in (("collected.png", "resources_collected_pct", "Fig. 8"),
-                              ("collision_time.png", "collision_time_per_robot_s", "Fig. 9"),
+                              ("collision_time.png", COLLISION_MIN, "Fig. 9"),
                               ("dropoff_time.png", "dropoff_time_mean_s", "Fig. 10")):
         written.append(boxplot_figure([(metric, QUEUE_METRICS[metric])], rows, sizes, strategies,
                                       QUEUE_LABELS, "number of robots",
@@ -189,8 +275,9 @@ def _trend(rows: Sequence[dict], who: str, sizes: Sequence[int], metric: str, ri
 
 def queue_headlines(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> list[Headline]:
     """The queue paper's headline claims (sec. VII and Table II) checked on the means per size."""
+    rows = with_minutes(rows)
     out = []
-    pct, col, drop = "resources_collected_pct", "collision_time_per_robot_s", "dropoff_time_mean_s"
+    pct, col, drop = "resources_collected_pct", COLLISION_MIN, "dropoff_time_mean_s"
     ours, holds = _extreme(rows, strategies, sizes, pct, "queue_qmt", highest=True)
     out.append(Headline("Q_MT collects the most resources of all strategies", "Table II: every size", ours, holds))
     queue_order = [s for s in ("queue_qse", "queue_qst", "queue_qme", "queue_qmt") if s in strategies]
@@ -220,12 +307,18 @@ def queue_headlines(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
         growth = {s: g for s, g in growth.items() if math.isfinite(g)}
         fastest = max(growth, key=growth.get) if growth else None
         out.append(Headline("Q_SE's collision time grows fastest with swarm size", "Fig. 9",
-                            f"fastest: {label(fastest, QUEUE_LABELS)} (+{fmt(growth[fastest], 1)} s)" if fastest else "—",
+                            f"fastest: {label(fastest, QUEUE_LABELS)} (+{fmt(growth[fastest], 2)} min)" if fastest else "—",
                             fastest == "queue_qse" if fastest else None))
     ours, holds = _extreme(rows, strategies, sizes, drop, "queue_qse", highest=True)
     out.append(Headline("Q_SE has the highest drop-off time (above CPFA's)", "Fig. 10", ours, holds))
     ours, holds = _extreme(rows, strategies, sizes, drop, "queue_qmt", highest=False)
     out.append(Headline("Q_MT has the lowest drop-off time", "Fig. 10: all experiments", ours, holds))
+    for name, cells in ordering_checks(rows, sizes, strategies):
+        verdicts = [h for _, _, h in cells]
+        ours = "; ".join(f"{c}: {text}" for c, text, _ in cells) or "—"
+        holds = None if not verdicts or None in verdicts else all(verdicts)
+        paper = "Table II, every size" if "<" in name else "Table II"
+        out.append(Headline(f"collection {name}", paper, ours, holds))
     return out
 
 

@@ -13,7 +13,16 @@ import numpy as np
 
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table
-from swarm_sim.compare.stats import cells_of, describe, pair_test, pairwise_tests, pct_change, stars, values_of
+from swarm_sim.compare.stats import (
+    cells_of,
+    describe,
+    mean_series,
+    pair_test,
+    pairwise_tests,
+    pct_change,
+    stars,
+    values_of,
+)
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 SPIRAL_STRATEGIES: tuple[str, ...] = ("ddsa", "mdbsa_c", "mdbsa_d")
@@ -29,10 +38,16 @@ SPIRAL_METRICS: dict[str, str] = {
     "foraging_rate_per_min": "foraging rate [resources / min, whole swarm]",
 }
 SPIRAL_TABLE_EXTRA: dict[str, str] = {"resources_collected_pct": "resources collected [%]"}
+PER_MINUTE = "resources_per_robot_per_min"
+"""The per-minute series field (`swarm_controllers.spiral_metrics`): Figs. 7 and 9."""
+PER_MINUTE_FIGURES: dict[int, str] = {1: "Fig. 7", 2: "Fig. 9"}
+"""The paper's per-minute figure of each experiment (experiment 3 has none)."""
 
 POWERLAW_LEVELS = 3
 """`powerlaw` layout: piles of 16 (one 4 x 4), 4 (four 2 x 2) and 1 (sixteen), 48 resources in
 piles; the rest of the count is scattered uniformly (see `resource_layout`)."""
+LAYOUTS: tuple[str, ...] = ("tiers", "powerlaw", "clustered")
+"""`resource_layout` names; the first is the default."""
 
 
 @dataclass(frozen=True)
@@ -146,18 +161,24 @@ PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
 """THE PAPER'S reported differences (quoted from mdbsa_spiral_search.md, Sec. VI), not ours."""
 
 
-def resource_layout(count: int, layout: str = "powerlaw") -> tuple[str, ...]:
+def resource_layout(count: int, layout: str = LAYOUTS[0]) -> tuple[str, ...]:
     """``--set`` overrides placing `count` resources in "clusters of different sizes".
 
     The MDBSA paper only says "randomly distributed [...] as clusters of various sizes".
-    `powerlaw` (default): Hecker & Moses piles with `POWERLAW_LEVELS` = 3 (one pile of 16, four of
-    4, sixteen of 1; 48 resources) and the rest scattered uniformly; the same piles for every
-    count, so more resources means a closer-to-random layout, which is how the paper reads its
-    experiment 3 ("the distribution of resources became closer to random"). Level 4 would need
-    256 resources, more than most counts in the paper. `clustered`: equal square clusters with
-    clusters * side^2 == count, the largest side of 5, 4, 3, 2, 1 that divides (5 x 5 for
-    100-300 in steps of 50, ten 4 x 4 for 160): every resource in a cluster, but one size.
+    `tiers` (default): what the authors ran, their ``PowerLawFoodDistribution``
+    (``FoodDistribution = "2"`` in every experiment file of MARSLab-UTRGV/DDSA-Distributed-
+    Deterministic-Spiral-Search-Algorithm and MARSLab-UTRGV/Adaptive-Multiple-Distributed-
+    Spiral-Search-Algorithm, branch luki-dev): `swarm_sim.world.resources.powerlaw_tiers`,
+    e.g. 200 -> 50 each in an 8 x 8 pile, 4 x 4 piles, 2 x 2 piles and singles; 300 takes a
+    fifth tier (16 x 16 down to singles, 60 each). The scenario's pitch and nest clearance
+    apply. The earlier alternatives, kept by name: `powerlaw`, Hecker & Moses piles with
+    `POWERLAW_LEVELS` = 3 (one pile of 16, four of 4, sixteen of 1; 48 resources) and the rest
+    scattered uniformly; `clustered`, equal square clusters with clusters * side^2 == count,
+    the largest side of 5, 4, 3, 2, 1 that divides (5 x 5 for 100-300 in steps of 50, ten
+    4 x 4 for 160).
     """
+    if layout == "tiers":
+        return ("resources.distribution=powerlaw_tiers", f"resources.count={count}")
     if layout == "powerlaw":
         return ("resources.distribution=powerlaw", f"resources.powerlaw_levels={POWERLAW_LEVELS}",
                 f"resources.count={count}")
@@ -165,7 +186,7 @@ def resource_layout(count: int, layout: str = "powerlaw") -> tuple[str, ...]:
         side = next(s for s in (5, 4, 3, 2, 1) if count % (s * s) == 0)
         return ("resources.distribution=clustered", f"resources.clusters={count // (side * side)}",
                 f"resources.cluster_side={side}", f"resources.count={count}")
-    raise ValueError(f"unknown resource layout {layout!r} (powerlaw or clustered)")
+    raise ValueError(f"unknown resource layout {layout!r} ({', '.join(LAYOUTS)})")
 
 
 def spiral_plans(
@@ -173,7 +194,7 @@ def spiral_plans(
     strategies: Sequence[str] = SPIRAL_STRATEGIES,
     *,
     values: Sequence[int] | None = None,
-    layout: str = "powerlaw",
+    layout: str = LAYOUTS[0],
     duration: float | None = None,
     overrides: Sequence[str] = (),
 ) -> list[RunPlan]:
@@ -219,9 +240,62 @@ def spiral_tables_md(rows: Sequence[dict], experiment: int, cells: Sequence[int]
                                                         for c in cells] for s in strategies]) + [""]
     if experiment == 3:
         lines += [f"> {_EXP3_COLLECTION_QUOTE} (the paper, Fig. 10: compare MDBSA-D's collected %)", ""]
-    lines += ["Figs 7 and 9 of the paper plot per-minute curves; our summaries hold only the whole-run "
-              "rate (deliveries / run minutes), so `foraging_rate.png` shows that scalar.", ""]
+    lines += ["`foraging_rate.png` is the whole-run rate (deliveries / run minutes); the paper's "
+              "per-minute curves (Figs. 7 and 9: resources per robot per minute) are "
+              "`foraging_rate_per_minute.png` and `per_minute.md`.", ""]
     return "\n".join(lines)
+
+
+def spiral_per_minute_md(rows: Sequence[dict], experiment: int, cells: Sequence[int],
+                         strategies: Sequence[str]) -> str:
+    """The data of `foraging_rate_per_minute.png`: resources collected per robot in each minute,
+    mean ± sample std over the seeds, one table per cell."""
+    exp = SPIRAL_EXPERIMENTS[experiment]
+    fig = PER_MINUTE_FIGURES.get(experiment, "no per-minute figure in the paper")
+    lines = [f"# MDBSA paper comparison: foraging rate per robot per minute, experiment {experiment} ({fig})", "",
+             "Resources delivered per robot in each whole minute (the authors' loop functions count "
+             "deliveries per minute and drop a last partial one): mean ± sample std over the seeds.", ""]
+    for cell in cells:
+        lines += [f"## {exp.vary} = {cell}", ""]
+        series = {s: mean_series(rows, s, cell, PER_MINUTE) for s in strategies}
+        minutes = max((len(t) for t, _, _ in series.values()), default=0)
+        body = []
+        for s, (t, mean, std) in series.items():
+            n = sum(1 for r in rows if r.get("strategy") == s and r.get("cell") in (cell, None) and r.get(PER_MINUTE))
+            body.append([f"{label(s, SPIRAL_LABELS)} (n={n})"]
+                        + [f"{fmt(m)} ± {fmt(d)}" for m, d in zip(mean, std)] + [""] * (minutes - len(t)))
+        lines += md_table(["minute"] + [str(k + 1) for k in range(minutes)], body) + [""]
+    return "\n".join(lines)
+
+
+def per_minute_figure(rows: Sequence[dict], experiment: int, cells: Sequence[int], strategies: Sequence[str],
+                      path: Path) -> Path:
+    """One panel per cell: resources per robot per minute, mean over the seeds with a ±1 std
+    band, one colour per algorithm (the paper's Figs. 7 and 9)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    exp = SPIRAL_EXPERIMENTS[experiment]
+    fig, axes = plt.subplots(1, len(cells), figsize=(3.6 * len(cells), 3.4), squeeze=False, sharey=True)
+    for ax, cell in zip(axes[0], cells):
+        for j, s in enumerate(strategies):
+            t, mean, std = mean_series(rows, s, cell, PER_MINUTE)
+            if len(t):
+                ax.plot(t / 60.0, mean, color=f"C{j}", marker="o", markersize=3, label=label(s, SPIRAL_LABELS))
+                ax.fill_between(t / 60.0, mean - std, mean + std, color=f"C{j}", alpha=0.2)
+        ax.set(title=f"{cell} {exp.vary}", xlabel="minute")
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("resources per robot per minute")
+    if axes[0][0].get_legend_handles_labels()[0]:
+        axes[0][0].legend(fontsize="small")
+    fig.suptitle(f"Experiment {experiment}: foraging rate per minute "
+                 f"(cf. MDBSA paper {PER_MINUTE_FIGURES.get(experiment, 'Fig. 10 setting')})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
 
 
 def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence[int],
@@ -268,13 +342,15 @@ def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence
 
 def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells: Sequence[int] | None = None,
                         strategies: Sequence[str] = SPIRAL_STRATEGIES) -> list[Path]:
-    """tables.md, mannwhitney.md and the Fig. 6-10 style box plots from result rows."""
+    """tables.md, mannwhitney.md, per_minute.md, the Fig. 6-10 style box plots and the Figs.
+    7/9 per-minute curves from result rows."""
     exp = SPIRAL_EXPERIMENTS[experiment]
     cells = list(cells or cells_of(rows))
     out.mkdir(parents=True, exist_ok=True)
-    written = [out / "tables.md", out / "mannwhitney.md"]
+    written = [out / "tables.md", out / "mannwhitney.md", out / "per_minute.md"]
     written[0].write_text(spiral_tables_md(rows, experiment, cells, strategies))
     written[1].write_text(spiral_mannwhitney_md(rows, experiment, cells, strategies))
+    written[2].write_text(spiral_per_minute_md(rows, experiment, cells, strategies))
     xlabel = f"number of {exp.vary}"
     panels = [(m, SPIRAL_METRICS[m]) for m in ("resources_per_robot", "collision_time_per_robot_s")]
     fig = {1: "Fig. 6", 2: "Fig. 8", 3: "Fig. 10"}[experiment]
@@ -285,6 +361,7 @@ def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells:
                                   cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment}: whole-run foraging rate",
                                   out / "foraging_rate.png", notch=True))
+    written.append(per_minute_figure(rows, experiment, cells, strategies, out / "foraging_rate_per_minute.png"))
     return written
 
 
@@ -324,8 +401,9 @@ def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--experiment", type=int, choices=sorted(SPIRAL_EXPERIMENTS), required=True)
     parser.add_argument("--values", type=int, nargs="+",
                         help="the swept setting's values (default: the paper's; regions, robots or resources)")
-    parser.add_argument("--layout", choices=("powerlaw", "clustered"), default="powerlaw",
-                        help="resource layout for 'clusters of different sizes' (default powerlaw)")
+    parser.add_argument("--layout", choices=LAYOUTS, default=LAYOUTS[0],
+                        help="resource layout for 'clusters of different sizes' (default: tiers, "
+                             "the authors' power law)")
 
 
 def _plans(args: argparse.Namespace, strategies: list[str]) -> list[RunPlan]:

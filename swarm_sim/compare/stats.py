@@ -35,6 +35,19 @@ def values_of(rows: Iterable[dict], strategy: str, cell: int, metric: str) -> li
     ]
 
 
+def mean_series(rows: Sequence[dict], strategy: str, cell: int, key: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(t [s], mean, std) of a time series field ([[t, value], ...]) over `strategy`'s runs in
+    `cell` (rows with cell None serve every cell), on the times every run has."""
+    series = [r[key] for r in rows
+              if r.get("strategy") == strategy and r.get("cell") in (cell, None) and r.get(key)]
+    if not series:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    n = min(len(s) for s in series)
+    values = np.array([[v for _, v in s[:n]] for s in series], dtype=float)
+    times = np.array([t for t, _ in series[0][:n]], dtype=float)
+    return times, values.mean(axis=0), values.std(axis=0, ddof=1) if len(series) > 1 else np.zeros(n)
+
+
 def cells_of(rows: Iterable[dict]) -> list[int]:
     return sorted({r["cell"] for r in rows if r.get("cell") is not None})
 

@@ -41,7 +41,7 @@ export default function script(event: Input<"/world/robot_stats">): Output {{
       const v = Number(kv.value);
       if (kv.key === "deliveries") out.deliveries += v;
       else if (kv.key === "pickups") out.pickups += v;
-      else if (kv.key === "collision_time_s") out.collision_time_s_mean += v;
+      else if (kv.key === "avoidance_time_s") out.collision_time_s_mean += v;  // the papers' collision time
       else if (kv.key === "stale_ticks") out.stale_ticks += v;
     }}
   }}

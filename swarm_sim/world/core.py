@@ -31,7 +31,8 @@ bit-identical observations.
 
 Order within a tick: commands are applied (missing robot: previous command; NaN/inf -> 0 and
 above-limit -> limit, both counted in ``stats.clamped_commands``), the physics substeps run
-(robot-robot contacts counted each substep), the pose is read, odometry is integrated, then
+(robot-robot contacts counted each substep; before them, the collision time of every robot
+whose last observation's proximity ring saw something ahead), the pose is read, odometry is integrated, then
 the world task does its bookkeeping (`swarm_sim.world.tasks`; foraging: drops and pick-ups,
 robots in index order). Its events are stamped with the new tick's time, which is also the
 stamp of the observations `step` returns.
@@ -53,6 +54,7 @@ import pybullet as p
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.world.start import start_positions
 from swarm_sim.world.tasks import TaskFactory, WorldTask
@@ -208,6 +210,7 @@ class World:
         noise = rc.odometry_noise
         self._noisy = noise.linear_std != 0.0 or noise.angular_std != 0.0
         self._scene = StaticScene.from_scenario(scenario)
+        self._ring = ProximityRing(scenario)
         self._scan_threads = scan_threads
         if task is None:
             from swarm_sim.registry import task_factory
@@ -244,6 +247,8 @@ class World:
         # Robots first, so their body ids are 0..n-1.
         n = self._n
         yaws = rng_start.uniform(-math.pi, math.pi, size=n)
+        if s.robots.start_layout == "groups":
+            yaws[:] = 0.0  # ARGoS <orientation method="constant" values="0.0, 0.0, 0.0"/>
         starts = start_positions(s, rng_start).tolist()
         shape = p.createCollisionShape(
             p.GEOM_CYLINDER, radius=self._radius, height=s.robots.height, physicsClientId=cid
@@ -288,6 +293,9 @@ class World:
         self._v = np.zeros(n)
         self._w = np.zeros(n)
         self._contact_substeps = np.zeros(n, dtype=np.int64)
+        self._avoidance_ticks = np.zeros(n, dtype=np.int64)
+        self._ring_ahead = np.zeros(n, dtype=bool)
+        """Whose proximity ring saw something ahead in the last observations."""
         self.stats: dict[RobotId, RobotStats] = {r: RobotStats() for r in self.robots}
         self.tick = 0
         self._read_state()
@@ -392,6 +400,9 @@ class World:
         if idx:
             self._apply_commands(idx, commands.values())
         self._fresh = False
+        if self._obs_cache is None:
+            self.observe()  # the observations these commands answer (tick 0 without a reset)
+        self._count_avoidance()
         self._obs_cache = None
         pos0, yaw0 = self._pos, self._yaw
         self._physics()
@@ -413,6 +424,15 @@ class World:
                 self.stats[self.robots[i]].clamped_commands += 1
         self._v[idx] = vw[:, 0]
         self._w[idx] = vw[:, 1]
+
+    def _count_avoidance(self) -> None:
+        """One more tick of collision time for every robot that acted on a ring reading ahead
+        (`swarm_sim.world.proximity`)."""
+        if self._ring_ahead.any():
+            self._avoidance_ticks += self._ring_ahead
+            dt = self._dt
+            for i in np.flatnonzero(self._ring_ahead).tolist():
+                self.stats[self.robots[i]].avoidance_time_s = float(self._avoidance_ticks[i]) * dt
 
     def _physics(self) -> None:
         """Run the substeps; count robot-robot contact per substep."""
@@ -491,6 +511,7 @@ class World:
                 self._pos, self._yaw, self._radius, self._scene, sc.rays, sc.fov, sc.range_max, sc.range_min
             )
         ranges.flags.writeable = False
+        self._ring_ahead = self._ring.ahead(ranges)
         rows = list(ranges)
 
         sensed = self.task.sense()

@@ -4,8 +4,8 @@ Every placement draws only from the `numpy.random.Generator` it is given, so the
 the same layout. All positions are [m, world frame]. A position is *valid* when it keeps
 ``resources.margin`` from the walls (``|x|, |y| <= L/2 - margin``) and lies at least
 ``resources.min_depot_clearance`` outside the depot disc, and at least one ``spacing`` outside
-every other drop zone (docks, MDBSA region centres): a resource inside a zone would count as
-delivered the moment it is picked up.
+every other drop zone (docks, extra zones): a resource inside a zone would count as delivered the
+moment it is picked up. MDBSA region centres are the exception, as in the authors' code (`_keep_out`).
 
 Distributions:
 
@@ -17,6 +17,10 @@ Distributions:
   ``j < powerlaw_levels``, with 4^(levels-1-j) piles of each size (so each size holds the same
   number of resources); piles of one resource are scattered uniformly, and so is whatever
   ``count`` holds beyond the piles.
+- ``powerlaw_tiers``: the power law of the DDSA/MDBSA authors' loop functions
+  (`powerlaw_tiers`): as many tiers as ``count`` needs, ``count`` split evenly over them, each
+  tier's piles filled in turn and the last one cut short; every pile, singles included, is
+  placed like a cluster.
 """
 
 from __future__ import annotations
@@ -46,9 +50,25 @@ Disc = tuple[float, float, float]
 
 
 def _keep_out(cfg: ResourceConfig, depot: DepotConfig, zones: Sequence[DropZoneConfig]) -> list[Disc]:
-    """The depot disc widened by min_depot_clearance, and every drop zone widened by spacing."""
-    discs = [(float(depot.center[0]), float(depot.center[1]), depot.radius + cfg.min_depot_clearance)]
-    discs += [(float(z.center[0]), float(z.center[1]), z.radius + cfg.spacing) for z in zones]
+    """The depot disc widened by min_depot_clearance, and every other drop zone widened by
+    spacing, except:
+
+    - the depot's own drop zone keeps min_depot_clearance, as the key says (with a clearance
+      below one spacing the zone's disc would otherwise decide);
+    - MDBSA region centres keep nothing: the authors keep food off the nest only
+      (``DSA_loop_functions::IsOutOfBounds`` checks ``IsCollidingWithNest``, MARSLab-UTRGV/
+      Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev, Distributed/
+      source/DSA/DSA_loop_functions.cpp), so DDSA, MDBSA-C and MDBSA-D get the same layout
+      for a seed, and a resource lying in a region centre is delivered as soon as it is
+      picked up, as their ``IsInTheRegion`` does. (Keeping 64 such discs clear also left no
+      room for the larger piles.)"""
+    disc = (float(depot.center[0]), float(depot.center[1]), depot.radius)
+    discs = [(disc[0], disc[1], depot.radius + cfg.min_depot_clearance)]
+    for z in zones:
+        own = (float(z.center[0]), float(z.center[1]), z.radius)
+        if z.kind == "region_center" or (z.kind == "depot" and own == disc):
+            continue
+        discs.append((own[0], own[1], z.radius + cfg.spacing))
     return discs
 
 
@@ -67,8 +87,15 @@ def _grid(side: int, spacing: float) -> np.ndarray:
     return np.column_stack([gx.ravel(), gy.ravel()])
 
 
+def _grid_rows(side: int, n: int, spacing: float) -> np.ndarray:
+    """(n, 2) the first n points of a side x side grid of pitch `spacing`, row by row from
+    the origin along +x, rows stacked along +y (a power-law pile cut short)."""
+    k = np.arange(n)
+    return np.column_stack([(k % side) * spacing, (k // side) * spacing]).astype(float)
+
+
 def _place_squares(
-    half_spans: list[float],
+    half_spans: Sequence[float] | Sequence[tuple[float, float]],
     cfg: ResourceConfig,
     arena: ArenaConfig,
     depot: DepotConfig,
@@ -76,25 +103,28 @@ def _place_squares(
     key: str,
     zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
-    """Centres (K, 2) for squares of the given half spans: valid and at least one pitch apart.
+    """Centres (K, 2) for squares (half span h) or rectangles (half spans (hx, hy)) [m]:
+    valid, and any two at least one pitch apart along x or y.
 
-    Rejection sampling, largest square first, BATCH candidates at a time; after MAX_ATTEMPTS
+    Rejection sampling, largest first, BATCH candidates at a time; after MAX_ATTEMPTS
     candidates for one square the whole layout restarts; after MAX_RESTARTS it raises
     ScenarioError naming `key`.
     """
     half = _half_extent(cfg, arena)
     discs = _keep_out(cfg, depot, zones)
     spans = np.asarray(half_spans, dtype=float)
-    order = np.argsort(-spans, kind="stable")
+    if spans.ndim == 1:
+        spans = np.column_stack([spans, spans])
+    order = np.argsort(-spans.max(axis=1), kind="stable")
     for _ in range(MAX_RESTARTS):
         centres = np.zeros((len(spans), 2))
         placed: list[int] = []
         for i in order.tolist():
             hs = spans[i]
             room = half - hs
-            if room < 0:
+            if room.min() < 0:
                 raise ScenarioError(
-                    f"{key}: a square of side {2 * hs:.2f} m does not fit in the arena "
+                    f"{key}: a group of {2 * hs[0]:.2f} x {2 * hs[1]:.2f} m does not fit in the arena "
                     f"(arena.size {arena.size} m, resources.margin {cfg.margin} m)"
                 )
             for _ in range(MAX_ATTEMPTS // BATCH):
@@ -102,12 +132,12 @@ def _place_squares(
                 # the point of each candidate square nearest to each keep-out centre
                 ok = np.ones(len(c), dtype=bool)
                 for cx, cy, r in discs:
-                    nx = np.clip(cx, c[:, 0] - hs, c[:, 0] + hs)
-                    ny = np.clip(cy, c[:, 1] - hs, c[:, 1] + hs)
+                    nx = np.clip(cx, c[:, 0] - hs[0], c[:, 0] + hs[0])
+                    ny = np.clip(cy, c[:, 1] - hs[1], c[:, 1] + hs[1])
                     ok &= np.hypot(nx - cx, ny - cy) >= r
                 if placed:
-                    gap = np.abs(c[:, None, :] - centres[None, placed, :]).max(axis=2)
-                    ok &= (gap >= hs + spans[placed][None, :] + cfg.spacing).all(axis=1)
+                    gap = np.abs(c[:, None, :] - centres[None, placed, :]) - spans[placed][None, :, :] - hs
+                    ok &= (gap.max(axis=2) >= cfg.spacing).all(axis=1)
                 hits = np.flatnonzero(ok)
                 if len(hits):
                     centres[i] = c[hits[0]]
@@ -149,6 +179,42 @@ def _uniform(
         f"resources.min_depot_clearance: no room for resources {cfg.min_depot_clearance} m clear of "
         f"the depot inside the {arena.size} m arena (margin {cfg.margin} m)"
     )
+
+
+def powerlaw_tiers(count: int) -> list[list[int]]:
+    """Resources per pile, tier by tier (largest piles first), of the DDSA/MDBSA authors'
+    power law; a pile of n holds the first n points of its side x side grid, row by row.
+
+    ``DSA_loop_functions::PowerLawFoodDistribution`` (MARSLab-UTRGV/DDSA-Distributed-
+    Deterministic-Spiral-Search-Algorithm, branch luki-dev, and MARSLab-UTRGV/Adaptive-
+    Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev, source/DSA/
+    DSA_loop_functions.cpp; the same function in both): the rank R = p + 1 for the least p >= 1
+    with 4^p (1 + p) >= count; tier h < R has 4^h piles of side 2^(R-1-h); every tier but the
+    first takes ceil(count / R) resources and the first the rest; piles are filled in turn and a tier stops at its share (160 resources: 40 in one 8 x 8 pile cut to 5
+    rows, 40 in 4 x 4 piles (16, 16, 8), 40 in ten 2 x 2, 40 singles).
+    """
+    if count <= 0:
+        return []
+    p = 1  # the authors' loop raises p at least once
+    while 4**p * (1 + p) < count:
+        p += 1
+    rank = p + 1
+    if count % rank == 0:
+        first = other = count // rank
+    else:
+        other = count // rank + 1
+        first = other - (4**p * rank - count) % rank
+    tiers = []
+    for h in range(rank):
+        quota, side = (first if h == 0 else other), 2 ** (rank - 1 - h)
+        piles = []
+        for _ in range(4**h):
+            if quota <= 0:
+                break
+            piles.append(min(side * side, quota))
+            quota -= piles[-1]
+        tiers.append(piles)
+    return tiers
 
 
 def powerlaw_pile_sizes(levels: int) -> list[int]:
@@ -195,6 +261,14 @@ def place_resources(
         parts = [c[None, :] + _grid(side, cfg.spacing) for c, side in zip(centres, sides)]
         parts.append(_uniform(cfg.count - sum(piles), cfg, arena, depot, rng, zones))
         return np.concatenate(parts, axis=0)
+    if cfg.distribution == "powerlaw_tiers":
+        tiers = powerlaw_tiers(cfg.count)
+        grids = [_grid_rows(2 ** (len(tiers) - 1 - h), n, cfg.spacing)
+                 for h, tier in enumerate(tiers) for n in tier]
+        spans = [tuple((g.max(axis=0) - g.min(axis=0)) / 2) for g in grids]
+        centres = _place_squares(spans, cfg, arena, depot, rng, "resources.count", zones)
+        return np.concatenate([c - (g.max(axis=0) + g.min(axis=0)) / 2 + g
+                               for c, g in zip(centres, grids)], axis=0)
     raise ScenarioError(f"resources.distribution: unknown distribution {cfg.distribution!r}")
 
 

@@ -27,6 +27,8 @@ def start_positions(scenario: Scenario, rng: np.random.Generator) -> np.ndarray:
         i = np.arange(n)
         return np.column_stack([cx + (i % side - (side - 1) / 2) * r.start_spacing,
                                 cy + (i // side - (side - 1) / 2) * r.start_spacing])
+    if r.start_layout == "groups":
+        return _groups(scenario)
     room = scenario.depot.radius - r.diameter / 2
     if r.start_layout == "depot_ring":
         phi = 2 * math.pi * np.arange(n) / n
@@ -42,3 +44,21 @@ def start_positions(scenario: Scenario, rng: np.random.Generator) -> np.ndarray:
         else:
             raise ScenarioError(f"robots.count: found no free start for robot {k} in the depot")
     return out
+
+
+def _groups(scenario: Scenario) -> np.ndarray:
+    """`groups` layout: an equal share of the robots per group, each on a grid of
+    `start_group_columns` columns centred on its point (the queue paper's authors' experiment
+    files: four ``<distribute>`` blocks, ``method="grid"``, ``layout="6, 6, 1"``, ``distances=
+    "0.3, 0.3, 0.0"``; robots fill a block row by row, x first, in our reading of ARGoS's grid
+    generator)."""
+    r = scenario.robots
+    groups = len(r.start_groups)
+    share, extra = divmod(r.count, groups)
+    cols = r.start_group_columns
+    out = []
+    for g, (gx, gy) in enumerate(r.start_groups):
+        k = np.arange(share + (1 if g < extra else 0))
+        out.append(np.column_stack([gx + (k % cols - (cols - 1) / 2) * r.start_spacing,
+                                    gy + (k // cols - (cols - 1) / 2) * r.start_spacing]))
+    return np.concatenate(out)
