@@ -202,8 +202,8 @@ def ordering_checks(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
             _, p = pair_test(va, vb, "t")
             ma, mb = describe(va).mean, describe(vb).mean
             if not math.isfinite(p):
-                order = 'in order' if mb > ma else 'tied' if mb == ma else 'reversed'
-                means = f": means {order}" if va and vb else ""
+                direction = 'in order' if mb > ma else 'tied' if mb == ma else 'reversed'
+                means = f": means {direction}" if va and vb else ""
                 cells.append((c, f"n/a{means}", None))
                 continue
             holds = mb > ma and p < ALPHA
