@@ -85,6 +85,7 @@ from enum import Enum
 
 import numpy as np
 
+from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
@@ -122,6 +123,11 @@ class SearchMode(Enum):
     UNINFORMED = "uninformed"
     SITE_FIDELITY = "site_fidelity"
     PHEROMONE = "pheromone"
+
+
+_DEPARTING, _SEARCHING, _UNINFORMED = CpfaState.DEPARTING, CpfaState.SEARCHING, SearchMode.UNINFORMED
+"""The members every tick compares against, as module constants: looking a member up on its
+Enum class costs ~0.1 us in Python 3.11 (measured), a global ~0.01 us."""
 
 
 def poisson_cdf(k: int, lam: float) -> float:
@@ -304,18 +310,18 @@ class CpfaBehaviour:
                 out = self._at_nest(obs, delivered=True)
         if self._docks and self._carrying and self._nearest_dock(obs)[1] < self._dock_r2:
             self._avoidance.reset()  # unloading at a dock: stand still, no avoidance
-            return Command(0.0, 0.0, out)
+            return new_command(0.0, 0.0, out)
         override = self._avoidance.update(obs.ranges)
         state = self._state
-        if state is CpfaState.DEPARTING:
+        if state is _DEPARTING:
             linear, angular = self._departing(obs)
-        elif state is CpfaState.SEARCHING:
+        elif state is _SEARCHING:
             linear, angular = self._searching(obs)
         else:
             linear, angular = self._returning(obs)
         if override is not None:
             linear, angular = override.linear, override.angular
-        return Command(linear, angular, out)
+        return new_command(linear, angular, out)
 
     # ------------------------------------------------------------------ states
 
@@ -324,7 +330,7 @@ class CpfaBehaviour:
         x, y = pose.x, pose.y
         tx, ty = self._target
         d2 = (tx - x) ** 2 + (ty - y) ** 2
-        if self._mode is SearchMode.UNINFORMED:
+        if self._mode is _UNINFORMED:
             # H&M: an uninformed traveller starts searching with probability p_s per tick.
             if self._rng.random() < self._p_switch or d2 < self._arrival2:
                 return self._start_search(obs)
@@ -357,7 +363,7 @@ class CpfaBehaviour:
         """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
         pose = obs.pose
         x, y, yaw = pose.x, pose.y, pose.yaw
-        if self._mode is SearchMode.UNINFORMED:
+        if self._mode is _UNINFORMED:
             sigma = self._omega
         else:
             t = self._search_legs if self._search_in_steps else obs.t - self._search_t0
