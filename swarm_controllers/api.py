@@ -40,6 +40,28 @@ def behaviour_rng(seed: int, robot: RobotId) -> np.random.Generator:
     return np.random.default_rng([seed, robot_index(robot)])
 
 
+_TWO_POW_MINUS_53 = 1.0 / 9007199254740992.0
+
+
+def uniform_draws(rng: np.random.Generator) -> Callable[[], float]:
+    """A function returning ``rng.random()``'s next number, for draws made on every tick.
+
+    A PCG64 generator (`behaviour_rng`'s) makes that double from its next 64-bit output as
+    ``(output >> 11) * 2**-53`` (numpy's ``pcg64_next_double``), so taking the raw output and
+    doing the same gives the same number and advances the generator as much, whatever other draws
+    come between; it skips ``Generator.random``'s argument handling (measured ~0.34 -> ~0.16 us a
+    draw). Any other generator: ``rng.random`` itself.
+    """
+    if type(rng) is not np.random.Generator or type(rng.bit_generator) is not np.random.PCG64:
+        return rng.random
+    raw = rng.bit_generator.random_raw
+
+    def draw() -> float:
+        return (raw() >> 11) * _TWO_POW_MINUS_53
+
+    return draw
+
+
 def _command_factory() -> Callable[[float, float, tuple[object, ...]], Command]:
     """A positional `Command` constructor that fills the slots directly.
 

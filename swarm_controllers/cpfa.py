@@ -85,7 +85,7 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.api import new_command
+from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
@@ -177,6 +177,8 @@ class CpfaBehaviour:
         dt = scenario.sim.dt
         self.robot = robot
         self._rng = rng
+        self._random = uniform_draws(rng)
+        """``rng.random`` (the same numbers, cheaper)."""
         self._limits = DriveLimits.from_scenario(scenario)
         self._avoidance = AvoidThenEscape(scenario, escape_distance=cfg.search_step)
         self._p_switch = per_tick_probability(
@@ -332,7 +334,7 @@ class CpfaBehaviour:
         d2 = (tx - x) ** 2 + (ty - y) ** 2
         if self._mode is _UNINFORMED:
             # H&M: an uninformed traveller starts searching with probability p_s per tick.
-            if self._rng.random() < self._p_switch or d2 < self._arrival2:
+            if self._random() < self._p_switch or d2 < self._arrival2:
                 return self._start_search(obs)
         elif d2 < self._arrival2 or (self._avoidance.active and d2 < self._blocked2):
             return self._start_search(obs)
@@ -347,7 +349,7 @@ class CpfaBehaviour:
 
     def _searching(self, obs: Observation) -> tuple[float, float]:
         # H&M: a searcher gives up and returns with probability p_r per tick.
-        if self._rng.random() < self._p_return:
+        if self._random() < self._p_return:
             self._state = CpfaState.RETURNING
             return self._returning(obs)
         pose = obs.pose
@@ -422,15 +424,14 @@ class CpfaBehaviour:
         site = self._site
         self._site = None
         self._state = CpfaState.DEPARTING
-        rng = self._rng
         if delivered and site is not None:
             c = self._site_count
-            if rng.random() < poisson_cdf(c, self._lambda_lp):
+            if self._random() < poisson_cdf(c, self._lambda_lp):
                 message = PheromoneMessage(int(obs.stamp_ns), site[0], site[1])
                 out = (message,)
                 self._pheromones.append((message.stamp_ns, site[0], site[1]))
                 self._own_unechoed.add(message)
-            if rng.random() < poisson_cdf(c, self._lambda_sf):
+            if self._random() < poisson_cdf(c, self._lambda_sf):
                 self._target = site
                 self._mode = SearchMode.SITE_FIDELITY
                 return out
@@ -491,7 +492,7 @@ class CpfaBehaviour:
         if not self._pheromones:
             return None
         weights = [self._strength(p[0], now_ns) for p in self._pheromones]
-        u = self._rng.random() * sum(weights)
+        u = self._random() * sum(weights)
         for weight, (_, x, y) in zip(weights, self._pheromones):
             if u < weight:
                 return (x, y)

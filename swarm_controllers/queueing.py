@@ -234,12 +234,13 @@ class QueueBehaviour:
                 if m.robot == self.robot:
                     self._on_grant(m, obs)
             elif isinstance(m, RadioQuery):
-                if m.sender != self.robot and within_range(m, x, y, self._gamma):
+                answers = self._phase is _QUEUED or self._phase is _SEEKING  # no one else replies
+                if answers and m.sender != self.robot and within_range(m, x, y, self._gamma):
                     reply = self._reply(m, obs)
                     if reply is not None:
                         out.append(reply)
             elif isinstance(m, RadioReply):
-                if m.to == self.robot and self._phase is Phase.SEEKING and within_range(m, x, y, self._gamma):
+                if m.to == self.robot and self._phase is _SEEKING and within_range(m, x, y, self._gamma):
                     self._on_reply(m, obs, out)
 
     def _valid_slot(self, what: str, line: str, cell: int) -> bool:
