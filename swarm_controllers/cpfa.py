@@ -89,6 +89,7 @@ from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
+from swarm_sim.messaging import per_inbox
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import scenario_docks
 from swarm_sim.types import (
@@ -128,6 +129,12 @@ class SearchMode(Enum):
 _DEPARTING, _SEARCHING, _UNINFORMED = CpfaState.DEPARTING, CpfaState.SEARCHING, SearchMode.UNINFORMED
 """The members every tick compares against, as module constants: looking a member up on its
 Enum class costs ~0.1 us in Python 3.11 (measured), a global ~0.01 us."""
+
+
+@per_inbox
+def _pheromones(messages: tuple[object, ...]) -> tuple[PheromoneMessage, ...]:
+    """The waypoints among a tick's messages, in order (once per tick in a batch run)."""
+    return tuple(m for m in messages if isinstance(m, PheromoneMessage))
 
 
 def poisson_cdf(k: int, lam: float) -> float:
@@ -299,8 +306,9 @@ class CpfaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
-        if obs.messages:
-            self._receive(obs.messages, obs.stamp_ns)
+        pheromones = _pheromones(obs.messages)
+        if pheromones:
+            self._receive(pheromones, obs.stamp_ns)
         out: tuple[object, ...] = ()
         carrying = bool(obs.sensed.carrying)
         if carrying != self._carrying:
@@ -463,15 +471,14 @@ class CpfaBehaviour:
         age = (now_ns - stamp_ns) / NS_PER_S
         return math.exp(-self._lambda_pd * age) if age > 0.0 else 1.0
 
-    def _receive(self, messages: tuple[object, ...], now_ns: int) -> None:
+    def _receive(self, pheromones: tuple[PheromoneMessage, ...], now_ns: int) -> None:
         changed = False
-        for message in messages:
-            if isinstance(message, PheromoneMessage):
-                if message in self._own_unechoed:
-                    self._own_unechoed.discard(message)
-                    continue
-                self._pheromones.append((message.stamp_ns, message.x, message.y))
-                changed = True
+        for message in pheromones:
+            if message in self._own_unechoed:
+                self._own_unechoed.discard(message)
+                continue
+            self._pheromones.append((message.stamp_ns, message.x, message.y))
+            changed = True
         if changed:
             self._forget(now_ns)
 

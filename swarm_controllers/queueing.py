@@ -63,6 +63,7 @@ from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_sim.inbound import Reason, Rejections
+from swarm_sim.messaging import per_inbox
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
 
@@ -103,6 +104,12 @@ _FORAGING, _TO_ENTRY, _SEEKING, _JOINING, _QUEUED = (
 )
 """The phases every tick compares against, as module constants (a member looked up on its Enum
 class costs ~0.1 us in Python 3.11; see `swarm_controllers.cpfa`)."""
+
+
+@per_inbox
+def _granted(messages: tuple[object, ...]) -> frozenset[str]:
+    """The robots a grant among a tick's messages is for (once per tick in a batch run)."""
+    return frozenset(m.robot for m in messages if isinstance(m, DepotGrant))
 
 
 @lru_cache(maxsize=8)
@@ -228,14 +235,18 @@ class QueueBehaviour:
     # ------------------------------------------------------------------ messages
 
     def _handle(self, obs: Observation, out: list[object]) -> None:
+        """The tick's messages, in order. A robot neither queued nor seeking that no grant is for
+        need not read them: only queued and seeking robots answer queries and take replies, and
+        only a grant can change the phase."""
+        if not (self._phase is _QUEUED or self._phase is _SEEKING or self.robot in _granted(obs.messages)):
+            return
         x, y = obs.pose.x, obs.pose.y
         for m in obs.messages:
             if isinstance(m, DepotGrant):
                 if m.robot == self.robot:
                     self._on_grant(m, obs)
             elif isinstance(m, RadioQuery):
-                answers = self._phase is _QUEUED or self._phase is _SEEKING  # no one else replies
-                if answers and m.sender != self.robot and within_range(m, x, y, self._gamma):
+                if m.sender != self.robot and within_range(m, x, y, self._gamma):
                     reply = self._reply(m, obs)
                     if reply is not None:
                         out.append(reply)
