@@ -306,7 +306,7 @@ class CpfaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
-        pheromones = _pheromones(obs.messages)
+        pheromones = _pheromones(obs.messages) if obs.messages else ()
         if pheromones:
             self._receive(pheromones, obs.stamp_ns)
         out: tuple[object, ...] = ()
