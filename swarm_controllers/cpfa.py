@@ -329,8 +329,8 @@ class CpfaBehaviour:
             linear, angular = self._searching(obs)
         else:
             linear, angular = self._returning(obs)
-        if override is not None:
-            linear, angular = override.linear, override.angular
+        if override is not None:  # the avoidance's own command, unless messages go out with it
+            return override if not out else new_command(override.linear, override.angular, out)
         return new_command(linear, angular, out)
 
     # ------------------------------------------------------------------ states
