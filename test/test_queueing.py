@@ -228,3 +228,12 @@ def test_message_handling_skips_only_what_cannot_matter(phase, grant):
 def test_message_handling_skips_only_what_cannot_matter_for_any_inbox(phase, messages, join, line, cell):
     args = (phase, messages, join, line, cell)
     assert _handled(*args, read_all=False) == _handled(*args, read_all=True)
+
+
+@pytest.mark.parametrize("name", ["queue_qse", "queue_qmt"])
+def test_the_slots_looked_up_every_tick_are_the_managers_cells(name):
+    b = QueueBehaviour(load_scenario(name), "robot_0", np.random.default_rng(0))
+    assert b._slots.keys() == b._cells.keys()
+    for line, cells in b._cells.items():
+        assert b._slots[line] == [(float(x), float(y)) for x, y in cells]
+        assert all(type(v) is float for xy in b._slots[line] for v in xy)
