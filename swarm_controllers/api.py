@@ -9,6 +9,8 @@ controller node and the batch runner, which both build it through
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -36,3 +38,55 @@ def behaviour_rng(seed: int, robot: RobotId) -> np.random.Generator:
     """The generator a robot's behaviour draws from: seeded by (run seed, robot index), so the
     graph and the batch runner, and every process split of the graph, seed it identically."""
     return np.random.default_rng([seed, robot_index(robot)])
+
+
+_TWO_POW_MINUS_53 = 1.0 / 9007199254740992.0
+
+
+def uniform_draws(rng: np.random.Generator) -> Callable[[], float]:
+    """A function returning ``rng.random()``'s next number, for draws made on every tick.
+
+    A PCG64 generator (`behaviour_rng`'s) makes that double from its next 64-bit output as
+    ``(output >> 11) * 2**-53`` (numpy's ``pcg64_next_double``), so taking the raw output and
+    doing the same gives the same number and advances the generator as much, whatever other draws
+    come between; it skips ``Generator.random``'s argument handling (measured ~0.34 -> ~0.16 us a
+    draw). Any other generator: ``rng.random`` itself.
+    """
+    if type(rng) is not np.random.Generator or type(rng.bit_generator) is not np.random.PCG64:
+        return rng.random
+    raw = rng.bit_generator.random_raw
+
+    def draw() -> float:
+        return (raw() >> 11) * _TWO_POW_MINUS_53
+
+    return draw
+
+
+def _command_factory() -> Callable[[float, float, tuple[object, ...]], Command]:
+    """A positional `Command` constructor that fills the slots directly.
+
+    A frozen dataclass's generated ``__init__`` sets every field through ``object.__setattr__``;
+    every behaviour builds a command per robot per tick, and this is ~2.5x cheaper (measured
+    ~0.33 vs ~0.89 us). Used only while Command has exactly these slot fields and no
+    ``__post_init__``; otherwise the ordinary constructor (test_api checks both give equal objects).
+    """
+    expected = ("linear", "angular", "messages")
+    fields = tuple(f.name for f in dataclasses.fields(Command))
+    if fields != expected or not hasattr(Command, "__slots__") or hasattr(Command, "__post_init__"):
+        return lambda linear, angular, messages=(): Command(linear, angular, messages)
+    set_linear, set_angular, set_messages = (getattr(Command, name).__set__ for name in expected)
+    new = object.__new__
+
+    def command(linear: float, angular: float, messages: tuple[object, ...] = ()) -> Command:
+        c = new(Command)
+        set_linear(c, linear)
+        set_angular(c, angular)
+        set_messages(c, messages)
+        return c
+
+    return command
+
+
+new_command = _command_factory()
+"""``new_command(linear, angular, messages=())``: the same `Command` as the constructor's, for
+the behaviours' hot paths."""

@@ -61,14 +61,15 @@ class ObstacleAvoidance:
         self._range_max = scan.range_max
         angles = ray_angles(scan)
         half_front = config.front_fov / 2.0 + 1e-12
-        front = [i for i, a in enumerate(angles) if abs(a) <= half_front]
-        # Contiguous in every sane configuration (angles are monotonic around the heading);
-        # an index list covers anything else.
+        self._front_rays = tuple(i for i, a in enumerate(angles) if abs(a) <= half_front)
+        front = self._front_rays
+        # Contiguous in every sane configuration (angles are monotonic around the heading): a
+        # slice, so a scan array's front sector is one view; an index list covers anything else.
         self._front: slice | list[int]
-        if front and front == list(range(front[0], front[-1] + 1)):
+        if front and front == tuple(range(front[0], front[-1] + 1)):
             self._front = slice(front[0], front[-1] + 1)
         else:
-            self._front = front
+            self._front = list(front)
         # Free space is compared over the forward half-plane only: what lies behind the robot
         # does not matter for where it can turn to and drive.
         self._left = [i for i, a in enumerate(angles) if 0.0 < a <= math.pi / 2 + 1e-12]
@@ -98,22 +99,23 @@ class ObstacleAvoidance:
     @property
     def front_rays(self) -> tuple[int, ...]:
         """Indices of the rays watched for obstacles."""
-        f = self._front
-        return tuple(range(f.start, f.stop)) if isinstance(f, slice) else tuple(f)
+        return self._front_rays
 
     def update(self, ranges: np.ndarray | Sequence[float]) -> Command | None:
         """A turn-away command if the front sector is blocked, else None.
 
         `ranges` [m] are the scan's rays in order (float32 array or any float sequence; inf
         where nothing was hit). A NaN ray is ignored.
+
+        Every robot calls this every tick, so only the front sector is read (an array's slice
+        as floats) until an episode starts; the whole scan is read then, for the free side.
         """
-        values = ranges.tolist() if isinstance(ranges, np.ndarray) else list(ranges)
-        if len(values) != self._rays:
+        if len(ranges) != self._rays:
             raise ValueError(
-                f"scan has {len(values)} rays, the scenario says sensors.scan.rays={self._rays}"
+                f"scan has {len(ranges)} rays, the scenario says sensors.scan.rays={self._rays}"
             )
-        f = self._front
-        front = values[f] if isinstance(f, slice) else [values[i] for i in f]
+        is_array = isinstance(ranges, np.ndarray)
+        front = ranges[self._front].tolist() if is_array else [ranges[i] for i in self._front_rays]
         if not front:
             self._active = False
             return None
@@ -126,6 +128,7 @@ class ObstacleAvoidance:
         if not self._active:
             self._active = True
             self._events += 1
+            values = ranges.tolist() if is_array else list(ranges)
             left = not self._keep_right and self._free_side(values) >= 0.0
             self._command = self._turn_left if left else self._turn_right
         return self._command
@@ -186,11 +189,12 @@ class AvoidThenEscape:
         """The command that overrides the behaviour this tick (a turn away or the escape run),
         or None when the behaviour steers."""
         avoid = self.avoidance.update(ranges)
-        if avoid is None and self._was_avoiding:
-            self._escape_left = self._escape_ticks
-        self._was_avoiding = avoid is not None
         if avoid is not None:
+            self._was_avoiding = True
             return avoid
+        if self._was_avoiding:  # the episode just ended: the escape run starts
+            self._was_avoiding = False
+            self._escape_left = self._escape_ticks
         if self._escape_left:
             self._escape_left -= 1
             return self._escape

@@ -85,9 +85,11 @@ from enum import Enum
 
 import numpy as np
 
+from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
+from swarm_sim.messaging import per_inbox
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import scenario_docks
 from swarm_sim.types import (
@@ -122,6 +124,17 @@ class SearchMode(Enum):
     UNINFORMED = "uninformed"
     SITE_FIDELITY = "site_fidelity"
     PHEROMONE = "pheromone"
+
+
+_DEPARTING, _SEARCHING, _UNINFORMED = CpfaState.DEPARTING, CpfaState.SEARCHING, SearchMode.UNINFORMED
+"""The members every tick compares against, as module constants: looking a member up on its
+Enum class costs ~0.1 us in Python 3.11 (measured), a global ~0.01 us."""
+
+
+@per_inbox
+def _pheromones(messages: tuple[object, ...]) -> tuple[PheromoneMessage, ...]:
+    """The waypoints among a tick's messages, in order (once per tick in a batch run)."""
+    return tuple(m for m in messages if isinstance(m, PheromoneMessage))
 
 
 def poisson_cdf(k: int, lam: float) -> float:
@@ -171,6 +184,8 @@ class CpfaBehaviour:
         dt = scenario.sim.dt
         self.robot = robot
         self._rng = rng
+        self._random = uniform_draws(rng)
+        """``rng.random`` (the same numbers, cheaper)."""
         self._limits = DriveLimits.from_scenario(scenario)
         self._avoidance = AvoidThenEscape(scenario, escape_distance=cfg.search_step)
         self._p_switch = per_tick_probability(
@@ -291,8 +306,9 @@ class CpfaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
-        if obs.messages:
-            self._receive(obs.messages, obs.stamp_ns)
+        pheromones = _pheromones(obs.messages) if obs.messages else ()
+        if pheromones:
+            self._receive(pheromones, obs.stamp_ns)
         out: tuple[object, ...] = ()
         carrying = bool(obs.sensed.carrying)
         if carrying != self._carrying:
@@ -304,18 +320,18 @@ class CpfaBehaviour:
                 out = self._at_nest(obs, delivered=True)
         if self._docks and self._carrying and self._nearest_dock(obs)[1] < self._dock_r2:
             self._avoidance.reset()  # unloading at a dock: stand still, no avoidance
-            return Command(0.0, 0.0, out)
+            return new_command(0.0, 0.0, out)
         override = self._avoidance.update(obs.ranges)
         state = self._state
-        if state is CpfaState.DEPARTING:
+        if state is _DEPARTING:
             linear, angular = self._departing(obs)
-        elif state is CpfaState.SEARCHING:
+        elif state is _SEARCHING:
             linear, angular = self._searching(obs)
         else:
             linear, angular = self._returning(obs)
-        if override is not None:
-            linear, angular = override.linear, override.angular
-        return Command(linear, angular, out)
+        if override is not None:  # the avoidance's own command, unless messages go out with it
+            return override if not out else new_command(override.linear, override.angular, out)
+        return new_command(linear, angular, out)
 
     # ------------------------------------------------------------------ states
 
@@ -324,9 +340,9 @@ class CpfaBehaviour:
         x, y = pose.x, pose.y
         tx, ty = self._target
         d2 = (tx - x) ** 2 + (ty - y) ** 2
-        if self._mode is SearchMode.UNINFORMED:
+        if self._mode is _UNINFORMED:
             # H&M: an uninformed traveller starts searching with probability p_s per tick.
-            if self._rng.random() < self._p_switch or d2 < self._arrival2:
+            if self._random() < self._p_switch or d2 < self._arrival2:
                 return self._start_search(obs)
         elif d2 < self._arrival2 or (self._avoidance.active and d2 < self._blocked2):
             return self._start_search(obs)
@@ -341,7 +357,7 @@ class CpfaBehaviour:
 
     def _searching(self, obs: Observation) -> tuple[float, float]:
         # H&M: a searcher gives up and returns with probability p_r per tick.
-        if self._rng.random() < self._p_return:
+        if self._random() < self._p_return:
             self._state = CpfaState.RETURNING
             return self._returning(obs)
         pose = obs.pose
@@ -357,7 +373,7 @@ class CpfaBehaviour:
         """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
         pose = obs.pose
         x, y, yaw = pose.x, pose.y, pose.yaw
-        if self._mode is SearchMode.UNINFORMED:
+        if self._mode is _UNINFORMED:
             sigma = self._omega
         else:
             t = self._search_legs if self._search_in_steps else obs.t - self._search_t0
@@ -416,15 +432,14 @@ class CpfaBehaviour:
         site = self._site
         self._site = None
         self._state = CpfaState.DEPARTING
-        rng = self._rng
         if delivered and site is not None:
             c = self._site_count
-            if rng.random() < poisson_cdf(c, self._lambda_lp):
+            if self._random() < poisson_cdf(c, self._lambda_lp):
                 message = PheromoneMessage(int(obs.stamp_ns), site[0], site[1])
                 out = (message,)
                 self._pheromones.append((message.stamp_ns, site[0], site[1]))
                 self._own_unechoed.add(message)
-            if rng.random() < poisson_cdf(c, self._lambda_sf):
+            if self._random() < poisson_cdf(c, self._lambda_sf):
                 self._target = site
                 self._mode = SearchMode.SITE_FIDELITY
                 return out
@@ -456,15 +471,14 @@ class CpfaBehaviour:
         age = (now_ns - stamp_ns) / NS_PER_S
         return math.exp(-self._lambda_pd * age) if age > 0.0 else 1.0
 
-    def _receive(self, messages: tuple[object, ...], now_ns: int) -> None:
+    def _receive(self, pheromones: tuple[PheromoneMessage, ...], now_ns: int) -> None:
         changed = False
-        for message in messages:
-            if isinstance(message, PheromoneMessage):
-                if message in self._own_unechoed:
-                    self._own_unechoed.discard(message)
-                    continue
-                self._pheromones.append((message.stamp_ns, message.x, message.y))
-                changed = True
+        for message in pheromones:
+            if message in self._own_unechoed:
+                self._own_unechoed.discard(message)
+                continue
+            self._pheromones.append((message.stamp_ns, message.x, message.y))
+            changed = True
         if changed:
             self._forget(now_ns)
 
@@ -485,7 +499,7 @@ class CpfaBehaviour:
         if not self._pheromones:
             return None
         weights = [self._strength(p[0], now_ns) for p in self._pheromones]
-        u = self._rng.random() * sum(weights)
+        u = self._random() * sum(weights)
         for weight, (_, x, y) in zip(weights, self._pheromones):
             if u < weight:
                 return (x, y)

@@ -1,13 +1,15 @@
 """Steering for a differential-drive robot: turn in place, or drive with a proportional turn.
 
 Plain `math` on purpose: these run for every robot every tick, and numpy's per-call overhead
-on scalars costs more than the arithmetic.
+on scalars costs more than the arithmetic (its functions imported by name: a module attribute
+lookup per call added ~0.1 us to a `go_to_point_twist`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from math import atan2, cos, hypot, inf, remainder
 
 from swarm_sim.geometry import wrap_angle
 from swarm_sim.scenario import Scenario
@@ -43,7 +45,7 @@ def steer(heading_error: float, distance: float, limits: DriveLimits) -> tuple[f
     max_linear, scaled by cos(error) and capped at distance/dt so it stops on a point target.
     A non-finite error gives (0, 0).
     """
-    if not -math.inf < heading_error < math.inf:  # nan or inf
+    if not -inf < heading_error < inf:  # nan or inf
         return 0.0, 0.0
     w_max = limits.max_angular
     angular = 0.5 / limits.dt * heading_error
@@ -58,7 +60,7 @@ def steer(heading_error: float, distance: float, limits: DriveLimits) -> tuple[f
         linear = limits.max_linear
     if linear < 0.0:
         linear = 0.0
-    return linear * math.cos(heading_error), angular
+    return linear * cos(heading_error), angular
 
 
 def go_to_point_twist(
@@ -67,10 +69,10 @@ def go_to_point_twist(
     """`steer` toward a point [m, world frame] from pose (x, y, yaw)."""
     dx = target_x - x
     dy = target_y - y
-    error = math.atan2(dy, dx) - yaw
-    if not -math.inf < error < math.inf:
+    error = atan2(dy, dx) - yaw
+    if not -inf < error < inf:
         return 0.0, 0.0
-    return steer(math.remainder(error, _TWO_PI), math.hypot(dx, dy), limits)
+    return steer(remainder(error, _TWO_PI), hypot(dx, dy), limits)
 
 
 def go_to_point(pose: Pose2D, target: tuple[float, float], limits: DriveLimits) -> Command:
@@ -82,7 +84,7 @@ def go_to_point(pose: Pose2D, target: tuple[float, float], limits: DriveLimits) 
 def hold_heading(pose: Pose2D, heading: float, limits: DriveLimits) -> Command:
     """A command that turns to `heading` [rad, world frame] and drives along it at full speed."""
     error = heading - pose.yaw
-    if not -math.inf < error < math.inf:
+    if not -inf < error < inf:
         return Command()
-    linear, angular = steer(wrap_angle(error), math.inf, limits)
+    linear, angular = steer(wrap_angle(error), inf, limits)
     return Command(linear, angular)

@@ -72,6 +72,7 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
     world = World(scenario)
     robots = world.robots
     behaviours = {r: make_behaviour(scenario, r, behaviour_rng(scenario.seed, r)) for r in robots}
+    steps = [b.step for b in behaviours.values()]  # robot order, bound once: stepped every tick
     servers = make_servers(scenario)
     router = Router()
     last_step_ns = 0
@@ -93,11 +94,11 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
             inbox = router.take_before(ROBOTS, world.t_ns)
-            commands = {}
-            for r, b in behaviours.items():
-                o = obs[r] if not inbox else with_messages(obs[r], inbox)
-                command = b.step(o)
-                commands[r] = command
+            seen = [obs[r] for r in robots]
+            if inbox:
+                seen = [with_messages(o, inbox) for o in seen]
+            answers = [step(o) for step, o in zip(steps, seen)]
+            for command in answers:
                 for message in command.messages:
                     router.post(message)
                     if keep and isinstance(message, keep):
@@ -106,7 +107,7 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
                 for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
                     router.post(message)
             last_step_ns = world.t_ns
-            obs = world.step(commands)
+            obs = world.step(dict(zip(robots, answers)))
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
             if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):

@@ -9,9 +9,12 @@ what the batch runner hands it. Every message type has a ``stamp_ns`` field.
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from swarm_sim.protocol import channel_of
+
+T = TypeVar("T")
 
 
 def delivery_order(message: Any) -> tuple[int, str, str]:
@@ -52,3 +55,23 @@ class Router:
     def take_before(self, channel: str, stamp_ns: int) -> tuple[Any, ...]:
         box = self._boxes.get(channel)
         return box.take_before(stamp_ns) if box is not None else ()
+
+
+def per_inbox(summary: Callable[[tuple[Any, ...]], T]) -> Callable[[tuple[Any, ...]], T]:
+    """`summary` of a tick's messages, computed once for all the robots that got the same tuple.
+
+    The batch runner hands every robot the very same tuple on a tick, so what a behaviour reads
+    from it independently of the robot (the messages of one kind, whom they address) need not be
+    worked out once per robot. The last tuple seen is kept alive with its summary, so its identity
+    cannot be taken for a new tuple's; a controller node's own tuples are simply summarised anew.
+    """
+    memo: list[tuple[tuple[Any, ...], T]] = [((), summary(()))]
+
+    def summarised(messages: tuple[Any, ...]) -> T:
+        last, value = memo[0]
+        if messages is not last:
+            value = summary(messages)
+            memo[0] = (messages, value)
+        return value
+
+    return summarised

@@ -5,11 +5,15 @@ perimeter; graph-free, so these are fast."""
 from __future__ import annotations
 
 import math
+from unittest import mock
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from depot_manager.config import QueueConfig
+from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
 from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
@@ -161,3 +165,75 @@ def test_dropoff_time_stops_at_the_dock_before_t_unload():
     # the foraging task drops on the first tick the carrier has been inside for T_unload
     assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - s.depot.unload_time)
     assert dropoff_times(trace) == [pytest.approx(100.0 - s.depot.unload_time - 40.0)]
+
+
+class _Everyone:
+    def __contains__(self, robot: object) -> bool:
+        return True
+
+
+_ROBOTS = ("robot_0", "robot_1", "robot_2")
+_LINES = ("entry_line_0", "entry_line_1", "nowhere")
+_near_x, _near_y = st.floats(0.4, 1.6), st.floats(-0.6, 0.6)  # about the robot at (1, 0): in radio range or not
+_queue_messages = st.lists(st.one_of(
+    st.builds(DepotGrant, st.just(0), st.sampled_from(_ROBOTS), st.sampled_from(_LINES), st.integers(-1, 4),
+              st.booleans(), st.sampled_from(list(Refusal))),
+    st.builds(RadioQuery, st.just(0), st.sampled_from(_ROBOTS), _near_x, _near_y),
+    st.builds(RadioReply, st.just(0), st.sampled_from(_ROBOTS), st.sampled_from(_ROBOTS), _near_x, _near_y,
+              st.sampled_from(("", *_LINES)), st.integers(-1, 4), st.booleans()),
+), max_size=6).map(tuple)
+
+
+def _handled(phase, messages, join, line, cell, *, read_all: bool):
+    """State and replies of robot_0 at (1, 0) after `_handle` (or, read_all, after the reference:
+    every message read)."""
+    s = load_scenario("queue_qmt", ["robots.count=3"])
+    b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
+    b._phase, b._join, b._line, b._cell = phase, join, line, cell
+    ranges = np.full(24, np.inf, dtype=np.float32)
+    obs = Observation("robot_0", 10**9, Pose2D(1.0, 0.0, 0.0), 0.0, 0.0, ranges, ForagingSense((), True), messages)
+    out: list[object] = []
+    if read_all:
+        with mock.patch("swarm_controllers.queueing._granted", lambda _messages: _Everyone()):
+            b._handle(obs, out)
+    else:
+        b._handle(obs, out)
+    names = ("_phase", "_join", "_line", "_cell", "_grant", "_last", "_retry_at", "_yield_until", "_goal")
+    return out, [getattr(b, n) for n in names], b.rejections.counts, b._rng.bit_generator.state
+
+
+_INBOX = (
+    RadioQuery(0, "robot_1", 1.1, 0.0),
+    RadioReply(0, "robot_1", "robot_0", 1.1, 0.1, "entry_line_0", 3, True),
+    DepotGrant(0, "robot_2", "entry_line_0", 2),
+)
+
+
+@pytest.mark.parametrize("phase", list(Phase))
+@pytest.mark.parametrize("grant", [None, DepotGrant(0, "robot_0", "entry_line_0", 2),
+                                   DepotGrant(0, "robot_0", "entry_line_0", -1, reason=Refusal.NOT_BEHIND_TAIL)])
+def test_message_handling_skips_only_what_cannot_matter(phase, grant):
+    """`_handle` returns early for a robot neither queued nor seeking that no grant is for;
+    reading every message instead (the reference) gives the same state and replies, in every
+    phase, with a grant for the robot before the others or none."""
+    inbox = _INBOX if grant is None else (grant, *_INBOX)
+    args = (phase, inbox, ("entry_line_0", 3), "entry_line_0", 1)
+    assert _handled(*args, read_all=False) == _handled(*args, read_all=True)
+
+
+@settings(max_examples=300)
+@given(st.sampled_from(list(Phase)), _queue_messages,
+       st.one_of(st.none(), st.tuples(st.sampled_from(_LINES[:2]), st.integers(0, 4))),
+       st.sampled_from(("", *_LINES[:2])), st.integers(-1, 3))
+def test_message_handling_skips_only_what_cannot_matter_for_any_inbox(phase, messages, join, line, cell):
+    args = (phase, messages, join, line, cell)
+    assert _handled(*args, read_all=False) == _handled(*args, read_all=True)
+
+
+@pytest.mark.parametrize("name", ["queue_qse", "queue_qmt"])
+def test_the_slots_looked_up_every_tick_are_the_managers_cells(name):
+    b = QueueBehaviour(load_scenario(name), "robot_0", np.random.default_rng(0))
+    assert b._slots.keys() == b._cells.keys()
+    for line, cells in b._cells.items():
+        assert b._slots[line] == [(float(x), float(y)) for x, y in cells]
+        assert all(type(v) is float for xy in b._slots[line] for v in xy)
