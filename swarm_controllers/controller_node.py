@@ -44,7 +44,7 @@ from rclpy.parameter import Parameter
 from launch_py.lifetime import die_with_parent, set_process_name
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
-from swarm_msgs_py.executor import make_executor
+from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
 from swarm_sim import registry
@@ -213,6 +213,7 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
         for robot in robots:
             nodes.append(ControllerNode(robot, config, scenario=scenario))
             executor.add_node(nodes[-1])
+        share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
         connecting = list(nodes)
         while rclpy.ok():
