@@ -44,11 +44,11 @@ from rclpy.parameter import Parameter
 from launch_py.lifetime import die_with_parent, set_process_name
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
-from swarm_msgs_py.executor import make_executor
+from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
 from swarm_sim import registry
-from swarm_sim.inbound import Inbound, Rejections, merged
+from swarm_sim.inbound import Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 from swarm_sim.types import Observation, robot_index
@@ -89,11 +89,13 @@ class ControllerNode(Node):
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
+        self._sense_topics = tuple((t.field, t.name) for t in self.sensing.topics)
         self.mailbox = Mailbox()
         self.rejections = Rejections()
         self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
                                self.get_logger().warning)
-        self._published_rejections: dict = {}
+        self._published_rejections = 0
+        """Messages dropped so far, as last published on ``/diagnostics``."""
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
@@ -153,42 +155,51 @@ class ControllerNode(Node):
         if stamp == self._answered_stamp:  # the world re-sent a tick: our answer was late or lost
             self._cmd_pub.publish(self._answer)
             return
-        self._latest[name] = decoded
-        if len(self._latest) == self._expected and all(v[0] == stamp for v in self._latest.values()):
+        latest = self._latest
+        latest[name] = decoded
+        if len(latest) == self._expected:
+            for value in latest.values():
+                if value[0] != stamp:
+                    return
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
         self.inbound.now_ns = self.inbound.released_ns = stamp_ns
         _, pose, v, w = self._latest[topics.ODOM]
-        sensed = self.sensing.sense(**{t.field: self._latest[t.name][1] for t in self.sensing.topics})
+        sensed = self.sensing.sense(**{field: self._latest[name][1] for field, name in self._sense_topics})
         obs = Observation(
             robot=self.robot, stamp_ns=stamp_ns, pose=pose, linear_velocity=v, angular_velocity=w,
             ranges=self._latest[topics.SCAN][1], sensed=sensed, messages=self.mailbox.take_before(stamp_ns),
         )
         command = self.behaviour.step(obs)
-        by_topic: dict[str, list] = defaultdict(list)
-        for message in command.messages:
-            topic = self._topic_of.get(type(message))
-            if topic is None:
-                raise TypeError(f"{self.robot}: this algorithm sends no {type(message).__name__}")
-            by_topic[topic].append(message)
-        for topic, messages in by_topic.items():
-            family, pub = self._outbound[topic]
-            for data in family.encode(stamp_ns, messages):
-                pub.publish(data)
+        if command.messages:
+            self._send(stamp_ns, command.messages)
         status = self.behaviour.status(stamp_ns)
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
-        counts = merged(self.rejections, getattr(self.behaviour, "rejections", None))
-        if counts != self._published_rejections:
-            self._published_rejections = counts
-            self._diagnostics_pub.publish(
-                diagnostics.encode_rejections(stamp_ns, self.get_fully_qualified_name(), counts))
+        core = getattr(self.behaviour, "rejections", None)
+        if (dropped := total(self.rejections, core)) != self._published_rejections:
+            self._published_rejections = dropped
+            self._diagnostics_pub.publish(diagnostics.encode_rejections(
+                stamp_ns, self.get_fully_qualified_name(), merged(self.rejections, core)))
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
+
+    def _send(self, stamp_ns: int, messages: tuple[object, ...]) -> None:
+        """The behaviour's outgoing messages, on the topics of their families."""
+        by_topic: dict[str, list] = defaultdict(list)
+        for message in messages:
+            topic = self._topic_of.get(type(message))
+            if topic is None:
+                raise TypeError(f"{self.robot}: this algorithm sends no {type(message).__name__}")
+            by_topic[topic].append(message)
+        for topic, group in by_topic.items():
+            family, pub = self._outbound[topic]
+            for data in family.encode(stamp_ns, group):
+                pub.publish(data)
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool]:
@@ -213,6 +224,7 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
         for robot in robots:
             nodes.append(ControllerNode(robot, config, scenario=scenario))
             executor.add_node(nodes[-1])
+        share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
         connecting = list(nodes)
         while rclpy.ok():

@@ -57,7 +57,8 @@ topic                 type                                 from -> to        cor
 Frames: ``world`` for poses, resources, pheromones and markers; ``<robot>/base_link`` for the
 scan and the command (odometry: frame ``world``, child ``<robot>/base_link``).
 
-QoS (`qos`): observations, commands and /clock use SENSOR_LOCKSTEP (reliable, keep-last 10);
+QoS (`qos`): observations, commands, /clock and acks use SENSOR_LOCKSTEP (best effort, keep-last 10;
+the lockstep barrier re-sends what was lost);
 markers, robot stats and assignment/state topics STATE_LATCHED (reliable, transient-local,
 depth 1); events, status and pheromones EVENTS (reliable, keep-last 1000).
 Names and types as data: `topics`.

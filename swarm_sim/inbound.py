@@ -74,6 +74,13 @@ class Rejections:
         return f"dropping a message on {where} ({key[1]}{': ' + detail if detail else ''}); {n} so far"
 
 
+def total(*sources: Rejections | None) -> int:
+    """Messages dropped by several `Rejections` together: counts only grow, so a node that
+    publishes its `merged` counts on change compares this number every tick instead of the
+    merged dicts (a dict built per robot per tick in a 112-robot controller process)."""
+    return sum(s.total for s in sources if s is not None)
+
+
 def merged(*sources: Rejections | None) -> dict[tuple[str, str], int]:
     """The counts of several `Rejections` (a node's and its cores') added up."""
     out: Counter[tuple[str, str]] = Counter()

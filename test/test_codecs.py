@@ -266,6 +266,27 @@ def test_gripper_round_trip(ns, carrying):
     assert gripper.decode_gripper(gripper.encode_gripper(ns, carrying)) == (ns, carrying)
 
 
+@FAST
+@given(STAMPS, st.floats(allow_nan=True), st.binary(min_size=0, max_size=4))
+def test_gripper_fast_path_reads_what_the_general_decoder_reads(ns, position, tail):
+    """The world's layout takes a one-unpack path; it must agree with the general decoder, and
+    any other layout (a longer frame id, extra bytes) must take the general path."""
+    data = bytearray(gripper.encode_gripper(ns, False))
+    data[-16:-8] = struct.pack("<d", position)
+    msg = deserialize_message(bytes(data), JointState)
+    assert gripper.decode_gripper(bytes(data)) == (ns, bool(position > 0.5))
+    assert gripper.decode_gripper(serialize_message(msg)) == (ns, bool(position > 0.5))
+    msg.header.frame_id = "b" * len(tail)
+    assert gripper.decode_gripper(serialize_message(msg)) == (ns, bool(position > 0.5))
+
+
+def test_gripper_fast_path_refuses_a_bad_stamp():
+    data = bytearray(gripper.encode_gripper(5, True))
+    data[8:12] = struct.pack("<I", 10**9)  # nanosec
+    with pytest.raises(CodecError, match="JointState.*nanosec"):
+        gripper.decode_gripper(bytes(data))
+
+
 def test_gripper_finds_its_joint_among_others():
     msg = JointState(
         header=header(1, "base"), name=["wheel", "gripper"], position=[3.0, 1.0],

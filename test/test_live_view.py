@@ -111,13 +111,14 @@ def test_a_websocket_client_subscribes_and_decodes_the_live_run(tmp_path):
     # and its metadata.yaml has each topic's offered QoS and type hash, as `ros2 bag record` writes them
     meta = yaml.safe_load((tmp_path / "bag" / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     recorded_topics = {t["topic_metadata"]["name"]: t["topic_metadata"] for t in meta["topics_with_message_count"]}
-    for topic, durability, depth in (("/robot_0/odom", "volatile", 10), ("/robot_1/cmd_vel", "volatile", 10),
-                                     ("/robot_0/status", "volatile", 1000), ("/center/markers", "transient_local", 1),
-                                     ("/center/reports", "volatile", 1000), ("/clock", "volatile", 10)):
+    for topic, reliability, durability, depth in (
+            ("/robot_0/odom", "best_effort", "volatile", 10), ("/robot_1/cmd_vel", "best_effort", "volatile", 10),
+            ("/robot_0/status", "reliable", "volatile", 1000), ("/center/markers", "reliable", "transient_local", 1),
+            ("/center/reports", "reliable", "volatile", 1000), ("/clock", "best_effort", "volatile", 10)):
         t = recorded_topics[topic]
         (profile,) = t["offered_qos_profiles"]
         assert (profile["reliability"], profile["durability"], profile["depth"], profile["history"]) == (
-            "reliable", durability, depth, "keep_last"), topic
+            reliability, durability, depth, "keep_last"), topic
         assert profile["deadline"] == {"sec": 9223372036, "nsec": 854775807}
         assert t["type_description_hash"] == store.hash_rihs01(t["type"]) and t["type_description_hash"].startswith("RIHS01_")
 

@@ -12,6 +12,7 @@ from rclpy.node import Node
 
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_msgs_py.executor import share_sim_time
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
@@ -168,6 +169,39 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
         executor.shutdown()
         node.destroy_node()
         peer.destroy_node()
+
+
+def test_controllers_in_one_process_share_one_clock_subscription(context):
+    """Three controller nodes of one process: one /clock subscription, every clock on sim time."""
+    from builtin_interfaces.msg import Time
+    from rosgraph_msgs.msg import Clock
+
+    nodes = [ControllerNode(f"robot_{i}", ControllerConfig(overrides=SMALL), context=context) for i in range(3)]
+    peer = Node("peer", context=context)
+    clock_pub = peer.create_publisher(Clock, "/clock", SENSOR_LOCKSTEP)
+    executor = SingleThreadedExecutor(context=context)
+    for n in (*nodes, peer):
+        executor.add_node(n)
+    try:
+        assert peer.count_subscribers("/clock") == 3  # rclpy's default: one per node
+        share_sim_time(nodes)
+        for _ in range(100):
+            executor.spin_once(timeout_sec=0.02)
+            if peer.count_subscribers("/clock") == 1 and clock_pub.get_subscription_count() == 1:
+                break
+        assert peer.count_subscribers("/clock") == 1
+        for sec in (5, 7):
+            clock_pub.publish(Clock(clock=Time(sec=sec, nanosec=250)))
+            for _ in range(100):
+                executor.spin_once(timeout_sec=0.02)
+                if all(n.get_clock().now().nanoseconds == sec * 10**9 + 250 for n in nodes):
+                    break
+            assert [n.get_clock().now().nanoseconds for n in nodes] == [sec * 10**9 + 250] * 3
+        assert all(n.get_parameter("use_sim_time").value for n in nodes)
+    finally:
+        executor.shutdown()
+        for n in (*nodes, peer):
+            n.destroy_node()
 
 
 def test_controller_node_refuses_bad_robot_id(context):

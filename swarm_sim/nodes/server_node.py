@@ -35,7 +35,7 @@ from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
 from swarm_sim import registry
-from swarm_sim.inbound import Inbound, Reason, Rejections, merged
+from swarm_sim.inbound import Inbound, Reason, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
 from swarm_sim.protocol import Server
 from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
@@ -73,7 +73,8 @@ class ServerNode(Node):
         self.rejections = Rejections()
         self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
                                self.get_logger().warning)
-        self._published_rejections: dict = {}
+        self._published_rejections = 0
+        """Messages dropped so far, as last published on ``/diagnostics``."""
         self.lost: list[str] = []
         """Robots the world declared dead, not yet told to the core."""
         self._done = -1
@@ -150,11 +151,11 @@ class ServerNode(Node):
                 for data in family.encode(stamp, messages):
                     pub.publish(data)
             self.publish_state(stamp)
-            counts = merged(self.rejections, getattr(self.server, "rejections", None))
-            if counts != self._published_rejections:
-                self._published_rejections = counts
-                self._diagnostics_pub.publish(
-                    diagnostics.encode_rejections(stamp, self.get_fully_qualified_name(), counts))
+            core = getattr(self.server, "rejections", None)
+            if (dropped := total(self.rejections, core)) != self._published_rejections:
+                self._published_rejections = dropped
+                self._diagnostics_pub.publish(diagnostics.encode_rejections(
+                    stamp, self.get_fully_qualified_name(), merged(self.rejections, core)))
             self._done = stamp
         if stamp == self._done:
             self._ack_pub.publish(ack.encode_ack(self.CHANNEL, stamp))
