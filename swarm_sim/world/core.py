@@ -54,6 +54,7 @@ import pybullet as p
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.world.start import start_positions
@@ -296,6 +297,8 @@ class World:
         self._avoidance_ticks = np.zeros(n, dtype=np.int64)
         self._ring_ahead = np.zeros(n, dtype=bool)
         """Whose proximity ring saw something ahead in the last observations."""
+        self._pairs = RobotPairs(s.sensors.scan.range_max + self._radius)
+        """The analytic scan's robot pairs, kept from tick to tick."""
         self.stats: dict[RobotId, RobotStats] = {r: RobotStats() for r in self.robots}
         self.tick = 0
         self._read_state()
@@ -508,7 +511,8 @@ class World:
             )
         else:
             ranges = cast_scan(
-                self._pos, self._yaw, self._radius, self._scene, sc.rays, sc.fov, sc.range_max, sc.range_min
+                self._pos, self._yaw, self._radius, self._scene, sc.rays, sc.fov, sc.range_max, sc.range_min,
+                self._pairs,
             )
         ranges.flags.writeable = False
         self._ring_ahead = self._ring.ahead(ranges)
