@@ -68,7 +68,7 @@ def test_reset_observations_at_tick_zero(make_world):
 
 
 def test_inlined_wire_yaw_is_bit_identical():
-    from swarm_sim.world.core import _wire_yaw
+    from swarm_sim.world.observations import _wire_yaw
 
     rng = np.random.default_rng(0)
     values = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-17, 7.0, -20.0, *rng.uniform(-10, 10, 2000)]
@@ -76,7 +76,7 @@ def test_inlined_wire_yaw_is_bit_identical():
 
 
 def test_fast_observation_constructor_equals_the_dataclass_one():
-    from swarm_sim.world.core import _new_observation
+    from swarm_sim.world.observations import _new_observation
 
     args = ("robot_1", 5, Pose2D(1.0, 2.0, 0.5), 0.1, -0.2, np.ones(3, np.float32), ("sensed",), ())
     fast, slow = _new_observation(*args), Observation(*args)
@@ -85,6 +85,37 @@ def test_fast_observation_constructor_equals_the_dataclass_one():
         assert getattr(fast, f.name) is getattr(slow, f.name)
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.sensed = None
+
+
+@pytest.mark.parametrize("slots", ["filled", "constructor"])
+def test_swarm_observations_equal_the_dataclass_ones(slots):
+    """Built field by field for the whole swarm (or, should the dataclasses change, by their
+    constructors): the same objects as Observation(...) and Pose2D(...) give, field for field."""
+    import swarm_sim.world.observations as observations
+
+    rng = np.random.default_rng(1)
+    n = 7
+    robots = tuple(f"robot_{i}" for i in range(n))
+    odometry = np.column_stack([rng.normal(size=(n, 2)), rng.uniform(-4.0, 4.0, n)])
+    speeds, turns = rng.normal(size=n), rng.normal(size=n)
+    ranges = rng.uniform(0.0, 3.0, (n, 24)).astype(np.float32)
+    sensed = [("sensed", i) for i in range(n)]
+    with pytest.MonkeyPatch.context() as m:
+        if slots == "constructor":
+            m.setattr(observations, "_OBSERVATION_SETTERS", None)
+            m.setattr(observations, "_POSE_SETTERS", None)
+        got = observations.observations(robots, 42, odometry, speeds, turns, ranges, sensed)
+    assert list(got) == list(robots)
+    for i, r in enumerate(robots):
+        x, y, yaw = odometry[i].tolist()
+        want = Observation(r, 42, Pose2D(x, y, wire_yaw(yaw)), float(speeds[i]), float(turns[i]), ranges[i],
+                           sensed[i], ())
+        o = got[r]
+        assert type(o) is Observation and type(o.pose) is Pose2D and o == want
+        assert type(o.pose.x) is float and type(o.linear_velocity) is float and o.sensed is sensed[i]
+        assert o.ranges.base is ranges and np.array_equal(o.ranges, ranges[i])
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            o.pose.x = 0.0
 
 
 def test_reset_after_teleport_restores_the_start(make_world):

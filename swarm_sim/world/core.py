@@ -42,11 +42,12 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import dataclasses
 import math
 import os
 import sys
+from collections import deque
 from collections.abc import Iterable, Mapping
+from itertools import repeat
 
 import numpy as np
 import pybullet as p
@@ -54,6 +55,8 @@ import pybullet as p
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.observations import observations
+from swarm_sim.world.observations import with_messages as with_messages  # the batch runner's import
 from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
@@ -82,8 +85,6 @@ SOLVER_ITERATIONS = 10
 """pybullet constraint solver iterations per substep (its default, 50, buys nothing here)."""
 
 
-_TWO_PI = 2.0 * math.pi
-
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 _malloc_tuned = False
 
@@ -109,60 +110,6 @@ def tune_malloc() -> None:
         libc.mallopt(_M_MMAP_THRESHOLD, 16 << 20)
     except (OSError, AttributeError):
         pass
-
-
-def _wire_yaw(
-    yaw: float, sin=math.sin, cos=math.cos, atan2=math.atan2, remainder=math.remainder
-) -> float:
-    """`geometry.wire_yaw` inlined (the same operations in the same order, so bit-identical) -
-    it runs for every robot on every tick."""
-    wrapped = remainder(2.0 * atan2(sin(yaw / 2), cos(yaw / 2)), _TWO_PI)
-    return math.pi if wrapped == -math.pi else wrapped
-
-
-def _observation_factory():
-    """A positional Observation constructor that skips the frozen dataclass __init__.
-
-    The generated __init__ of a frozen dataclass sets each field through object.__setattr__,
-    which made building 112 observations per tick ~40% slower than filling the slots directly.
-    Used only while Observation has exactly these fields and no __post_init__; otherwise the
-    ordinary constructor (test_world checks both give equal objects).
-    """
-    expected = ("robot", "stamp_ns", "pose", "linear_velocity", "angular_velocity", "ranges",
-                "sensed", "messages")
-    fields = tuple(f.name for f in dataclasses.fields(Observation))
-    plain = hasattr(Observation, "__slots__") and not hasattr(Observation, "__post_init__")
-    if fields != expected or not plain:
-        return lambda *values: Observation(*values)
-    robot, stamp, pose, lin, ang, ranges, sensed, messages = (
-        getattr(Observation, name).__set__ for name in expected
-    )
-    new = object.__new__
-
-    def make(r, s, q, v, w, g, d, m):  # noqa: PLR0913 - one argument per field
-        o = new(Observation)
-        robot(o, r)
-        stamp(o, s)
-        pose(o, q)
-        lin(o, v)
-        ang(o, w)
-        ranges(o, g)
-        sensed(o, d)
-        messages(o, m)
-        return o
-
-    return make
-
-
-_new_observation = _observation_factory()
-
-
-def with_messages(obs: Observation, messages: tuple[object, ...]) -> Observation:
-    """A copy of `obs` carrying `messages` (what ``dataclasses.replace`` gives, for a fifth of its
-    cost: the batch runner hands every robot its messages on every tick)."""
-    return _new_observation(obs.robot, obs.stamp_ns, obs.pose, obs.linear_velocity, obs.angular_velocity,
-                            obs.ranges, obs.sensed, messages)
-
 
 
 @contextlib.contextmanager
@@ -445,8 +392,8 @@ class World:
         step = p.stepSimulation
         contacts = p.getContactPoints
         bodies = self._bodies
-        w = self._w.tolist()
         zeros = [0.0] * n
+        angular = list(zip(zeros, zeros, self._w.tolist()))
         touched_any: set[int] = set()
         after_substep = getattr(self.task, "after_substep", None)
         for j in range(self._substeps):
@@ -454,8 +401,8 @@ class World:
             vx = (self._v * np.cos(yaw)).tolist()
             vy = (self._v * np.sin(yaw)).tolist()
             vz = ((self._z0 - self._z) / h).tolist() if j == 0 else zeros
-            for body, a, b, c, d in zip(bodies, vx, vy, vz, w):
-                reset_velocity(body, (a, b, c), (0.0, 0.0, d), cid)  # positional: cheaper
+            # One C-level loop of positional calls (1000 robots: ~0.15 ms a tick less than a for loop).
+            deque(map(reset_velocity, bodies, zip(vx, vy, vz), angular, repeat(cid)), maxlen=0)
             step(physicsClientId=cid)
             if after_substep is not None:
                 after_substep(h)
@@ -516,20 +463,7 @@ class World:
             )
         ranges.flags.writeable = False
         self._ring_ahead = self._ring.ahead(ranges)
-        rows = list(ranges)
-
-        sensed = self.task.sense()
-        stamp = self.t_ns
-        xs = self._odo[:, 0].tolist()
-        ys = self._odo[:, 1].tolist()
-        yaws = self._odo[:, 2].tolist()
-        vs = self._meas_v.tolist()
-        ws = self._meas_w.tolist()
-        new = _new_observation
-        obs = {
-            r: new(r, stamp, Pose2D(xs[i], ys[i], _wire_yaw(yaws[i])), vs[i], ws[i], rows[i], sensed[i], ())
-            for i, r in enumerate(self.robots)
-        }
+        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, self.task.sense())
         self._obs_cache = obs
         return dict(obs)
 

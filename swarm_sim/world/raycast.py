@@ -263,12 +263,15 @@ def _cast_robots(
         pos -= nearest
         pos *= pos
         q = np.flatnonzero(pos <= half2)
-        back, pair = np.divmod(q, len(i))
-        robot = np.where(back == 1, j.take(pair), i.take(pair))
-        sign = 1.0 - 2.0 * back  # (dx, dy) from robot j is -(dx, dy) from robot i
-        k = nearest.ravel().take(q).astype(np.int64) % rays
-        _hit_circles(best, ux, uy, robot * rays + k, dx.take(pair) * sign, dy.take(pair) * sign,
-                     d2.take(pair), r2, False)
+        back = np.searchsorted(q, len(i))  # q[back:] are the j -> i ones
+        pair = q.copy()
+        pair[back:] -= len(i)
+        robot = np.concatenate([i.take(pair[:back]), j.take(pair[back:])])
+        dx_q, dy_q = dx.take(pair), dy.take(pair)
+        np.negative(dx_q[back:], out=dx_q[back:])  # (dx, dy) from robot j is -(dx, dy) from robot i
+        np.negative(dy_q[back:], out=dy_q[back:])
+        k = nearest.ravel().take(q).astype(np.intp) % rays
+        _hit_circles(best, ux, uy, robot * rays + k, dx_q, dy_q, d2.take(pair), r2, False)
     if len(wide):
         i, j, dx, dy, d2, bearing = i[wide], j[wide], dx[wide], dy[wide], d2[wide], bearing[wide]
         _cast_circles(
