@@ -473,3 +473,107 @@ def test_reset_replays_the_run(make_world):
     first = run(w, 50, seed=2)
     second = run(w, 50, seed=2)
     assert first == second
+
+
+# --------------------------------------------------------------------------- velocities pybullet keeps
+
+
+def sticky_commands(robots, rng: np.random.Generator, last: dict) -> dict:
+    """Commands as behaviours give them: most robots keep theirs, many stand still, turn in place
+    or drive straight (what lets the world skip setting velocities pybullet already holds)."""
+    out = {}
+    for r in robots:
+        u = rng.uniform()
+        if r in last and u < 0.6:
+            out[r] = last[r]
+        elif u < 0.7:
+            out[r] = Command(0.0, 0.0)
+        elif u < 0.8:
+            out[r] = Command(0.0, float(rng.choice([-1.5, 1.5])))
+        elif u < 0.9:
+            out[r] = Command(0.16, 0.0)
+        else:
+            out[r] = Command(float(rng.uniform(-0.05, 0.2)), float(rng.uniform(-2.5, 2.5)))
+    return out
+
+
+def trajectory(s: Scenario, seed: int, ticks: int, always_set: bool) -> list:
+    """True poses, observations and stats of a run of sticky commands (a teleport half-way)."""
+    rng = np.random.default_rng(seed)
+    out, last = [], {}
+    with World(s) as w, pytest.MonkeyPatch.context() as m:
+        if always_set:  # the reference: every velocity set on every substep
+            m.setattr(w, "_velocities_kept", lambda touching: np.zeros(len(touching), dtype=bool))
+        obs = w.reset()
+        for k in range(ticks):
+            if k == ticks // 2:
+                w.teleport({w.robots[0]: Pose2D(0.3, 0.4, 1.0)})
+            last = sticky_commands(w.robots, rng, last)
+            obs = w.step(last)
+            out.append((w.positions.tobytes(), w.headings.tobytes(), obs))
+        out.append({r: dataclasses.replace(st) for r, st in w.stats.items()})
+    return out
+
+
+@settings(max_examples=6, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 2**31), robots=st.integers(8, 25), arena=st.sampled_from([2.5, 3.0]))
+def test_skipping_velocities_pybullet_keeps_changes_nothing(seed, robots, arena):
+    """A crowded swarm pushing, turning and stopping: bit for bit the run that sets every velocity."""
+    s = load_scenario("cpfa", robots__count=robots, arena__size=arena, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    skipping = trajectory(s, seed, 120, always_set=False)
+    assert skipping == trajectory(s, seed, 120, always_set=True)
+    assert sum(st.collision_time_s for st in skipping[-1].values()) > 0  # robots did touch
+
+
+def _holds_what_was_set(w: World, i: int) -> bool:
+    (vx, vy, vz), (ax, ay, az) = p.getBaseVelocity(i, physicsClientId=w.client)
+    return (vx, vy, vz, az) == tuple(w._held[i]) and ax == ay == 0.0
+
+
+def test_pybullet_holds_exactly_the_velocities_taken_as_kept(make_world):
+    """What `_velocities_kept` rests on: a robot it selects reads back, bit for bit, the velocity
+    last set (and some robots it does not select do not)."""
+    s = load_scenario("cpfa", robots__count=25, arena__size=3.0, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    w = make_world(s)
+    rng = np.random.default_rng(0)
+    w.reset()
+    kept = changed = 0
+    last: dict = {}
+    for _ in range(100):
+        last = sticky_commands(w.robots, rng, last)
+        w.step(last)
+        for i in range(w._n):
+            exact = _holds_what_was_set(w, i)
+            if w._kept[i]:
+                assert exact, i
+                kept += 1
+            changed += not exact
+    assert kept > 1000 and changed > 100
+
+
+@pytest.mark.parametrize("how", ["teleported", "set upright"])
+def test_a_robot_whose_pose_was_reset_gets_its_velocity_set_again(make_world, how):
+    """Resetting a pose zeroes the velocity pybullet holds: the next substep must set it again,
+    although the command did not change."""
+    w = make_world(scenario(1))
+    w.reset()
+    w.teleport({w.robots[0]: Pose2D(-1.0, 0.5, 0.0)})  # heading 0: the same velocity bits after the reset
+    go = {w.robots[0]: Command(0.16, 0.0)}
+    for _ in range(3):
+        w.step(go)
+    assert w._kept[0] and _holds_what_was_set(w, 0)  # driving straight, touching nothing
+    if how == "teleported":
+        w.teleport({w.robots[0]: Pose2D(0.5, 0.5, 0.0)})
+        start = w.positions[0].copy()
+        w.step(go)
+        assert w.positions[0, 0] - start[0] == pytest.approx(0.016, abs=1e-6)
+    else:  # tilted behind the world's back: its read-back sets it upright, zeroing the velocity
+        (x, y, z), _ = p.getBasePositionAndOrientation(0, physicsClientId=w.client)
+        tilt = (math.sin(5e-4), 0.0, 0.0, math.cos(5e-4))
+        p.resetBasePositionAndOrientation(0, (x, y, z), tilt, physicsClientId=w.client)
+        p.resetBaseVelocity(0, tuple(w._held[0, :3]), (0.0, 0.0, 0.0), physicsClientId=w.client)
+        w._read_state()
+        assert p.getBasePositionAndOrientation(0, physicsClientId=w.client)[1][0] == 0.0  # upright again
+    assert not w._kept[0] or _holds_what_was_set(w, 0)
