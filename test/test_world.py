@@ -227,6 +227,45 @@ def test_the_shared_readings_of_robots_detecting_nothing_equal_their_own(make_wo
     assert carrying == [False, True, False, True, False, False]
 
 
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), robots=st.integers(1, 40), resources=st.integers(1, 400))
+def test_resources_in_reach_by_cells_are_those_of_testing_every_pair(seed, robots, resources):
+    """The grid search finds exactly the (robot, resource) pairs testing every pair finds: within
+    the radius and inside the strip [x - r, x + r] as rounded, also for resources placed one ulp
+    either side of a robot's strip or circle, and for robots and resources off the grid."""
+    import swarm_sim.world.tasks.foraging as foraging
+
+    rng = np.random.default_rng(seed)
+    s = load_scenario("cpfa", robots__count=robots, arena__size=6.0, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    with World(s) as w:
+        w.teleport({r: Pose2D(*rng.uniform(-3.5, 3.5, 2), 0.0) for r in w.robots})  # the arena: +-3 m
+        task = w.task
+        pos, r = w.positions, task._near_r
+        near = pos[rng.integers(0, robots, resources)]
+        xy = near + rng.uniform(-1.5 * r, 1.5 * r, near.shape)
+        edge = rng.uniform(size=resources) < 0.3  # on the strip's or circle's edge
+        side = np.where(rng.uniform(size=resources) < 0.5, -1.0, 1.0)
+        xy[edge, 0] = np.nextafter(near[edge, 0] + side[edge] * r, rng.choice([-np.inf, np.inf], edge.sum()))
+        xy[edge, 1] = near[edge, 1]
+        task._res_xy, task._on_ground = xy, np.ones(resources, dtype=bool)
+        task._ground_changed()
+        def d2(a, b):
+            return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1])
+
+        want = sorted(
+            (i, d2(g_xy, xy_i), g)
+            for i, xy_i in enumerate(pos.tolist()) for g, g_xy in enumerate(xy.tolist())
+            if d2(g_xy, xy_i) <= r * r and xy_i[0] - r <= g_xy[0] <= xy_i[0] + r
+        )
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(foraging, "_ALL_PAIRS", 0)  # always the cells
+            robot, g, dist2 = task._near_resources()
+    assert list(zip(robot.tolist(), dist2.tolist(), g.tolist())) == want
+    i, j = np.divmod(task._cells(np.array([[-3.0, -3.0], [3.0, 3.0]])), task._grid)  # the arena's corners
+    assert i.tolist() == j.tolist() == [1, math.floor(6.0 / task._cell) + 1] and i[1] <= task._grid - 2
+
+
 # --------------------------------------------------------------------------- gripper
 
 
