@@ -513,7 +513,8 @@ class World:
             )
         ranges.flags.writeable = False
         self._ring_ahead = self._ring.ahead(ranges)
-        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, self.task.sense())
+        sensed = self.task.sense()
+        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed)
         self._obs_cache = obs
         return dict(obs)
 

@@ -236,11 +236,12 @@ def _cast_robots(
     the window a robot subtends is narrower than that (with 24 rays: beyond ~0.65 m for a robot
     of radius 0.085 m). Then only the ray nearest to the bearing can lie in the window, and one
     rounding per pair and direction finds it: no ragged windows to expand (1000 robots on
-    38 x 38 m, ~80,000 pairs in reach: scan 4.8 -> 3.1 ms a tick). The window is compared squared, so
-    these pairs need no square root: its half-width in rays is tan(asin(r / d)) / inc, as in
-    `_window_half_angles`, and tan^2(asin(x)) = r^2 / (d^2 - r^2). The wider windows (near pairs,
-    a robot inside another, partial fields of view) go through `_ray_windows`. Both only choose
-    which rays the exact test (`_hit_circles`) sees; their windows hold every ray that can hit.
+    38 x 38 m, ~80,000 pairs in reach: scan 4.8 -> 3.1 ms a tick). The window is compared
+    squared, so these pairs need no square root: its half-width in rays is tan(asin(r / d)) /
+    inc, as in `_window_half_angles`, and tan^2(asin(x)) = r^2 / (d^2 - r^2). The wider windows
+    (near pairs, a robot inside another, partial fields of view) go through `_ray_windows`. Both
+    only choose which rays the exact test (`_hit_circles`) sees; their windows hold every ray
+    that can hit.
     """
     bearing = np.arctan2(dy, dx)
     wide = np.arange(len(i))
