@@ -560,7 +560,7 @@ def trajectory(s: Scenario, seed: int, ticks: int, always_set: bool) -> list:
     out, last = [], {}
     with World(s) as w, pytest.MonkeyPatch.context() as m:
         if always_set:  # the reference: every velocity set on every substep
-            m.setattr(w, "_velocities_kept", lambda touching: np.zeros(len(touching), dtype=bool))
+            m.setattr(w, "_velocities_kept", lambda turning, touching: np.zeros(len(touching), dtype=bool))
         obs = w.reset()
         for k in range(ticks):
             if k == ticks // 2:
