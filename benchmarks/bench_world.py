@@ -90,14 +90,16 @@ def time_ticks(world: World, policy, obs: dict, ticks: int) -> tuple[list[tuple[
 
 def breakdown(world: World, policy: Wander, obs: dict, ticks: int) -> dict[str, float]:
     """ms per tick of the parts of step(), measured by calling them one by one."""
-    parts = dict.fromkeys(("commands", "physics", "read+odometry", "gripper", "scan", "observations"), 0.0)
+    parts = dict.fromkeys(("commands", "physics", "read+odometry", "task", "scan", "observations"), 0.0)
     sc = world.scenario.sensors.scan
     scene = StaticScene.from_scenario(world.scenario)
     for _ in range(ticks):
         commands = policy(obs)
         t = [time.perf_counter()]
-        world._apply_commands([world._index[r] for r in commands], commands.values())
+        idx = np.fromiter(map(world._index.__getitem__, commands), np.intp, len(commands))
+        world._apply_commands(idx, commands.values())
         world._fresh = False
+        world._count_avoidance()
         world._obs_cache = None
         pos0, yaw0 = world._pos, world._yaw
         t.append(time.perf_counter())
@@ -106,14 +108,15 @@ def breakdown(world: World, policy: Wander, obs: dict, ticks: int) -> dict[str, 
         world._read_state()
         world._odometry(pos0, yaw0)
         t.append(time.perf_counter())
-        world._gripper((world.tick + 1) * world._dt_ns)
+        world.task.post_step((world.tick + 1) * world._dt_ns)
         world.tick += 1
         t.append(time.perf_counter())
         if sc.backend == "pybullet":
             cast_scan_pybullet(world.client, world._pos, world._yaw, world._z0, world._radius, sc)
         else:
             cast_scan(
-                world._pos, world._yaw, world._radius, scene, sc.rays, sc.fov, sc.range_max, sc.range_min
+                world._pos, world._yaw, world._radius, scene, sc.rays, sc.fov, sc.range_max, sc.range_min,
+                world._pairs,
             )
         t.append(time.perf_counter())
         obs = world.observe()  # includes the scan again; subtract below

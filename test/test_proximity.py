@@ -3,7 +3,7 @@
 import math
 
 import numpy as np
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_sim.scenario import load_scenario
@@ -45,3 +45,24 @@ def test_one_reading_counts_iff_within_the_ahead_angle(bearing, gap):
     k = round((math.radians(bearing) - START) / INC) % RAYS
     angle = math.degrees(math.remainder(START + k * INC, 2 * math.pi))
     assert RING.ahead(_scan({bearing: gap}))[0] == (abs(angle) <= SCENARIO.sensors.proximity_ring.ahead + 1e-9)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 300), near=st.floats(0.0, 1.0))
+def test_readings_are_those_of_the_whole_ring_formula(seed, n, near):
+    """The readings, computed for the rays that hit only, give bit for bit the mean vector of
+    exp(-gap) over every ray (0 where nothing is within range) that the ring's rule is stated in."""
+    rng = np.random.default_rng(seed)
+    ranges = rng.uniform(0.0, 0.4, (n, RAYS))
+    ranges[rng.uniform(size=ranges.shape) > near] = np.inf
+    ranges[rng.uniform(size=ranges.shape) < 0.02] = -np.inf
+    ranges = ranges.astype(np.float32)
+    d = ranges.astype(float) - BODY
+    with np.errstate(invalid="ignore"):
+        hit = d <= RING._range
+        value = np.where(hit, np.exp(-np.maximum(d, 0.0)), 0.0)
+    assert np.exp(-np.maximum(d[hit], 0.0)).tobytes() == value[hit].tobytes()  # what the ring relies on
+    x, y = value @ RING._cos, value @ RING._sin
+    norm = np.hypot(x, y)
+    want = (norm > 0.0) & (x >= RING._cos_ahead * norm)
+    assert np.array_equal(RING.ahead(ranges), want)

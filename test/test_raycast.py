@@ -193,16 +193,111 @@ def test_batched_scan_equals_brute_force(seed, n, crowd, rays, fov):
        range_max=st.sampled_from([0.3, 1.0, 3.5]))
 def test_kd_tree_pairs_give_the_all_pairs_scan_bit_for_bit(seed, n, crowd, range_max):
     """Large swarms find robot pairs with a k-d tree, small ones test all pairs: same ranges."""
-    import swarm_sim.world.raycast as raycast
+    import swarm_sim.world.pairs as pairs
 
     rng = np.random.default_rng(seed)
     origins, headings, scene = random_scene(rng, n, crowd)
     with pytest.MonkeyPatch.context() as m:
-        m.setattr(raycast, "KD_TREE_FROM", 10**9)
+        m.setattr(pairs, "KD_TREE_FROM", 10**9)
         all_pairs = cast_scan(origins, headings, R, scene, 24, FULL, range_max)
-        m.setattr(raycast, "KD_TREE_FROM", 2)
+        m.setattr(pairs, "KD_TREE_FROM", 2)
         tree = cast_scan(origins, headings, R, scene, 24, FULL, range_max)
     assert all_pairs.tobytes() == tree.tobytes()
+
+
+def exact_reference_scan(origins, headings, scene, rays, fov, range_max, range_min=0.0):
+    """`cast_scan`'s own arithmetic on every ray against every shape, without its shortcuts (pairs
+    in reach, angular windows, the nearest-ray path): what it must equal bit for bit. A shape
+    counts if its bounding circle is within reach, as in the scan."""
+    angle_min, inc = scan_angles(rays, fov)
+    angles = headings[:, None] + (angle_min + inc * np.arange(rays))[None, :]
+    ux, uy = np.cos(angles), np.sin(angles)  # (n, rays)
+    ox, oy = origins[:, 0], origins[:, 1]
+    h = scene.half_size
+    with np.errstate(divide="ignore", invalid="ignore"):
+        best = np.maximum(np.fmin((np.copysign(h, ux) - ox[:, None]) / ux, (np.copysign(h, uy) - oy[:, None]) / uy), 0.0)
+
+    def lower(t, valid):  # t, valid: (n, shapes, rays)
+        nonlocal best
+        best = np.minimum(best, np.where(valid, t, np.inf).min(axis=1, initial=np.inf))
+
+    # circles: the other robots and the cylinders (x, y, radius)
+    n = len(origins)
+    c = np.concatenate([np.column_stack([ox, oy, np.full(n, R)]), scene.circles])
+    dx, dy = c[None, :, 0] - ox[:, None], c[None, :, 1] - oy[:, None]
+    d2 = dx * dx + dy * dy
+    r2 = c[:, 2] * c[:, 2]
+    reach = (range_max + c[:, 2]) ** 2
+    counts = (d2 < reach) & ~np.eye(n, len(c), dtype=bool)
+    along = dx[..., None] * ux[:, None, :] + dy[..., None] * uy[:, None, :]
+    disc = r2[None, :, None] - d2[..., None] + along * along
+    inside = (d2 <= r2)[..., None]
+    hit = (disc >= 0.0) & ((along > 0.0) | inside) & counts[..., None]
+    with np.errstate(invalid="ignore"):
+        lower(np.maximum(along - np.sqrt(disc), 0.0), hit)
+
+    # boxes (x, y, half x, half y, yaw): slab test in the box frame
+    b = scene.boxes
+    bound = np.hypot(b[:, 2], b[:, 3])
+    dx, dy = b[None, :, 0] - ox[:, None], b[None, :, 1] - oy[:, None]
+    counts = dx * dx + dy * dy < (range_max + bound) ** 2
+    cos_b, sin_b = np.cos(b[:, 4])[None, :, None], np.sin(b[:, 4])[None, :, None]
+    px, py = -dx[..., None], -dy[..., None]
+    lx, ly = cos_b * px + sin_b * py, -sin_b * px + cos_b * py
+    wx, wy = ux[:, None, :], uy[:, None, :]
+    vx, vy = cos_b * wx + sin_b * wy, -sin_b * wx + cos_b * wy
+    hx, hy = b[None, :, 2, None], b[None, :, 3, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ax, bx = (-hx - lx) / vx, (hx - lx) / vx
+        ay, by = (-hy - ly) / vy, (hy - ly) / vy
+    near = np.fmax(np.fmin(ax, bx), np.fmin(ay, by))
+    far = np.fmin(np.fmax(ax, bx), np.fmax(ay, by))
+    lower(np.maximum(near, 0.0), (near <= far) & (far >= 0.0) & counts[..., None])
+
+    out = best.astype(np.float32)
+    out[out >= np.float32(range_max)] = np.inf
+    if range_min > 0.0:
+        out[out < np.float32(range_min)] = -np.inf
+    return out
+
+
+def crowded_scene(rng: np.random.Generator, n: int, spread: float):
+    """Robots anywhere in a square of side 2 spread, overlapping ones and exact copies included:
+    every kind of robot pair (far, near, touching, one inside the other, coincident)."""
+    origins = rng.uniform(-spread, spread, (n, 2))
+    copies = rng.integers(0, n, n // 4)
+    origins[rng.integers(0, n, n // 4)] = origins[copies]
+    return origins, rng.uniform(-math.pi, math.pi, n)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(2, 40),
+    spread=st.sampled_from([0.2, 1.0, 3.0, 5.8]),
+    rays=st.sampled_from([1, 3, 8, 24, 36]),
+    fov=st.sampled_from([FULL, math.pi, 6.2]),
+    range_max=st.sampled_from([0.14, 1.0, 3.5]),
+    scene=st.sampled_from(["open", "obstacles"]),
+)
+def test_scan_is_its_own_arithmetic_on_every_ray_bit_for_bit(seed, n, spread, rays, fov, range_max, scene):
+    """The windows and the nearest-ray path only choose which rays the exact test sees: never
+    one that would hit less, so the ranges are bit for bit those of testing every ray."""
+    rng = np.random.default_rng(seed)
+    origins, headings = crowded_scene(rng, n, spread)
+    static = OPEN if scene == "open" else random_scene(rng, 1, False)[2]
+    got = cast_scan(origins, headings, R, static, rays, fov, range_max, 0.05)
+    want = exact_reference_scan(origins, headings, static, rays, fov, range_max, 0.05)
+    assert got.tobytes() == want.tobytes()
+
+
+def test_the_exact_reference_agrees_with_the_brute_force_one():
+    """The bit-for-bit reference above is itself right (against the scalar brute force)."""
+    rng = np.random.default_rng(5)
+    origins, headings, scene = random_scene(rng, 20, crowd=True)
+    want = reference_scan(origins, headings, scene, 24, FULL, 3.5)
+    got = exact_reference_scan(origins, headings, scene, 24, FULL, 3.5)
+    np.testing.assert_allclose(got, want.astype(np.float32), rtol=1e-6, atol=1e-6)
 
 
 # --------------------------------------------------------------------------- pybullet

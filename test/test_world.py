@@ -68,7 +68,7 @@ def test_reset_observations_at_tick_zero(make_world):
 
 
 def test_inlined_wire_yaw_is_bit_identical():
-    from swarm_sim.world.core import _wire_yaw
+    from swarm_sim.world.observations import _wire_yaw
 
     rng = np.random.default_rng(0)
     values = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, 1e-17, 7.0, -20.0, *rng.uniform(-10, 10, 2000)]
@@ -76,7 +76,7 @@ def test_inlined_wire_yaw_is_bit_identical():
 
 
 def test_fast_observation_constructor_equals_the_dataclass_one():
-    from swarm_sim.world.core import _new_observation
+    from swarm_sim.world.observations import _new_observation
 
     args = ("robot_1", 5, Pose2D(1.0, 2.0, 0.5), 0.1, -0.2, np.ones(3, np.float32), ("sensed",), ())
     fast, slow = _new_observation(*args), Observation(*args)
@@ -85,6 +85,37 @@ def test_fast_observation_constructor_equals_the_dataclass_one():
         assert getattr(fast, f.name) is getattr(slow, f.name)
     with pytest.raises(dataclasses.FrozenInstanceError):
         fast.sensed = None
+
+
+@pytest.mark.parametrize("slots", ["filled", "constructor"])
+def test_swarm_observations_equal_the_dataclass_ones(slots):
+    """Built field by field for the whole swarm (or, should the dataclasses change, by their
+    constructors): the same objects as Observation(...) and Pose2D(...) give, field for field."""
+    import swarm_sim.world.observations as observations
+
+    rng = np.random.default_rng(1)
+    n = 7
+    robots = tuple(f"robot_{i}" for i in range(n))
+    odometry = np.column_stack([rng.normal(size=(n, 2)), rng.uniform(-4.0, 4.0, n)])
+    speeds, turns = rng.normal(size=n), rng.normal(size=n)
+    ranges = rng.uniform(0.0, 3.0, (n, 24)).astype(np.float32)
+    sensed = [("sensed", i) for i in range(n)]
+    with pytest.MonkeyPatch.context() as m:
+        if slots == "constructor":
+            m.setattr(observations, "_OBSERVATION_SETTERS", None)
+            m.setattr(observations, "_POSE_SETTERS", None)
+        got = observations.observations(robots, 42, odometry, speeds, turns, ranges, sensed)
+    assert list(got) == list(robots)
+    for i, r in enumerate(robots):
+        x, y, yaw = odometry[i].tolist()
+        want = Observation(r, 42, Pose2D(x, y, wire_yaw(yaw)), float(speeds[i]), float(turns[i]), ranges[i],
+                           sensed[i], ())
+        o = got[r]
+        assert type(o) is Observation and type(o.pose) is Pose2D and o == want
+        assert type(o.pose.x) is float and type(o.linear_velocity) is float and o.sensed is sensed[i]
+        assert o.ranges.base is ranges and np.array_equal(o.ranges, ranges[i])
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            o.pose.x = 0.0
 
 
 def test_reset_after_teleport_restores_the_start(make_world):
@@ -176,6 +207,63 @@ def test_detected_resources_are_nearest_first(make_world):
     np.testing.assert_allclose(found, want, atol=1e-9)
     assert found[-1] == (float(corner[0]), float(corner[1]))
     assert all(type(v) is float for xy in found for v in xy)
+
+
+def test_the_shared_readings_of_robots_detecting_nothing_equal_their_own(make_world):
+    """`sense` hands robots that detect nothing one shared reading per gripper state: equal to
+    the reading built from `sense_fields`, robot by robot, carrying or not, detecting or not."""
+    from swarm_sim.world.tasks.foraging import ForagingSense
+
+    w = make_world(scenario(6))
+    xy = w.task.resource_positions()
+    spots = [xy[0] + 0.02, xy[5] + 0.02, (0.0, 0.0), (0.0, 0.6), (0.6, 0.0), (-0.6, 0.0)]
+    w.teleport({r: Pose2D(float(x), float(y), 0.0) for r, (x, y) in zip(w.robots, spots)})
+    w.task._carrying[[1, 3]] = 7, 8  # two robots hold something (one of them detects resources)
+    senses = w.task.sense()
+    detected, carrying = w.task.sense_fields()
+    assert [type(s) for s in senses] == [ForagingSense] * 6
+    assert senses == [ForagingSense(d, c) for d, c in zip(detected, carrying)]
+    assert [bool(d) for d in detected] == [True, True, False, False, False, False]
+    assert carrying == [False, True, False, True, False, False]
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), robots=st.integers(1, 40), resources=st.integers(1, 400))
+def test_resources_in_reach_by_cells_are_those_of_testing_every_pair(seed, robots, resources):
+    """The grid search finds exactly the (robot, resource) pairs testing every pair finds: within
+    the radius and inside the strip [x - r, x + r] as rounded, also for resources placed one ulp
+    either side of a robot's strip or circle, and for robots and resources off the grid."""
+    import swarm_sim.world.tasks.foraging as foraging
+
+    rng = np.random.default_rng(seed)
+    s = load_scenario("cpfa", robots__count=robots, arena__size=6.0, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    with World(s) as w:
+        w.teleport({r: Pose2D(*rng.uniform(-3.5, 3.5, 2), 0.0) for r in w.robots})  # the arena: +-3 m
+        task = w.task
+        pos, r = w.positions, task._near_r
+        near = pos[rng.integers(0, robots, resources)]
+        xy = near + rng.uniform(-1.5 * r, 1.5 * r, near.shape)
+        edge = rng.uniform(size=resources) < 0.3  # on the strip's or circle's edge
+        side = np.where(rng.uniform(size=resources) < 0.5, -1.0, 1.0)
+        xy[edge, 0] = np.nextafter(near[edge, 0] + side[edge] * r, rng.choice([-np.inf, np.inf], edge.sum()))
+        xy[edge, 1] = near[edge, 1]
+        task._res_xy, task._on_ground = xy, np.ones(resources, dtype=bool)
+        task._ground_changed()
+        def d2(a, b):
+            return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1])
+
+        want = sorted(
+            (i, d2(g_xy, xy_i), g)
+            for i, xy_i in enumerate(pos.tolist()) for g, g_xy in enumerate(xy.tolist())
+            if d2(g_xy, xy_i) <= r * r and xy_i[0] - r <= g_xy[0] <= xy_i[0] + r
+        )
+        with pytest.MonkeyPatch.context() as m:
+            m.setattr(foraging, "_ALL_PAIRS", 0)  # always the cells
+            robot, g, dist2 = task._near_resources()
+    assert list(zip(robot.tolist(), dist2.tolist(), g.tolist())) == want
+    i, j = np.divmod(task._cells(np.array([[-3.0, -3.0], [3.0, 3.0]])), task._grid)  # the arena's corners
+    assert i.tolist() == j.tolist() == [1, math.floor(6.0 / task._cell) + 1] and i[1] <= task._grid - 2
 
 
 # --------------------------------------------------------------------------- gripper
@@ -442,3 +530,107 @@ def test_reset_replays_the_run(make_world):
     first = run(w, 50, seed=2)
     second = run(w, 50, seed=2)
     assert first == second
+
+
+# --------------------------------------------------------------------------- velocities pybullet keeps
+
+
+def sticky_commands(robots, rng: np.random.Generator, last: dict) -> dict:
+    """Commands as behaviours give them: most robots keep theirs, many stand still, turn in place
+    or drive straight (what lets the world skip setting velocities pybullet already holds)."""
+    out = {}
+    for r in robots:
+        u = rng.uniform()
+        if r in last and u < 0.6:
+            out[r] = last[r]
+        elif u < 0.7:
+            out[r] = Command(0.0, 0.0)
+        elif u < 0.8:
+            out[r] = Command(0.0, float(rng.choice([-1.5, 1.5])))
+        elif u < 0.9:
+            out[r] = Command(0.16, 0.0)
+        else:
+            out[r] = Command(float(rng.uniform(-0.05, 0.2)), float(rng.uniform(-2.5, 2.5)))
+    return out
+
+
+def trajectory(s: Scenario, seed: int, ticks: int, always_set: bool) -> list:
+    """True poses, observations and stats of a run of sticky commands (a teleport half-way)."""
+    rng = np.random.default_rng(seed)
+    out, last = [], {}
+    with World(s) as w, pytest.MonkeyPatch.context() as m:
+        if always_set:  # the reference: every velocity set on every substep
+            m.setattr(w, "_velocities_kept", lambda turning, touching: np.zeros(len(touching), dtype=bool))
+        obs = w.reset()
+        for k in range(ticks):
+            if k == ticks // 2:
+                w.teleport({w.robots[0]: Pose2D(0.3, 0.4, 1.0)})
+            last = sticky_commands(w.robots, rng, last)
+            obs = w.step(last)
+            out.append((w.positions.tobytes(), w.headings.tobytes(), obs))
+        out.append({r: dataclasses.replace(st) for r, st in w.stats.items()})
+    return out
+
+
+@settings(max_examples=6, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 2**31), robots=st.integers(8, 25), arena=st.sampled_from([2.5, 3.0]))
+def test_skipping_velocities_pybullet_keeps_changes_nothing(seed, robots, arena):
+    """A crowded swarm pushing, turning and stopping: bit for bit the run that sets every velocity."""
+    s = load_scenario("cpfa", robots__count=robots, arena__size=arena, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    skipping = trajectory(s, seed, 120, always_set=False)
+    assert skipping == trajectory(s, seed, 120, always_set=True)
+    assert sum(st.collision_time_s for st in skipping[-1].values()) > 0  # robots did touch
+
+
+def _holds_what_was_set(w: World, i: int) -> bool:
+    (vx, vy, vz), (ax, ay, az) = p.getBaseVelocity(i, physicsClientId=w.client)
+    return (vx, vy, vz, az) == tuple(w._held[i]) and ax == ay == 0.0
+
+
+def test_pybullet_holds_exactly_the_velocities_taken_as_kept(make_world):
+    """What `_velocities_kept` rests on: a robot it selects reads back, bit for bit, the velocity
+    last set (and some robots it does not select do not)."""
+    s = load_scenario("cpfa", robots__count=25, arena__size=3.0, depot__radius=0.3,
+                      resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
+    w = make_world(s)
+    rng = np.random.default_rng(0)
+    w.reset()
+    kept = changed = 0
+    last: dict = {}
+    for _ in range(100):
+        last = sticky_commands(w.robots, rng, last)
+        w.step(last)
+        for i in range(w._n):
+            exact = _holds_what_was_set(w, i)
+            if w._kept[i]:
+                assert exact, i
+                kept += 1
+            changed += not exact
+    assert kept > 1000 and changed > 100
+
+
+@pytest.mark.parametrize("how", ["teleported", "set upright"])
+def test_a_robot_whose_pose_was_reset_gets_its_velocity_set_again(make_world, how):
+    """Resetting a pose zeroes the velocity pybullet holds: the next substep must set it again,
+    although the command did not change."""
+    w = make_world(scenario(1))
+    w.reset()
+    w.teleport({w.robots[0]: Pose2D(-1.0, 0.5, 0.0)})  # heading 0: the same velocity bits after the reset
+    go = {w.robots[0]: Command(0.16, 0.0)}
+    for _ in range(3):
+        w.step(go)
+    assert w._kept[0] and _holds_what_was_set(w, 0)  # driving straight, touching nothing
+    if how == "teleported":
+        w.teleport({w.robots[0]: Pose2D(0.5, 0.5, 0.0)})
+        start = w.positions[0].copy()
+        w.step(go)
+        assert w.positions[0, 0] - start[0] == pytest.approx(0.016, abs=1e-6)
+    else:  # tilted behind the world's back: its read-back sets it upright, zeroing the velocity
+        (x, y, z), _ = p.getBasePositionAndOrientation(0, physicsClientId=w.client)
+        tilt = (math.sin(5e-4), 0.0, 0.0, math.cos(5e-4))
+        p.resetBasePositionAndOrientation(0, (x, y, z), tilt, physicsClientId=w.client)
+        p.resetBaseVelocity(0, tuple(w._held[0, :3]), (0.0, 0.0, 0.0), physicsClientId=w.client)
+        w._read_state()
+        assert p.getBasePositionAndOrientation(0, physicsClientId=w.client)[1][0] == 0.0  # upright again
+    assert not w._kept[0] or _holds_what_was_set(w, 0)

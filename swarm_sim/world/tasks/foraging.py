@@ -12,7 +12,8 @@ scenario asks); an empty robot within the pick-up radius of a resource picks up 
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+import math
+from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -38,11 +39,13 @@ class ForagingSense(NamedTuple):
 _new_sense = functools.partial(tuple.__new__, ForagingSense)
 """ForagingSense from a (resources, carrying) pair without the Python-level NamedTuple
 ``__new__``: built for every robot on every tick (measured: 112 robots, +8 % per tick)."""
+_DETECTING_NOTHING = (_new_sense(((), False)), _new_sense(((), True)))
+"""The reading of a robot that detects no resource, by whether it carries one."""
 
 
 _ALL_PAIRS = 4096
 """Up to this many (robot, resource) pairs every pair is tested at once; more (the queue paper's
-112 robots and 320 resources) go through the sorted x window. Both give the same result."""
+112 robots and 320 resources) go through the grid of cells (`ForagingTask._ground_changed`)."""
 
 
 class ForagingTask:
@@ -60,6 +63,12 @@ class ForagingTask:
         self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
         self._detect_r = s.sensors.resource_detection_radius
         self._pickup_r = s.sensors.pickup_radius
+        self._near_r = max(self._detect_r, self._pickup_r)
+        # The grid of square cells over the arena, an empty ring of cells around it. A cell is a
+        # little wider than the radius, so rounding never puts a resource in reach two cells away.
+        self._cell = self._near_r * (1 + 1e-6)
+        self._grid = math.ceil(s.arena.size / self._cell) + 3
+        self._grid_corner = -s.arena.size / 2 - self._cell  # the lower left corner of cell (0, 0)
         self._ground_version = 0
         # Every resource ever placed keeps its index; `_on_ground` says where it is.
         self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, zones)
@@ -74,43 +83,65 @@ class ForagingTask:
     # ------------------------------------------------------------------ the ground index
 
     def _ground_changed(self) -> None:
-        """Refresh the ground index after a pick-up or a respawn."""
+        """Refresh the ground index after a pick-up or a respawn: the resources on the ground,
+        sorted by the square cell of the grid they lie in, and where each cell's run starts."""
         self._ground_ids = np.nonzero(self._on_ground)[0]
         self._ground_xy = self._res_xy[self._ground_ids]
-        self._ground_by_x = np.argsort(self._ground_xy[:, 0], kind="stable")
-        self._ground_x_sorted = self._ground_xy[self._ground_by_x, 0]
+        cells = self._cells(self._ground_xy)
+        self._ground_by_cell = np.argsort(cells, kind="stable")
+        self._cell_start = np.zeros(self._grid * self._grid + 1, dtype=np.intp)
+        np.cumsum(np.bincount(cells, minlength=self._grid * self._grid), out=self._cell_start[1:])
         self._ground_version += 1
         self._near_cache = None
 
-    def _near_resources(self, radius: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(robot index, ground index, squared distance) of ground resources within `radius` of a
-        robot centre, sorted by robot, then distance, then resource index."""
+    def _cells(self, xy: np.ndarray) -> np.ndarray:
+        """Cell i * grid + j of points (x, y), (i, j) clipped to the grid's inner cells (the outer
+        ring stays empty, so the 3 x 3 cells around any point's cell are 9 distinct cells)."""
+        ij = np.floor((xy - self._grid_corner) / self._cell).astype(np.intp)
+        np.clip(ij, 1, self._grid - 2, out=ij)
+        return ij[:, 0] * self._grid + ij[:, 1]
+
+    def _near_resources(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(robot index, ground index, squared distance) of ground resources within the sensing
+        radius (the larger of detection and pick-up) of a robot centre, sorted by robot, then
+        distance, then resource index.
+
+        Beyond _ALL_PAIRS pairs, each robot looks into the 3 x 3 cells around its own, one run of
+        the sorted resources per column of cells. (1000 robots and 3,200 resources: 0.45 -> 0.18 ms
+        a tick; the strip x +- r searched before held ~300 times the resources within reach.) A
+        resource counts if it is within the radius and inside that strip as rounded, as before, so
+        the result is the same bit for bit (one ulp outside the strip can be within the radius)."""
+        radius = self._near_r
         empty = np.zeros(0, dtype=np.int64)
         if len(self._ground_ids) == 0:
             return empty, empty, np.zeros(0)
         pos = self._world.positions
-        rx = pos[:, 0]
+        rx, ry = pos[:, 0], pos[:, 1]
         if len(rx) * len(self._ground_ids) <= _ALL_PAIRS:
             dx = self._ground_xy[None, :, 0] - rx[:, None]
-            dy = self._ground_xy[None, :, 1] - pos[:, 1, None]
+            dy = self._ground_xy[None, :, 1] - ry[:, None]
             d2 = dx * dx + dy * dy
             robot, g = np.nonzero(d2 <= radius * radius)
             d2 = d2[robot, g]
             order = np.lexsort((g, d2, robot))
             return robot[order], g[order], d2[order]
-        lo = np.searchsorted(self._ground_x_sorted, rx - radius, side="left")
-        hi = np.searchsorted(self._ground_x_sorted, rx + radius, side="right")
-        count = hi - lo
+        # Per robot and column of cells i - 1, i, i + 1: the run of cells j - 1 .. j + 1.
+        bottom = (self._cells(pos)[:, None] + (-self._grid - 1, -1, self._grid - 1)).ravel()
+        lo = self._cell_start[bottom]
+        count = self._cell_start[bottom + 3] - lo
         total = int(count.sum())
         if total == 0:
             return empty, empty, np.zeros(0)
-        robot = np.repeat(np.arange(len(rx)), count)
+        run = np.repeat(np.arange(len(count)), count)
         starts = np.cumsum(count) - count
-        g = self._ground_by_x[np.arange(total) - starts[robot] + lo[robot]]
-        dx = self._ground_xy[g, 0] - rx[robot]
-        dy = self._ground_xy[g, 1] - pos[robot, 1]
+        g = self._ground_by_cell[np.arange(total) - starts[run] + lo[run]]
+        robot = run // 3
+        gx = self._ground_xy[g, 0]
+        x = rx[robot]
+        dx = gx - x
+        dy = self._ground_xy[g, 1] - ry[robot]
         d2 = dx * dx + dy * dy
-        keep = d2 <= radius * radius
+        keep = (d2 <= radius * radius) & (gx >= x - radius) & (gx <= x + radius)
         robot, g, d2 = robot[keep], g[keep], d2[keep]
         order = np.lexsort((g, d2, robot))  # ground order is resource-index order
         return robot[order], g[order], d2[order]
@@ -119,8 +150,7 @@ class ForagingTask:
         """`_near_resources` for the larger of the detection and pick-up radii, once per state."""
         key = self._ground_version
         if self._near_cache is None or self._near_cache[0] != key:
-            radius = max(self._detect_r, self._pickup_r)
-            self._near_cache = (key, *self._near_resources(radius))
+            self._near_cache = (key, *self._near_resources())
         return self._near_cache[1:]
 
     # ------------------------------------------------------------------ WorldTask
@@ -192,13 +222,24 @@ class ForagingTask:
             self._ground_changed()
 
     def sense(self) -> list[ForagingSense]:
-        return list(map(_new_sense, zip(*self.sense_fields())))
+        carrying = (self._carrying >= 0).tolist()
+        # Most robots detect nothing: they share one reading per gripper state (1000 robots: the
+        # readings built in a third of the time).
+        senses = list(map(_DETECTING_NOTHING.__getitem__, carrying))
+        for i, resources in self._detections():
+            senses[i] = _new_sense((resources, carrying[i]))
+        return senses
 
     def sense_fields(self) -> tuple[list[tuple[tuple[float, float], ...]], list[bool]]:
         """Per robot, the resources it detects (nearest first) and whether it carries one: the
         fields of `ForagingSense`, for tasks whose sense extends it."""
-        n = len(self._world.robots)
-        detected: list[tuple[tuple[float, float], ...]] = [()] * n
+        detected: list[tuple[tuple[float, float], ...]] = [()] * len(self._world.robots)
+        for i, resources in self._detections():
+            detected[i] = resources
+        return detected, (self._carrying >= 0).tolist()
+
+    def _detections(self) -> Iterator[tuple[int, tuple[tuple[float, float], ...]]]:
+        """(robot, the resources it detects, nearest first) for every robot that detects any."""
         robot, g, d2 = self._near_cached()
         if len(robot):
             keep = d2 <= self._detect_r ** 2
@@ -206,9 +247,8 @@ class ForagingTask:
             start = 0
             for k in range(1, len(robot) + 1):
                 if k == len(robot) or robot[k] != robot[start]:
-                    detected[robot[start]] = tuple(tuple(xy) for xy in g[start:k])
+                    yield robot[start], tuple(tuple(xy) for xy in g[start:k])
                     start = k
-        return detected, (self._carrying >= 0).tolist()
 
     def drain_events(self) -> list[PickupEvent | DropEvent]:
         events, self._events = self._events, []
