@@ -351,12 +351,29 @@ def cast_scan(
 
     `pairs`: the swarm's `RobotPairs` with reach range_max + robot_radius, kept by the caller
     from tick to tick (default: the pairs are found from scratch)."""
+    hits = nearest_hits(origins, headings, robot_radius, scene, rays, fov, range_max, pairs)
+    return _finish(hits, float(range_min), float(range_max))
+
+
+def nearest_hits(
+    origins: np.ndarray,
+    headings: np.ndarray,
+    robot_radius: float,
+    scene: StaticScene,
+    rays: int,
+    fov: float,
+    range_max: float,
+    pairs: RobotPairs | None = None,
+) -> np.ndarray:
+    """`cast_scan` before its float32 rounding and out-of-range markers: (N, rays) float64, the
+    distance [m] to the nearest hit of every ray (the wall at the latest). The tests compare
+    these bits: the float32 rounding would hide a change in the last bits."""
     origins = np.asarray(origins, dtype=float)
     headings = np.ascontiguousarray(headings, dtype=float)
     n = len(origins)
     angle_min, inc = scan_angles(rays, fov)
     full = is_full_circle(fov)
-    range_max, range_min = float(range_max), float(range_min)
+    range_max = float(range_max)
     ox, oy = origins[:, 0].copy(), origins[:, 1].copy()
     # Ray directions and bearings by numpy: its cos, sin and arctan2 differ from libm's in the
     # last bit now and then, and its arctan2 is ~15x faster than libm's (SIMD).
@@ -385,8 +402,7 @@ def cast_scan(
         bearing = np.arctan2(b[None, :, 1] - oy[:, None], b[None, :, 0] - ox[:, None])
         _lower_by_boxes(best, ux, uy, headings, ox, oy, b, np.hypot(b[:, 2], b[:, 3]), np.cos(b[:, 4]),
                         np.sin(b[:, 4]), bearing, range_max, angle_min, inc, full)
-
-    return _finish(best, range_min, range_max)
+    return best
 
 
 @kernel
