@@ -10,8 +10,8 @@ in reach: rebuilt every ~12 ticks, scan 3.1 -> 2.5 ms a tick; 112 robots on 12 x
 
 Every way gives the same set of pairs, because the candidates are always filtered with the same
 exact ``d2 < reach^2`` test on the same (dx, dy) = origin j - origin i, i < j; only their order
-differs, and the scan keeps the nearest hit per ray with ``np.minimum.at``, which does not
-depend on the order, so its ranges are bit for bit the same either way.
+differs, and the scan keeps the nearest hit per ray (a minimum), which does not depend on the
+order, so its ranges are bit for bit the same either way.
 """
 
 from __future__ import annotations
@@ -65,8 +65,8 @@ def _filter(
     """`_within` compiled (fastmath off: the same IEEE operations as numpy's dx * dx + dy * dy).
 
     Every candidate is written at the next free place and kept by advancing that place only if
-    it is near: no branch on a test whose outcome the CPU cannot predict (1000 robots, ~100,000
-    candidates: 0.55 -> 0.xx ms a tick)."""
+    it is near: no branch on a test whose outcome the CPU cannot predict. (1000 robots, ~103,000
+    candidates, ~85,000 of them near: 0.55 -> 0.21 ms, against numpy's eight passes.)"""
     n = len(i)
     near_i, near_j = np.empty(n, np.intp), np.empty(n, np.intp)
     near_dx, near_dy, near_d2 = np.empty(n), np.empty(n), np.empty(n)
