@@ -316,7 +316,8 @@ def test_rays_grazing_a_robot_are_their_own_arithmetic_bit_for_bit(seed, rays, f
     heading = rng.uniform(-math.pi, math.pi)
     angles = heading + angle_min + inc * rng.integers(0, rays, 12)
     tangent = math.asin(R / distance)
-    offsets = rng.choice([0.0, tangent, -tangent, 0.5 * inc, tangent * (1 + 1e-12), tangent * (1 - 1e-12)], 12)
+    offsets = rng.choice([0.0, tangent, -tangent, 0.5 * inc, tangent * (1 + 1e-12), tangent * (1 - 1e-12)],
+                         12)
     d = distance * rng.choice([1.0, 1.0 + 1e-15, 1.0 - 1e-15], 12)
     others = np.column_stack([d * np.cos(angles + offsets), d * np.sin(angles + offsets)])
     origins = np.vstack([[[0.0, 0.0]], others])

@@ -22,10 +22,10 @@ both); later processes (sweep workers, the graph's world node) load it instead. 
 process, measured as a 1 s, 16-robot CPFA batch run (0.06 s without numba): compiling 3.2 s
 (the obstacle kernels 0.8 s more, only in scenarios with obstacles), loading from the cache
 0.4 s, plus 0.2 s to import numba. A sweep's fork pool pays that once per worker, not per run.
-Concurrent first runs each compile and write the same files (numba writes them atomically). The cache is keyed by the source file's modification time
-and size and by the CPU, so an edited file or another machine compiles afresh. Where no cache
-directory is writable at all, the kernels compile in memory in every process (with a warning,
-once).
+Concurrent first runs each compile and write the same files (numba writes them atomically).
+The cache is keyed by the source file's modification time and size and by the CPU, so an edited
+file or another machine compiles afresh. Where no cache directory is writable at all, the
+kernels compile in memory in every process (with a warning, once).
 """
 
 from __future__ import annotations

@@ -126,8 +126,8 @@ class ForagingTask:
             d2 = d2[robot, g]
             order = np.lexsort((g, d2, robot))
             return robot[order], g[order], d2[order]
-        return _near_in_cells(rx, ry, self._cells(pos), self._ground_xy, self._ground_by_cell, self._cell_start,
-                              self._grid, radius)
+        return _near_in_cells(rx, ry, self._cells(pos), self._ground_xy, self._ground_by_cell,
+                              self._cell_start, self._grid, radius)
 
     def _near_cached(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """`_near_resources` for the larger of the detection and pick-up radii, once per state."""
