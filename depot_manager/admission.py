@@ -351,6 +351,15 @@ class DepotAdmission:
             for o in self._robots.values()
         )
 
+    def last_robots(self) -> frozenset[str]:
+        """The robots `is_last` says are last, for all robots at once (the server asks every
+        tick): on an entry line, at the lowest cell of the robots on that line."""
+        lowest: dict[int, int] = {}
+        for o in self._robots.values():
+            if o.pos < o.entry_len and o.pos < lowest.get(o.entry, o.pos + 1):
+                lowest[o.entry] = o.pos
+        return frozenset(r.name for r in self._robots.values() if r.pos < r.entry_len and r.pos == lowest[r.entry])
+
     @property
     def robots_inside(self) -> tuple[str, ...]:
         return tuple(sorted(self._robots))
