@@ -23,6 +23,7 @@ setup(
     ],
     install_requires=[
         "numpy",
+        "numba",  # compiled world kernels (swarm_sim.world.jit): the scan, its robot pairs
         "pybullet",
         "pyyaml",
         "mcap",

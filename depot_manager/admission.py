@@ -184,12 +184,17 @@ class DepotAdmission:
         only robots dispatched into that same inner queue (``own``; others are kept apart by
         cell ownership and keep-clear alone). Both keep at most two robots per inner queue."""
         self._m = _model(layout)
+        m = self._m
+        self._rank: list[int] = m.rank.tolist()
+        self._bearing: list[float] = m.bearing.tolist()
+        self._intersection: list[bool] = m.intersection.tolist()
+        """The model's per-cell arrays as lists: `step` reads them cell by cell every tick
+        (a numpy element costs ~5x a list item)."""
         self._owner: list[str | None] = [None] * len(self._m.xy)
         self._robots: dict[str, _Robot] = {}
         self._reported: dict[str, tuple[str, int]] = {}
         self._left = 0
         self._t = 0.0
-        m = self._m
         if m.kind == "single":
             e_in = m.xy[m.line_ids[m.entry_names[0]][-1]]
             a0 = _bearing(e_in, m.center)
@@ -321,11 +326,9 @@ class DepotAdmission:
         """Extend grants (FCFS, ties counter-clockwise); -> robots whose grant changed since the
         last step -> (line, furthest granted cell)."""
         self._t = t
-        m = self._m
-        order = sorted(
-            self._robots.values(), key=lambda r: (r.key, m.bearing[r.route[r.pos]], r.name)
-        )
-        claims = np.full(len(m.xy), -1, dtype=int)
+        bearing = self._bearing
+        order = sorted(self._robots.values(), key=lambda r: (r.key, bearing[r.route[r.pos]], r.name))
+        claims = [-1] * len(bearing)
         for r in order:
             self._advance(r, claims)
         changed = {}
@@ -350,6 +353,15 @@ class DepotAdmission:
             o.entry == r.entry and o.pos < r.pos and o.pos < o.entry_len
             for o in self._robots.values()
         )
+
+    def last_robots(self) -> frozenset[str]:
+        """The robots `is_last` says are last, for all robots at once (the server asks every
+        tick): on an entry line, at the lowest cell of the robots on that line."""
+        lowest: dict[int, int] = {}
+        for o in self._robots.values():
+            if o.pos < o.entry_len and o.pos < lowest.get(o.entry, o.pos + 1):
+                lowest[o.entry] = o.pos
+        return frozenset(r.name for r in self._robots.values() if r.pos < r.entry_len and r.pos == lowest[r.entry])
 
     @property
     def robots_inside(self) -> tuple[str, ...]:
@@ -410,11 +422,11 @@ class DepotAdmission:
         return True
 
     def _stoppable(self, r: _Robot, i: int) -> bool:
-        return not self._m.intersection[r.route[i]] or (r.complete and i == len(r.route) - 1)
+        return not self._intersection[r.route[i]] or (r.complete and i == len(r.route) - 1)
 
-    def _extension(self, r: _Robot, claims: np.ndarray) -> int:
+    def _extension(self, r: _Robot, claims: list[int]) -> int:
         """Furthest route index the robot can be granted now (r.end if none)."""
-        rank = self._m.rank[r.route[r.pos]]
+        rank = self._rank[r.route[r.pos]]
         limit = r.pos + self.lookahead
         i = best = r.end
         n = len(r.route)
@@ -443,7 +455,7 @@ class DepotAdmission:
                 break
         return out
 
-    def _claim(self, cells, rank: int, claims: np.ndarray) -> None:
+    def _claim(self, cells, rank: int, claims: list[int]) -> None:
         for c in cells:
             claims[c] = max(claims[c], rank)
             for x in self._m.conflicts[c]:
@@ -454,12 +466,12 @@ class DepotAdmission:
             self._owner[c] = r.name
         r.end = end
 
-    def _advance(self, r: _Robot, claims: np.ndarray) -> None:
+    def _advance(self, r: _Robot, claims: list[int]) -> None:
         m = self._m
         if r.end - r.pos >= self.lookahead:
             return
         stopped = r.end == r.pos
-        rank = int(m.rank[r.route[r.pos]])
+        rank = self._rank[r.route[r.pos]]
         if r.end == r.dock_pos:
             if not r.unloaded:
                 return
@@ -492,7 +504,7 @@ class DepotAdmission:
             return False
         return self._free(int(ids[-1]), r.name)
 
-    def _dispatch(self, r: _Robot, claims: np.ndarray) -> None:
+    def _dispatch(self, r: _Robot, claims: list[int]) -> None:
         """Single queue: send a robot granted up to the inner entry point into an inner queue."""
         m = self._m
         for k in self._dock_order:

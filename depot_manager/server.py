@@ -78,7 +78,8 @@ class DepotServer:
                 self.rejections.add("DepotReport", Reason.REFUSED, f"t={t:.3f} {m.robot} {kind} {m.line}/{m.cell}: {e}")
         changed = adm.step(t)
         inside = adm.robots_inside
-        last = {r: adm.is_last(r) for r in inside}
+        lasts = adm.last_robots()
+        last = {r: r in lasts for r in inside}
         for r in inside:
             if r in changed or last[r] != self._last.get(r):
                 line, cell = changed.get(r) or adm.grant(r)

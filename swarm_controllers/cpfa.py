@@ -82,6 +82,7 @@ from __future__ import annotations
 
 import math
 from enum import Enum
+from math import inf, remainder
 
 import numpy as np
 
@@ -102,6 +103,8 @@ from swarm_sim.types import (
 )
 
 _TWO_PI = 2.0 * math.pi
+_IDLE = (0.0, 0.0)
+"""A state's twist when it stands still, or when the avoidance drives and nobody reads it."""
 _FOUR_PI = 4.0 * math.pi
 _LEG_REDRAWS = 8
 _SITE_REDRAWS = 16
@@ -126,7 +129,9 @@ class SearchMode(Enum):
     PHEROMONE = "pheromone"
 
 
-_DEPARTING, _SEARCHING, _UNINFORMED = CpfaState.DEPARTING, CpfaState.SEARCHING, SearchMode.UNINFORMED
+_DEPARTING, _SEARCHING, _RETURNING, _UNINFORMED = (
+    CpfaState.DEPARTING, CpfaState.SEARCHING, CpfaState.RETURNING, SearchMode.UNINFORMED
+)
 """The members every tick compares against, as module constants: looking a member up on its
 Enum class costs ~0.1 us in Python 3.11 (measured), a global ~0.01 us."""
 
@@ -188,6 +193,7 @@ class CpfaBehaviour:
         """``rng.random`` (the same numbers, cheaper)."""
         self._limits = DriveLimits.from_scenario(scenario)
         self._avoidance = AvoidThenEscape(scenario, escape_distance=cfg.search_step)
+        self._update_avoidance = self._avoidance.update
         self._p_switch = per_tick_probability(
             cfg.probability_of_switching_to_searching, cfg.draw_rate, dt
         )
@@ -306,36 +312,42 @@ class CpfaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
-        pheromones = _pheromones(obs.messages) if obs.messages else ()
-        if pheromones:
-            self._receive(pheromones, obs.stamp_ns)
+        if obs.messages:
+            pheromones = _pheromones(obs.messages)
+            if pheromones:
+                self._receive(pheromones, obs.stamp_ns)
         out: tuple[object, ...] = ()
         carrying = bool(obs.sensed.carrying)
-        if carrying != self._carrying:
+        if carrying is not self._carrying:
             self._carrying = carrying
             if carrying:
                 self._found_resource(obs)
             else:
                 self._trips += 1
                 out = self._at_nest(obs, delivered=True)
-        if self._docks and self._carrying and self._nearest_dock(obs)[1] < self._dock_r2:
+        if self._docks and carrying and self._nearest_dock(obs)[1] < self._dock_r2:
             self._avoidance.reset()  # unloading at a dock: stand still, no avoidance
             return new_command(0.0, 0.0, out)
-        override = self._avoidance.update(obs.ranges)
+        override = self._update_avoidance(obs.ranges)
+        steering = override is None
         state = self._state
-        if state is _DEPARTING:
-            linear, angular = self._departing(obs)
-        elif state is _SEARCHING:
-            linear, angular = self._searching(obs)
+        if state is _SEARCHING:  # the states by how often robots are in them
+            linear, angular = self._searching(obs, steering)
+        elif state is _RETURNING:
+            linear, angular = self._returning(obs, steering)
         else:
-            linear, angular = self._returning(obs)
+            linear, angular = self._departing(obs, steering)
         if override is not None:  # the avoidance's own command, unless messages go out with it
             return override if not out else new_command(override.linear, override.angular, out)
         return new_command(linear, angular, out)
 
     # ------------------------------------------------------------------ states
+    #
+    # Each state's tick runs its rules (and their draws) and returns the (linear, angular) twist
+    # of its motion. On a tick the obstacle avoidance drives (`steering` False: about half the
+    # ticks of a crowded swarm) nothing reads that twist, and it is not computed: `_IDLE`.
 
-    def _departing(self, obs: Observation) -> tuple[float, float]:
+    def _departing(self, obs: Observation, steering: bool = True) -> tuple[float, float]:
         pose = obs.pose
         x, y = pose.x, pose.y
         tx, ty = self._target
@@ -343,31 +355,33 @@ class CpfaBehaviour:
         if self._mode is _UNINFORMED:
             # H&M: an uninformed traveller starts searching with probability p_s per tick.
             if self._random() < self._p_switch or d2 < self._arrival2:
-                return self._start_search(obs)
+                return self._start_search(obs, steering)
         elif d2 < self._arrival2 or (self._avoidance.active and d2 < self._blocked2):
-            return self._start_search(obs)
-        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+            return self._start_search(obs, steering)
+        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits) if steering else _IDLE
 
-    def _start_search(self, obs: Observation) -> tuple[float, float]:
+    def _start_search(self, obs: Observation, steering: bool = True) -> tuple[float, float]:
         self._state = CpfaState.SEARCHING
         self._search_t0 = obs.t
         self._search_legs = 0
         self._new_leg(obs)
-        return self._walk(obs)
+        return self._walk(obs) if steering else _IDLE
 
-    def _searching(self, obs: Observation) -> tuple[float, float]:
+    def _searching(self, obs: Observation, steering: bool = True) -> tuple[float, float]:
         # H&M: a searcher gives up and returns with probability p_r per tick.
         if self._random() < self._p_return:
             self._state = CpfaState.RETURNING
-            return self._returning(obs)
+            return self._returning(obs, steering)
         pose = obs.pose
         if (pose.x - self._leg_x) ** 2 + (pose.y - self._leg_y) ** 2 >= self._step2:
             self._new_leg(obs)
-        return self._walk(obs)
+        if not steering:
+            return _IDLE
+        return steer(remainder(self._heading - pose.yaw, _TWO_PI), inf, self._limits)  # walk the leg
 
     def _walk(self, obs: Observation) -> tuple[float, float]:
-        error = math.remainder(self._heading - obs.pose.yaw, _TWO_PI)
-        return steer(error, math.inf, self._limits)
+        """Along the current leg's heading."""
+        return steer(remainder(self._heading - obs.pose.yaw, _TWO_PI), inf, self._limits)
 
     def _new_leg(self, obs: Observation) -> None:
         """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
@@ -401,19 +415,21 @@ class CpfaBehaviour:
         k = min(range(len(d2)), key=d2.__getitem__)
         return self._docks[k], d2[k]
 
-    def _returning(self, obs: Observation) -> tuple[float, float]:
+    def _returning(self, obs: Observation, steering: bool = True) -> tuple[float, float]:
         pose = obs.pose
         x, y = pose.x, pose.y
         if self._docks and self._carrying:
+            if not steering:
+                return _IDLE
             (tx, ty), _ = self._nearest_dock(obs)
             return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
         nx, ny = self._nest
         d2 = (nx - x) ** 2 + (ny - y) ** 2
         if not self._carrying and d2 < self._nest_r2:
             self._at_nest(obs, delivered=False)  # gave up; no messages on this path
-            return self._departing(obs)
-        if d2 < self._arrival2:
-            return 0.0, 0.0  # at the centre, waiting for the drop
+            return self._departing(obs, steering)
+        if d2 < self._arrival2 or not steering:
+            return _IDLE  # at the centre, waiting for the drop (or the avoidance drives)
         return go_to_point_twist(x, y, pose.yaw, nx, ny, self._limits)
 
     # ------------------------------------------------------------------ events

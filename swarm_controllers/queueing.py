@@ -140,7 +140,10 @@ class QueueBehaviour:
         self._lane = queue.lane_spacing
         self._gamma = scenario.robots.radio_range
         self._tail = queue.joining == "tail"
-        self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._R + KEEP_OUT_BAND)
+        self._keep_out = self._R + KEEP_OUT_BAND
+        """Non-carriers stay outside this radius about the depot centre [m]."""
+        self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out)
+        self._cpfa_step = self._cpfa.step
         self._avoid = AvoidThenEscape(scenario, escape_distance=0.1)
         self._layout, self._cells, self._slots = _queues(DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
         self._entry_lines = tuple(line.name for line in self._layout.entry_lines)
@@ -154,9 +157,14 @@ class QueueBehaviour:
             for i in np.flatnonzero(np.hypot(*(cells - dock.stop).T) < 1e-6)
         }
         self._exit_lines = {line.name for line in self._layout.exit_lines}
-        self._front = tuple(
-            i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE
+        front = [i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE]
+        self._front: slice | list[int] = (
+            slice(front[0], front[-1] + 1) if front and front == list(range(front[0], front[-1] + 1)) else front
         )
+        """The rays of the braking cone (a slice when they are contiguous, as in every sane scan)."""
+        self._brake_range = float(np.float32(BRAKE_RANGE))
+        """BRAKE_RANGE as the float32 the scan's ranges are compared with (numpy compares a
+        float32 with a Python float in float32), for comparing the rays read as Python floats."""
         self._phase = Phase.FORAGING
         self._carrying = False
         self._line = ""  # the line the robot is on (or joining)
@@ -200,16 +208,18 @@ class QueueBehaviour:
         carrying = bool(obs.sensed.carrying)
         dropped = self._carrying and not carrying
         self._carrying = carrying
-        if obs.messages:
-            self._handle(obs, out)
-        x, y = obs.pose.x, obs.pose.y
-        r = math.hypot(x - self._center[0], y - self._center[1])
-        if self._phase is _FORAGING:
-            if carrying and r <= self._R + KEEP_OUT_BAND:
-                self._begin_delivery(obs, r, out)
-            else:
-                return self._forage(obs, r, out)
         phase = self._phase
+        if obs.messages and (phase is _QUEUED or phase is _SEEKING or self.robot in _granted(obs.messages)):
+            self._handle(obs, out)
+            phase = self._phase
+        pose = obs.pose
+        cx, cy = self._center
+        r = math.hypot(pose.x - cx, pose.y - cy)
+        if phase is _FORAGING:
+            if not (carrying and r <= self._keep_out):
+                return self._forage(obs, r, out)
+            self._begin_delivery(obs, r, out)
+            phase = self._phase
         if dropped and phase is _QUEUED:
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, self._line, self._cell))
         if phase is _TO_ENTRY:
@@ -230,7 +240,7 @@ class QueueBehaviour:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
                 self._braked_since = math.inf  # swerved for a second: try the line again
-        elif linear > 0.0 and min(obs.ranges[i] for i in self._front) < BRAKE_RANGE:
+        elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:
             linear = 0.0
             self._braked_since = min(self._braked_since, obs.t)
         else:
@@ -240,11 +250,9 @@ class QueueBehaviour:
     # ------------------------------------------------------------------ messages
 
     def _handle(self, obs: Observation, out: list[object]) -> None:
-        """The tick's messages, in order. A robot neither queued nor seeking that no grant is for
-        need not read them: only queued and seeking robots answer queries and take replies, and
-        only a grant can change the phase."""
-        if not (self._phase is _QUEUED or self._phase is _SEEKING or self.robot in _granted(obs.messages)):
-            return
+        """The tick's messages, in order. Only for a robot queued or seeking or one a grant is for
+        (`step`): only queued and seeking robots answer queries and take replies, and only a grant
+        can change the phase."""
         x, y = obs.pose.x, obs.pose.y
         for m in obs.messages:
             if isinstance(m, DepotGrant):
@@ -315,10 +323,10 @@ class QueueBehaviour:
     # ------------------------------------------------------------------ phases
 
     def _forage(self, obs: Observation, r: float, out: list[object]) -> Command:
-        command = self._cpfa.step(obs)
+        command = self._cpfa_step(obs)
         if out:  # radio replies of this tick go out first
             command = new_command(command.linear, command.angular, (*out, *command.messages))
-        if self._carrying or r > self._R + KEEP_OUT_BAND:
+        if self._carrying or r > self._keep_out:
             return command
         messages = command.messages
         cx, cy = self._center

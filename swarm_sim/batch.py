@@ -19,6 +19,8 @@ import sys
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
+from itertools import chain
+from operator import attrgetter, call
 
 import numpy as np
 
@@ -32,7 +34,6 @@ from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
-from swarm_sim.world.core import with_messages
 
 
 @dataclass
@@ -41,6 +42,8 @@ class BatchRun:
     poses: np.ndarray | None
     """(ticks + 1, robots, 3) odometry poses (x, y, yaw) as the behaviours saw them, if asked."""
 
+
+_MESSAGES = attrgetter("messages")
 
 GC_THRESHOLD = 50_000
 """Tracked objects allocated (net) between two young-generation collections during a run. A tick
@@ -93,21 +96,19 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
-            inbox = router.take_before(ROBOTS, world.t_ns)
-            seen = [obs[r] for r in robots]
-            if inbox:
-                seen = [with_messages(o, inbox) for o in seen]
-            answers = [step(o) for step, o in zip(steps, seen)]
-            for command in answers:
-                for message in command.messages:
-                    router.post(message)
-                    if keep and isinstance(message, keep):
-                        trace.messages.append(message)
+            answers = list(map(call, steps, obs.values()))  # the world's dict is in robot order
+            for message in chain.from_iterable(map(_MESSAGES, answers)):
+                router.post(message)
+                if keep and isinstance(message, keep):
+                    trace.messages.append(message)
             for channel, server in servers.items():
                 for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
                     router.post(message)
             last_step_ns = world.t_ns
-            obs = world.step(dict(zip(robots, answers)))
+            # The next tick's inbox, handed out with its observations: every message stamped
+            # before it has been posted by now (the robots' and servers' of this tick).
+            inbox = router.take_before(ROBOTS, world.t_ns + world.dt_ns)
+            obs = world.step(dict(zip(robots, answers)), inbox)
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
             if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):

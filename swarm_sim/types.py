@@ -10,10 +10,14 @@ nanoseconds so that graph and batch runs compare exactly.
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Annotated, Any
+from typing import Annotated, Any, TypeVar
 
 import numpy as np
+
+T = TypeVar("T")
 
 class _RobotIdMark:
     """Marks a message field that names a robot, so a node can refuse ids of no robot of the
@@ -200,3 +204,53 @@ class BehaviourStatus:
     obstacle_avoidance_events: int
     trips: int
     extra: tuple[tuple[str, str], ...] = field(default=())
+
+
+# ---------------------------------------------------------------------- fast constructors
+
+
+def slot_setters(cls: type) -> tuple[Callable[[Any, Any], None], ...] | None:
+    """The setters of frozen slotted dataclass `cls`'s slots, in field order, or None when building
+    one takes more than setting its fields (a ``__post_init__``, a field left out of ``__init__``
+    or made by a ``default_factory``, no slots).
+
+    A frozen dataclass's generated ``__init__`` sets each field through ``object.__setattr__``;
+    a slot's descriptor sets it for a fraction of that. The world builds an `Observation` and a
+    `Pose2D` per robot per tick, a behaviour a `Command`: what `slot_constructor` and the world's
+    field-by-field build (`swarm_sim.world.observations`) use.
+    """
+    if not dataclasses.is_dataclass(cls) or "__slots__" not in cls.__dict__ or hasattr(cls, "__post_init__"):
+        return None
+    fields = dataclasses.fields(cls)
+    if any(not f.init or f.default_factory is not dataclasses.MISSING for f in fields):
+        return None
+    return tuple(getattr(cls, f.name).__set__ for f in fields)
+
+
+def slot_constructor(cls: type[T]) -> Callable[..., T]:
+    """A constructor of `cls` taking its fields positionally (with their defaults) and filling
+    the slots through `slot_setters`: the same object as ``cls(...)``'s for about a third of
+    the cost (`Command`, measured ~0.33 vs ~0.89 us). `cls` itself when `slot_setters` says no.
+
+    The function is generated, as dataclasses generate ``__init__``: one setter call per field,
+    no loop (a loop over the setters costs as much as it saves)."""
+    setters = slot_setters(cls)
+    if setters is None:
+        return cls
+    fields = dataclasses.fields(cls)
+    names = [f"_{f.name}" for f in fields]  # no clash with the helpers' names below
+    scope: dict[str, Any] = {"_new": object.__new__, "_cls": cls}
+    params = []
+    for name, f, setter in zip(names, fields, setters):
+        scope[f"_set{name}"] = setter
+        if f.default is dataclasses.MISSING:
+            params.append(name)
+        else:
+            scope[f"_default{name}"] = f.default
+            params.append(f"{name}=_default{name}")
+    body = "".join(f"    _set{name}(o, {name})\n" for name in names)
+    source = f"def new_{cls.__name__}({', '.join(params)}):\n    o = _new(_cls)\n{body}    return o\n"
+    exec(source, scope)  # noqa: S102 - our own source text, built from the dataclass's field names
+    make = scope[f"new_{cls.__name__}"]
+    make.__doc__ = f"``{cls.__name__}({', '.join(f.name for f in fields)})``, its slots filled directly."
+    return make

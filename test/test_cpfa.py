@@ -617,3 +617,57 @@ def test_queue_paper_parameter_set():
     assert CpfaConfig.of(bp).rate_of_site_fidelity == CpfaConfig().rate_of_site_fidelity
     with pytest.raises(ValueError, match="controller.cpfa.rate_of_site_fidelity"):
         load_scenario("queue_cpfa", ["controller.cpfa.rate_of_site_fidelity=2.0"])
+
+
+class _AlwaysSteering(CpfaBehaviour):
+    """The reference: every state works out its motion, also on the ticks the avoidance drives
+    (`CpfaBehaviour` skips it then)."""
+
+    def _departing(self, obs, steering=True):
+        return super()._departing(obs, True)
+
+    def _start_search(self, obs, steering=True):
+        return super()._start_search(obs, True)
+
+    def _searching(self, obs, steering=True):
+        return super()._searching(obs, True)
+
+    def _returning(self, obs, steering=True):
+        return super()._returning(obs, True)
+
+
+def _inner_state(b: CpfaBehaviour) -> tuple:
+    return (b.state, b.search_mode, b.target, b.site, b.trips, b.obstacle_avoidance_events, b.pheromones,
+            b._heading, b._leg_x, b._leg_y, b._rng.bit_generator.state["state"]["state"])
+
+
+QUEUE_QMT = load_scenario("queue_qmt")
+
+
+@pytest.mark.parametrize(("s", "keep_out"), [(BASE, None), (QUEUE_CPFA, None), (QUEUE_QMT, QUEUE_QMT.depot.perimeter_radius + 0.25)],
+                         ids=["cpfa", "docks", "keep_out"])
+def test_the_motion_skipped_while_the_avoidance_drives_changes_nothing(s, keep_out):
+    """Same commands, same states and draws as a CPFA that steers on every tick, along a drive
+    (a unicycle) with random obstacles ahead, finds, drops and pheromones."""
+    fast = CpfaBehaviour(s, "robot_0", behaviour_rng(3, "robot_0"), keep_out=keep_out)
+    slow = _AlwaysSteering(s, "robot_0", behaviour_rng(3, "robot_0"), keep_out=keep_out)
+    rng = np.random.default_rng(5)
+    robot, carrying, avoided, states = Unicycle(), False, 0, Counter()
+    for k in range(6000):
+        ranges = CLEAR.copy()
+        if rng.random() < 0.3:
+            ranges[rng.integers(8, 17, 3)] = rng.uniform(0.05, 0.5, 3)
+        if not carrying and rng.random() < 0.004:
+            carrying = True  # a find
+        elif carrying and math.hypot(robot.x, robot.y) < 0.5:
+            carrying = False  # a drop in the depot
+        messages = (PheromoneMessage(k * DT_NS, *map(float, rng.uniform(-4, 4, 2))),) if rng.random() < 0.002 else ()
+        o = robot.observe(ranges=ranges, carrying=carrying, messages=messages)
+        command = fast.step(o)
+        assert command == slow.step(o)
+        assert _inner_state(fast) == _inner_state(slow)
+        robot.apply(command)
+        robot.k += 1
+        avoided += fast._avoidance.active
+        states[fast.state] += 1
+    assert avoided > 500 and min(states.values()) > 200 and fast.trips > 3

@@ -311,6 +311,7 @@ def check_invariants(adm: DepotAdmission, lay: QueueLayout, g: Geo, bots: list[B
         tail = min((b.pos[1] for b in on), default=-1)
         for b in on:
             assert adm.is_last(b.name) == (b.pos[1] == tail)
+    assert adm.last_robots() == {name for name in adm.robots_inside if adm.is_last(name)}  # all at once
 
 
 def check_fcfs(adm: DepotAdmission, g: Geo, before, bots: dict[str, Bot]) -> int:

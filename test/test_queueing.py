@@ -9,12 +9,13 @@ from unittest import mock
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from depot_manager.config import QueueConfig
 from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
-from swarm_controllers.queueing import KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
+from swarm_controllers.avoidance import ray_angles
+from swarm_controllers.queueing import BRAKE_CONE, BRAKE_RANGE, KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
@@ -185,21 +186,20 @@ _queue_messages = st.lists(st.one_of(
 
 
 def _handled(phase, messages, join, line, cell, *, read_all: bool):
-    """State and replies of robot_0 at (1, 0) after `_handle` (or, read_all, after the reference:
-    every message read)."""
+    """Command and state of robot_0 at (1, 0) after a step with `messages` (or, read_all, after
+    the reference: every message read)."""
     s = load_scenario("queue_qmt", ["robots.count=3"])
     b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
     b._phase, b._join, b._line, b._cell = phase, join, line, cell
     ranges = np.full(24, np.inf, dtype=np.float32)
     obs = Observation("robot_0", 10**9, Pose2D(1.0, 0.0, 0.0), 0.0, 0.0, ranges, ForagingSense((), True), messages)
-    out: list[object] = []
     if read_all:
         with mock.patch("swarm_controllers.queueing._granted", lambda _messages: _Everyone()):
-            b._handle(obs, out)
+            command = b.step(obs)
     else:
-        b._handle(obs, out)
+        command = b.step(obs)
     names = ("_phase", "_join", "_line", "_cell", "_grant", "_last", "_retry_at", "_yield_until", "_goal")
-    return out, [getattr(b, n) for n in names], b.rejections.counts, b._rng.bit_generator.state
+    return command, [getattr(b, n) for n in names], b.rejections.counts, b._rng.bit_generator.state
 
 
 _INBOX = (
@@ -213,9 +213,9 @@ _INBOX = (
 @pytest.mark.parametrize("grant", [None, DepotGrant(0, "robot_0", "entry_line_0", 2),
                                    DepotGrant(0, "robot_0", "entry_line_0", -1, reason=Refusal.NOT_BEHIND_TAIL)])
 def test_message_handling_skips_only_what_cannot_matter(phase, grant):
-    """`_handle` returns early for a robot neither queued nor seeking that no grant is for;
-    reading every message instead (the reference) gives the same state and replies, in every
-    phase, with a grant for the robot before the others or none."""
+    """A step does not read the messages of a robot neither queued nor seeking that no grant is
+    for; reading every message instead (the reference) gives the same command, state and
+    replies, in every phase, with a grant for the robot before the others or none."""
     inbox = _INBOX if grant is None else (grant, *_INBOX)
     args = (phase, inbox, ("entry_line_0", 3), "entry_line_0", 1)
     assert _handled(*args, read_all=False) == _handled(*args, read_all=True)
@@ -226,6 +226,7 @@ def test_message_handling_skips_only_what_cannot_matter(phase, grant):
        st.one_of(st.none(), st.tuples(st.sampled_from(_LINES[:2]), st.integers(0, 4))),
        st.sampled_from(("", *_LINES[:2])), st.integers(-1, 3))
 def test_message_handling_skips_only_what_cannot_matter_for_any_inbox(phase, messages, join, line, cell):
+    assume(line or phase is not Phase.QUEUED)  # a queued robot is on a line
     args = (phase, messages, join, line, cell)
     assert _handled(*args, read_all=False) == _handled(*args, read_all=True)
 
@@ -237,3 +238,36 @@ def test_the_slots_looked_up_every_tick_are_the_managers_cells(name):
     for line, cells in b._cells.items():
         assert b._slots[line] == [(float(x), float(y)) for x, y in cells]
         assert all(type(v) is float for xy in b._slots[line] for v in xy)
+
+
+def _queued_robot() -> tuple[QueueBehaviour, Pose2D]:
+    """robot_0 queued at slot 1 of entry_line_0, granted slot 3, facing slot 2 from 5 cm short
+    of it: it drives on unless it brakes."""
+    b = QueueBehaviour(load_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
+    b._phase, b._line, b._cell, b._grant = Phase.QUEUED, "entry_line_0", 1, ("entry_line_0", 3)
+    (x1, y1), (x2, y2) = b._slots["entry_line_0"][1:3]
+    yaw = math.atan2(y2 - y1, x2 - x1)
+    return b, Pose2D(x2 - 0.05 * math.cos(yaw), y2 - 0.05 * math.sin(yaw), yaw)
+
+
+@settings(max_examples=200)
+@given(st.lists(st.floats(0.0, 0.25, width=32) | st.just(float(np.float32(BRAKE_RANGE))) | st.just(math.inf), min_size=24,
+                max_size=24))
+def test_a_queued_robot_brakes_as_the_float32_scan_compares(ranges):
+    """The braking cone's rays, read as Python floats, brake exactly when the float32 rays
+    compared with BRAKE_RANGE did (numpy compares a float32 with a Python float in float32)."""
+    b, pose = _queued_robot()
+    scan = np.asarray(ranges, dtype=np.float32)
+    cone = [i for i, a in enumerate(ray_angles(load_scenario("queue_qmt").sensors.scan)) if abs(a) <= BRAKE_CONE]
+    brakes = bool(min(scan[i] for i in cone) < BRAKE_RANGE)  # the reference: numpy's comparison
+    command = b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True)))
+    assert (command.linear == 0.0) == brakes
+
+
+def test_a_ray_at_the_float32_brake_range_does_not_brake_and_one_below_does():
+    b, pose = _queued_robot()
+    scan = np.full(24, np.inf, dtype=np.float32)
+    scan[12] = np.float32(BRAKE_RANGE)  # 0.0799999982 < 0.08 as float64, equal as float32
+    assert b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True))).linear > 0.0
+    scan[12] = np.nextafter(np.float32(BRAKE_RANGE), np.float32(0.0))
+    assert b.step(Observation("robot_0", 2 * 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True))).linear == 0.0

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from swarm_sim.scenario import ObstacleConfig, ScanConfig, load_scenario
 from swarm_sim.types import Pose2D
 from swarm_sim.world import World
-from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, scan_angles
+from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, nearest_hits, scan_angles
 
 R = 0.085  # robot radius [m]
 OPEN = StaticScene(6.0, np.zeros((0, 3)), np.zeros((0, 5)))
@@ -206,9 +206,19 @@ def test_kd_tree_pairs_give_the_all_pairs_scan_bit_for_bit(seed, n, crowd, range
 
 
 def exact_reference_scan(origins, headings, scene, rays, fov, range_max, range_min=0.0):
-    """`cast_scan`'s own arithmetic on every ray against every shape, without its shortcuts (pairs
-    in reach, angular windows, the nearest-ray path): what it must equal bit for bit. A shape
-    counts if its bounding circle is within reach, as in the scan."""
+    """`cast_scan`'s ranges from `exact_reference_hits`, rounded and marked in numpy."""
+    out = exact_reference_hits(origins, headings, scene, rays, fov, range_max).astype(np.float32)
+    out[out >= np.float32(range_max)] = np.inf
+    if range_min > 0.0:
+        out[out < np.float32(range_min)] = -np.inf
+    return out
+
+
+def exact_reference_hits(origins, headings, scene, rays, fov, range_max):
+    """`nearest_hits`'s own arithmetic on every ray against every shape, in numpy, without its
+    shortcuts (pairs in reach, angular windows, the nearest-ray path, the compiled loops): what
+    it must equal bit for bit, in float64. A shape counts if its bounding circle is within reach,
+    as in the scan."""
     angle_min, inc = scan_angles(rays, fov)
     angles = headings[:, None] + (angle_min + inc * np.arange(rays))[None, :]
     ux, uy = np.cos(angles), np.sin(angles)  # (n, rays)
@@ -253,12 +263,7 @@ def exact_reference_scan(origins, headings, scene, rays, fov, range_max, range_m
     near = np.fmax(np.fmin(ax, bx), np.fmin(ay, by))
     far = np.fmin(np.fmax(ax, bx), np.fmax(ay, by))
     lower(np.maximum(near, 0.0), (near <= far) & (far >= 0.0) & counts[..., None])
-
-    out = best.astype(np.float32)
-    out[out >= np.float32(range_max)] = np.inf
-    if range_min > 0.0:
-        out[out < np.float32(range_min)] = -np.inf
-    return out
+    return best
 
 
 def crowded_scene(rng: np.random.Generator, n: int, spread: float):
@@ -286,9 +291,39 @@ def test_scan_is_its_own_arithmetic_on_every_ray_bit_for_bit(seed, n, spread, ra
     rng = np.random.default_rng(seed)
     origins, headings = crowded_scene(rng, n, spread)
     static = OPEN if scene == "open" else random_scene(rng, 1, False)[2]
+    hits = nearest_hits(origins, headings, R, static, rays, fov, range_max)
+    assert hits.tobytes() == exact_reference_hits(origins, headings, static, rays, fov, range_max).tobytes()
     got = cast_scan(origins, headings, R, static, rays, fov, range_max, 0.05)
     want = exact_reference_scan(origins, headings, static, rays, fov, range_max, 0.05)
     assert got.tobytes() == want.tobytes()
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    rays=st.sampled_from([4, 24, 36]),
+    fov=st.sampled_from([FULL, math.pi, 6.2]),
+    distance=st.sampled_from([0.2, 0.5, 1.0, 3.0, 3.58, "one ray"]),
+)
+def test_rays_grazing_a_robot_are_their_own_arithmetic_bit_for_bit(seed, rays, fov, distance):
+    """Robots placed where the windows' edges are: each ray of robot 0 aimed at another robot's
+    centre, or grazing its edge (tangent, or a hair inside or outside), or passing exactly between
+    two rays, at distances around the nearest-ray path's limit and at the edge of reach."""
+    rng = np.random.default_rng(seed)
+    angle_min, inc = scan_angles(rays, fov)
+    if distance == "one ray":  # a robot a ray apart from the bearing is hit just closer than this
+        distance = R / math.sin(inc / 2) * rng.choice([0.999, 1.0, 1.001, 1.04])
+    heading = rng.uniform(-math.pi, math.pi)
+    angles = heading + angle_min + inc * rng.integers(0, rays, 12)
+    tangent = math.asin(R / distance)
+    offsets = rng.choice([0.0, tangent, -tangent, 0.5 * inc, tangent * (1 + 1e-12), tangent * (1 - 1e-12)],
+                         12)
+    d = distance * rng.choice([1.0, 1.0 + 1e-15, 1.0 - 1e-15], 12)
+    others = np.column_stack([d * np.cos(angles + offsets), d * np.sin(angles + offsets)])
+    origins = np.vstack([[[0.0, 0.0]], others])
+    headings = np.concatenate([[heading], rng.uniform(-math.pi, math.pi, 12)])
+    hits = nearest_hits(origins, headings, R, OPEN, rays, fov, 3.5)
+    assert hits.tobytes() == exact_reference_hits(origins, headings, OPEN, rays, fov, 3.5).tobytes()
 
 
 def test_the_exact_reference_agrees_with_the_brute_force_one():

@@ -157,6 +157,27 @@ def test_time_advances_one_tick_per_step(make_world):
     assert w.observe() == obs
 
 
+
+def test_observations_carry_the_messages_handed_to_step(make_world):
+    """The batch runner's inbox goes out in the observations the world builds: the same objects
+    as the message-less ones with the messages put in, and asking again gives them again."""
+    from swarm_sim.types import PheromoneMessage
+
+    inbox = (PheromoneMessage(0, 1.0, 2.0), PheromoneMessage(0, -1.0, 0.5))
+    a, b = make_world(scenario(3)), make_world(scenario(3))
+    a.reset(), b.reset()
+    plain = a.step({}, ())
+    carrying = b.step({}, inbox)
+    assert list(carrying) == list(plain)
+    for r, o in carrying.items():
+        assert o.messages is inbox
+        assert o == dataclasses.replace(plain[r], messages=inbox)
+    assert b.observe(inbox) == carrying and b.observe(tuple(inbox)) == carrying
+    assert b.observe() == plain and all(o.messages == () for o in b.observe().values())
+    assert a.observe(inbox) == carrying  # cached without messages, asked with them
+    later = b.step({})
+    assert all(o.messages == () for o in later.values())
+
 def test_a_robot_drives_forward_at_the_commanded_speed(make_world):
     w = make_world(scenario(1))
     w.reset()

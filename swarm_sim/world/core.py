@@ -57,8 +57,7 @@ import pybullet as p
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
-from swarm_sim.world.observations import observations
-from swarm_sim.world.observations import with_messages as with_messages  # the batch runner's import
+from swarm_sim.world.observations import observations, with_messages
 from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
@@ -263,6 +262,8 @@ class World:
         self._meas_v = np.zeros(n)
         self._meas_w = np.zeros(n)
         self._obs_cache: dict[RobotId, Observation] | None = None
+        self._obs_messages: tuple[object, ...] = ()
+        """The messages the cached observations carry."""
         self.task: WorldTask = self._task_factory(self, task_seeds)
         self._fresh = True
 
@@ -351,8 +352,11 @@ class World:
             self._build()
         return self.observe()
 
-    def step(self, commands: Mapping[RobotId, Command]) -> dict[RobotId, Observation]:
-        """Apply `commands`, advance one tick, return the new tick's observations."""
+    def step(
+        self, commands: Mapping[RobotId, Command], messages: tuple[object, ...] = ()
+    ) -> dict[RobotId, Observation]:
+        """Apply `commands`, advance one tick, return the new tick's observations, each carrying
+        `messages` (see `observe`)."""
         try:
             idx = np.fromiter(map(self._index.__getitem__, commands), np.intp, len(commands))
         except KeyError as exc:
@@ -372,7 +376,7 @@ class World:
         self._odometry(pos0, yaw0)
         self.task.post_step((self.tick + 1) * self._dt_ns)
         self.tick += 1
-        return self.observe()
+        return self.observe(messages)
 
     def _apply_commands(self, idx: np.ndarray, commands: Collection[Command]) -> None:
         """Store the commanded (v, w) of robots `idx`, NaN/inf -> 0 and clamped to the limits."""
@@ -498,10 +502,14 @@ class World:
         self._meas_v = forward / self._dt
         self._meas_w = turn / self._dt
 
-    def observe(self) -> dict[RobotId, Observation]:
-        """Observations for the current tick (wire-rounded; messages=())."""
+    def observe(self, messages: tuple[object, ...] = ()) -> dict[RobotId, Observation]:
+        """Observations for the current tick (wire-rounded), each carrying `messages`: the batch
+        runner hands every robot the tick's inbox in them (a graph controller takes its messages
+        from its own mailbox); the world itself sends no messages."""
         if self._obs_cache is not None:
-            return dict(self._obs_cache)
+            if messages is self._obs_messages or messages == self._obs_messages:
+                return dict(self._obs_cache)
+            return {r: with_messages(o, messages) for r, o in self._obs_cache.items()}
         sc = self.scenario.sensors.scan
         if sc.backend == "pybullet":
             ranges = cast_scan_pybullet(
@@ -515,8 +523,8 @@ class World:
         ranges.flags.writeable = False
         self._ring_ahead = self._ring.ahead(ranges)
         sensed = self.task.sense()
-        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed)
-        self._obs_cache = obs
+        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed, messages)
+        self._obs_cache, self._obs_messages = obs, messages
         return dict(obs)
 
     def true_poses(self) -> dict[RobotId, Pose2D]:

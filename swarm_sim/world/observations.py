@@ -3,9 +3,10 @@
 `Observation` and `Pose2D` are frozen slotted dataclasses. Their generated ``__init__`` sets
 each field through ``object.__setattr__``, which made constructing them most of the cost of
 `World.observe` (1000 robots: 1.1 ms a tick). Here the slots are filled through their
-descriptors directly: field by field for the whole swarm (`observations`, 1000 robots: 0.7 ms),
-or one object at a time (`with_messages`). Both fall back to the ordinary constructor should the
-classes ever gain fields or a ``__post_init__`` (test_world checks both give equal objects).
+descriptors directly (`swarm_sim.types.slot_setters`): field by field for the whole swarm
+(`observations`, 1000 robots: 0.7 ms; the batch runner's inbox is one more column), or one
+object at a time (`with_messages`). Both fall back to the ordinary constructor should the classes
+ever gain fields or a ``__post_init__`` (test_world checks both give equal objects).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm_sim.types import Observation, Pose2D, RobotId
+from swarm_sim.types import Observation, Pose2D, RobotId, slot_constructor, slot_setters
 
 _TWO_PI = 2.0 * math.pi
 _OBSERVATION_FIELDS = ("robot", "stamp_ns", "pose", "linear_velocity", "angular_velocity", "ranges",
@@ -36,17 +37,13 @@ def _wire_yaw(
     return math.pi if wrapped == -math.pi else wrapped
 
 
-def _slot_setters(cls: type, expected: tuple[str, ...]) -> tuple[Callable[[Any, Any], None], ...] | None:
-    """The slot descriptors' setters of dataclass `cls`, in field order, if its fields are
-    exactly `expected` and nothing else runs when it is built (no ``__post_init__``)."""
-    fields = tuple(f.name for f in dataclasses.fields(cls))
-    if fields != expected or not hasattr(cls, "__slots__") or hasattr(cls, "__post_init__"):
-        return None
-    return tuple(getattr(cls, name).__set__ for name in expected)
+def _setters(cls: type, expected: tuple[str, ...]) -> tuple[Callable[[Any, Any], None], ...] | None:
+    """`slot_setters` of `cls` if its fields are `expected`, the columns `observations` passes."""
+    return slot_setters(cls) if tuple(f.name for f in dataclasses.fields(cls)) == expected else None
 
 
-_OBSERVATION_SETTERS = _slot_setters(Observation, _OBSERVATION_FIELDS)
-_POSE_SETTERS = _slot_setters(Pose2D, _POSE_FIELDS)
+_OBSERVATION_SETTERS = _setters(Observation, _OBSERVATION_FIELDS)
+_POSE_SETTERS = _setters(Pose2D, _POSE_FIELDS)
 
 
 def _build(cls: type, setters: tuple | None, columns: Sequence[Iterable[Any]], n: int) -> list:
@@ -63,47 +60,25 @@ def _build(cls: type, setters: tuple | None, columns: Sequence[Iterable[Any]], n
 
 def observations(
     robots: Sequence[RobotId], stamp_ns: int, odometry: np.ndarray, speeds: np.ndarray,
-    turn_rates: np.ndarray, ranges: np.ndarray, sensed: Sequence[Any],
+    turn_rates: np.ndarray, ranges: np.ndarray, sensed: Sequence[Any], messages: tuple[object, ...] = (),
 ) -> dict[RobotId, Observation]:
-    """Every robot's observation, messages=(): `odometry` (n, 3) x, y, yaw [m, rad] (the yaw
-    rounded as on the wire here), measured forward `speeds` and `turn_rates` (n,), `ranges`
-    (n, rays) (each robot gets its row), `sensed` the task's readings."""
+    """Every robot's observation: `odometry` (n, 3) x, y, yaw [m, rad] (the yaw rounded as on the
+    wire here), measured forward `speeds` and `turn_rates` (n,), `ranges` (n, rays) (each robot
+    gets its row), `sensed` the task's readings, `messages` the same tuple for every robot."""
     n = len(robots)
     x, y, yaw = odometry.T.tolist()
     poses = _build(Pose2D, _POSE_SETTERS, (x, y, map(_wire_yaw, yaw)), n)
     columns = (robots, repeat(stamp_ns), poses, speeds.tolist(), turn_rates.tolist(), list(ranges), sensed,
-               repeat(()))
+               repeat(messages))
     return dict(zip(robots, _build(Observation, _OBSERVATION_SETTERS, columns, n)))
 
 
 def with_messages(obs: Observation, messages: tuple[object, ...]) -> Observation:
     """A copy of `obs` carrying `messages` (what ``dataclasses.replace`` gives, for a fifth of its
-    cost: the batch runner hands every robot its messages on every tick)."""
+    cost)."""
     return _new_observation(obs.robot, obs.stamp_ns, obs.pose, obs.linear_velocity, obs.angular_velocity,
                             obs.ranges, obs.sensed, messages)
 
 
-def _observation_factory() -> Callable[..., Observation]:
-    """A positional Observation constructor that fills the slots directly (~40% cheaper than the
-    frozen dataclass ``__init__``), or the ordinary constructor (see `_slot_setters`)."""
-    if _OBSERVATION_SETTERS is None:
-        return lambda *values: Observation(*values)
-    robot, stamp, pose, lin, ang, ranges, sensed, messages = _OBSERVATION_SETTERS
-    new = object.__new__
-
-    def make(r, s, q, v, w, g, d, m):  # noqa: PLR0913 - one argument per field
-        o = new(Observation)
-        robot(o, r)
-        stamp(o, s)
-        pose(o, q)
-        lin(o, v)
-        ang(o, w)
-        ranges(o, g)
-        sensed(o, d)
-        messages(o, m)
-        return o
-
-    return make
-
-
-_new_observation = _observation_factory()
+_new_observation = slot_constructor(Observation)
+"""``Observation(...)``, positional, for a fraction of its cost (`swarm_sim.types.slot_constructor`)."""

@@ -10,13 +10,15 @@ in reach: rebuilt every ~12 ticks, scan 3.1 -> 2.5 ms a tick; 112 robots on 12 x
 
 Every way gives the same set of pairs, because the candidates are always filtered with the same
 exact ``d2 < reach^2`` test on the same (dx, dy) = origin j - origin i, i < j; only their order
-differs, and the scan keeps the nearest hit per ray with ``np.minimum.at``, which does not
-depend on the order, so its ranges are bit for bit the same either way.
+differs, and the scan keeps the nearest hit per ray (a minimum), which does not depend on the
+order, so its ranges are bit for bit the same either way.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from swarm_sim.world.jit import kernel
 
 KD_TREE_FROM = 200
 """Swarms of at least this many robots find their pairs within reach with a k-d tree; smaller
@@ -53,15 +55,31 @@ def _within(
     origins: np.ndarray, i: np.ndarray, j: np.ndarray, reach: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The candidate pairs (i, j) strictly closer than `reach`, with (dx, dy, d2)."""
-    ox, oy = origins[:, 0].copy(), origins[:, 1].copy()  # contiguous: faster to gather from
-    dx = ox.take(j) - ox.take(i)
-    dy = oy.take(j) - oy.take(i)
-    d2 = dx * dx + dy * dy
-    near = d2 < reach * reach
-    if near.all():
-        return i, j, dx, dy, d2
-    k = np.flatnonzero(near)
-    return i[k], j[k], dx[k], dy[k], d2[k]
+    return _filter(origins[:, 0].copy(), origins[:, 1].copy(), i, j, reach * reach)
+
+
+@kernel
+def _filter(
+    ox: np.ndarray, oy: np.ndarray, i: np.ndarray, j: np.ndarray, reach2: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """`_within` compiled (fastmath off: the same IEEE operations as numpy's dx * dx + dy * dy).
+
+    Every candidate is written at the next free place and kept by advancing that place only if
+    it is near: no branch on a test whose outcome the CPU cannot predict. (1000 robots, ~103,000
+    candidates, ~85,000 of them near: 0.55 -> 0.21 ms, against numpy's eight passes.)"""
+    n = len(i)
+    near_i, near_j = np.empty(n, np.intp), np.empty(n, np.intp)
+    near_dx, near_dy, near_d2 = np.empty(n), np.empty(n), np.empty(n)
+    count = 0
+    for p in range(n):
+        a, b = i[p], j[p]
+        dx = ox[b] - ox[a]
+        dy = oy[b] - oy[a]
+        d2 = dx * dx + dy * dy
+        near_i[count], near_j[count] = a, b
+        near_dx[count], near_dy[count], near_d2[count] = dx, dy, d2
+        count += d2 < reach2
+    return near_i[:count], near_j[:count], near_dx[:count], near_dy[:count], near_d2[:count]
 
 
 def pairs_in_reach(origins: np.ndarray, reach: float) -> tuple[np.ndarray, ...]:
