@@ -430,9 +430,10 @@ class World:
         (`swarm_sim.world.proximity`)."""
         if self._ring_ahead.any():
             self._avoidance_ticks += self._ring_ahead
-            dt = self._dt
-            for i in np.flatnonzero(self._ring_ahead).tolist():
-                self.stats[self.robots[i]].avoidance_time_s = float(self._avoidance_ticks[i]) * dt
+            dt, stats, names = self._dt, self.stats, self.robots
+            ahead = np.flatnonzero(self._ring_ahead)
+            for i, ticks in zip(ahead.tolist(), self._avoidance_ticks[ahead].tolist()):
+                stats[names[i]].avoidance_time_s = ticks * dt  # a Python int: the same float as numpy's
 
     def _physics(self) -> None:
         """Run the substeps; count robot-robot contact per substep."""
@@ -513,11 +514,11 @@ class World:
         d = self._pos - pos0
         c, s = np.cos(yaw0), np.sin(yaw0)
         forward = d[:, 0] * c + d[:, 1] * s
-        lateral = -d[:, 0] * s + d[:, 1] * c
         turn = np.remainder(self._yaw - yaw0 + math.pi, 2 * math.pi) - math.pi
         if not self._noisy:
             self._odo = np.column_stack([self._pos, self._yaw])
         else:
+            lateral = -d[:, 0] * s + d[:, 1] * c  # only the noisy estimate moves sideways
             noise = self.scenario.robots.odometry_noise
             scale = 1.0 + self._rng_odometry.normal(0.0, noise.linear_std, self._n)
             turn = turn * (1.0 + self._rng_odometry.normal(0.0, noise.angular_std, self._n))
