@@ -57,11 +57,11 @@ import pybullet as p
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.observations import observations, with_messages
 from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
-from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.start import start_positions
 from swarm_sim.world.tasks import TaskFactory, WorldTask
 
@@ -131,6 +131,7 @@ def _quiet_stdout():
         os.close(saved)
         os.close(devnull)
 
+
 @kernel
 def _stale_rows(
     v: np.ndarray, cos_yaw: np.ndarray, sin_yaw: np.ndarray, vz: np.ndarray, w: np.ndarray,
@@ -139,8 +140,8 @@ def _stale_rows(
     """The substep's base velocity of every robot i, (v cos yaw, v sin yaw, vz, w), compared bit
     for bit with row i of `held`: the robots whose velocity differs, or whom pybullet does not
     keep (`kept` False), get it written into `held` and are listed in `stale`; returns how many.
-    The products are numpy's (one IEEE multiply each, `swarm_sim.world.jit`); compared bit for bit
-    (`_differ`: 0.0 is not -0.0)."""
+    Each product is the one IEEE multiply numpy did (`swarm_sim.world.jit`), the cosines and sines
+    are numpy's, computed outside; the comparison is bit for bit (`_differ`: 0.0 is not -0.0)."""
     k = 0
     for i in range(v.shape[0]):
         row = (v[i] * cos_yaw[i], v[i] * sin_yaw[i], vz[i], w[i])

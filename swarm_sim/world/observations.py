@@ -45,7 +45,7 @@ def _wire_yaws(yaws: np.ndarray) -> list[float]:
 
     The kernel's sin, cos and atan2 are the C library's, as `math`'s are (numba calls libm; not
     numpy's own versions, `swarm_sim.world.jit`): bit for bit the same values (measured on 15
-    million yaws; test_world compares the two on every run's yaws and edge cases). The wrap,
+    million yaws in [-pi, pi]; test_world compares the two on random yaws and edge cases). The wrap,
     ``remainder(w, 2 pi)``, leaves every w with ``|w| < pi`` as it is (the quotient rounds to 0),
     which is every world yaw (odometry yaws lie in [-pi, pi]: w = 2 atan2(., cos >= 0)); any
     other value, and NaN, takes the Python route."""
