@@ -48,7 +48,7 @@ import os
 import sys
 from collections import deque
 from collections.abc import Collection, Mapping
-from itertools import chain, repeat
+from itertools import repeat
 from operator import attrgetter
 
 import numpy as np
@@ -327,11 +327,15 @@ class World:
 
     def _read_state(self) -> None:
         """Read every robot's true pose from pybullet into `_pos` (n, 2), `_z`, `_yaw`."""
-        cid, n = self._cid, self._n
-        # One C-level loop: each body's ((x, y, z), (qx, qy, qz, qw)) flattened straight into the
-        # array (1000 robots: ~0.1 ms a tick less than a for loop extending a list).
-        poses = map(p.getBasePositionAndOrientation, self._bodies, repeat(cid, n))
-        a = np.fromiter(chain.from_iterable(chain.from_iterable(poses)), float, 7 * n).reshape(n, 7)
+        cid = self._cid
+        get = p.getBasePositionAndOrientation
+        flat: list[float] = []
+        extend = flat.extend
+        for body in self._bodies:
+            pos, orn = get(body, cid)
+            extend(pos)
+            extend(orn)
+        a = np.array(flat).reshape(self._n, 7)
         qx, qy, qz, qw = a[:, 3], a[:, 4], a[:, 5], a[:, 6]
         self._pos = a[:, :2].copy()
         self._z = a[:, 2].copy()
@@ -481,7 +485,8 @@ class World:
         stepSimulation included (it now updates the bounding boxes the skipped calls used to);
         Q_MT 4.2 -> 3.7 ms. The body ids are the robot indices. Which rows to set is one compiled
         loop (`_stale_rows`), in place of the ten numpy calls a substep that built the velocities
-        and compared them (~15 us a substep at 112 robots)."""
+        and compared them (measured without the pybullet calls, two substeps: 112 robots 30 -> 20
+        us a tick, 1000 robots 171 -> 135 us)."""
         stale = self._stale
         k = _stale_rows(self._v, cos_yaw, sin_yaw, vz, self._w, self._held, self._kept, stale)
         rows = stale[:k]

@@ -40,7 +40,7 @@ def _wire_yaw(
 
 def _wire_yaws(yaws: np.ndarray) -> list[float]:
     """`_wire_yaw` of every yaw: the quaternion round trip in one compiled loop
-    (`_quaternion_yaws`, 1000 robots: 0.16 -> 0.03 ms a tick), the wrap in Python only where it
+    (`_quaternion_yaws`; 112 robots 17 -> 5 us a tick, 1000 robots 141 -> 29 us), the wrap in Python only where it
     is not the identity.
 
     The kernel's sin, cos and atan2 are the C library's, as `math`'s are (numba calls libm; not
