@@ -216,6 +216,8 @@ class QueueBehaviour:
         cx, cy = self._center
         r = math.hypot(pose.x - cx, pose.y - cy)
         if phase is _FORAGING:
+            if r > self._keep_out and not out:  # out in the open, no replies to send: the CPFA's
+                return self._cpfa_step(obs)  # command as is (what `_forage` returns; most robots)
             if not (carrying and r <= self._keep_out):
                 return self._forage(obs, r, out)
             self._begin_delivery(obs, r, out)

@@ -75,6 +75,51 @@ def test_inlined_wire_yaw_is_bit_identical():
     assert all(_wire_yaw(float(y)) == wire_yaw(float(y)) for y in values)
 
 
+
+@pytest.mark.parametrize("low, high", [(-math.pi, math.pi), (-10.0, 10.0)])
+def test_compiled_wire_yaws_are_bit_identical(low, high):
+    """The swarm's wire yaws in one compiled loop (`_wire_yaws`): bit for bit `_wire_yaw`'s, on
+    world yaws (the compiled route) and on any yaws (partly the Python route)."""
+    from swarm_sim.world.observations import _wire_yaw, _wire_yaws
+
+    rng = np.random.default_rng(2)
+    edges = [0.0, -0.0, math.pi, -math.pi, math.pi / 2, -math.pi / 2, 1e-17, -1e-300, 5e-324,
+             math.nextafter(math.pi, 0.0), math.nextafter(-math.pi, 0.0)]
+    yaws = np.array([*edges, *rng.uniform(low, high, 200_000)])
+    want = np.array([_wire_yaw(y) for y in yaws.tolist()])
+    got = np.array(_wire_yaws(yaws))
+    assert got.view(np.int64).tolist() == want.view(np.int64).tolist()
+    strided = np.column_stack([yaws, yaws, yaws])[:, 2]  # the odometry's yaw column
+    assert np.array(_wire_yaws(strided)).view(np.int64).tolist() == want.view(np.int64).tolist()
+
+
+def test_stale_rows_kernel_equals_the_numpy_comparison():
+    """`_stale_rows` against the straightforward numpy version: the velocities, which rows differ
+    bit for bit (0.0 against -0.0 too) or are not kept, and `held` afterwards."""
+    from swarm_sim.world.core import _stale_rows
+
+    rng = np.random.default_rng(5)
+    n = 500
+    for _ in range(20):
+        v = rng.choice([0.0, -0.0, 0.16, 0.05], n)
+        w = rng.choice([0.0, -0.0, 1.5, -0.3], n)
+        yaw = rng.choice([0.0, math.pi / 2, 1.0, -2.0], n)
+        vz = rng.choice([0.0, -0.0, 1e-6], n)
+        kept = rng.random(n) < 0.7
+        held = np.column_stack([v * np.cos(yaw), v * np.sin(yaw), vz, w])
+        flip = rng.random((n, 4)) < 0.05
+        held[flip] = rng.choice([0.0, -0.0, 0.1], int(flip.sum()))
+        velocity = np.empty((n, 4))
+        np.multiply(v, np.cos(yaw), out=velocity[:, 0])
+        np.multiply(v, np.sin(yaw), out=velocity[:, 1])
+        velocity[:, 2], velocity[:, 3] = vz, w
+        same = (velocity.view(np.int64) == held.view(np.int64)).all(axis=1)
+        want = np.flatnonzero(~(same & kept))
+        stale = np.empty(n, dtype=np.intp)
+        k = _stale_rows(v, np.cos(yaw), np.sin(yaw), vz, w, held, kept, stale)
+        assert stale[:k].tolist() == want.tolist() and 0 < k < n
+        assert held.view(np.int64).tolist() == velocity.view(np.int64).tolist()
+
 def test_fast_observation_constructor_equals_the_dataclass_one():
     from swarm_sim.world.observations import _new_observation
 

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from swarm_sim.types import Observation, Pose2D, RobotId, slot_constructor, slot_setters
+from swarm_sim.world.jit import kernel
 
 _TWO_PI = 2.0 * math.pi
 _OBSERVATION_FIELDS = ("robot", "stamp_ns", "pose", "linear_velocity", "angular_velocity", "ranges",
@@ -35,6 +36,33 @@ def _wire_yaw(
     it runs for every robot on every tick."""
     wrapped = remainder(2.0 * atan2(sin(yaw / 2), cos(yaw / 2)), _TWO_PI)
     return math.pi if wrapped == -math.pi else wrapped
+
+
+def _wire_yaws(yaws: np.ndarray) -> list[float]:
+    """`_wire_yaw` of every yaw: the quaternion round trip in one compiled loop
+    (`_quaternion_yaws`; 112 robots 17 -> 5 us a tick, 1000 robots 141 -> 29 us), the wrap in Python only where it
+    is not the identity.
+
+    The kernel's sin, cos and atan2 are the C library's, as `math`'s are (numba calls libm; not
+    numpy's own versions, `swarm_sim.world.jit`): bit for bit the same values (measured on 15
+    million yaws in [-pi, pi]; test_world compares the two on random yaws and edge cases). The wrap,
+    ``remainder(w, 2 pi)``, leaves every w with ``|w| < pi`` as it is (the quotient rounds to 0),
+    which is every world yaw (odometry yaws lie in [-pi, pi]: w = 2 atan2(., cos >= 0)); any
+    other value, and NaN, takes the Python route."""
+    w = np.empty(len(yaws))
+    _quaternion_yaws(yaws, w)
+    if not (np.abs(w) < math.pi).all():
+        return list(map(_wire_yaw, yaws.tolist()))
+    return w.tolist()
+
+
+@kernel
+def _quaternion_yaws(yaws: np.ndarray, out: np.ndarray) -> None:
+    """``2 atan2(sin(yaw / 2), cos(yaw / 2))`` of every yaw into `out` (`_wire_yaw` before its
+    wrap)."""
+    for i in range(yaws.shape[0]):
+        half = yaws[i] / 2
+        out[i] = 2.0 * math.atan2(math.sin(half), math.cos(half))
 
 
 def _setters(cls: type, expected: tuple[str, ...]) -> tuple[Callable[[Any, Any], None], ...] | None:
@@ -66,8 +94,8 @@ def observations(
     wire here), measured forward `speeds` and `turn_rates` (n,), `ranges` (n, rays) (each robot
     gets its row), `sensed` the task's readings, `messages` the same tuple for every robot."""
     n = len(robots)
-    x, y, yaw = odometry.T.tolist()
-    poses = _build(Pose2D, _POSE_SETTERS, (x, y, map(_wire_yaw, yaw)), n)
+    x, y = odometry[:, 0].tolist(), odometry[:, 1].tolist()
+    poses = _build(Pose2D, _POSE_SETTERS, (x, y, _wire_yaws(odometry[:, 2])), n)
     columns = (robots, repeat(stamp_ns), poses, speeds.tolist(), turn_rates.tolist(), list(ranges), sensed,
                repeat(messages))
     return dict(zip(robots, _build(Observation, _OBSERVATION_SETTERS, columns, n)))
