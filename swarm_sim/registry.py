@@ -206,11 +206,19 @@ def _section_class(path: str) -> type:
 
 
 def config_section(name: str) -> type:
-    """The dataclass of section ``controller.<name>``."""
+    """The dataclass of section ``controller.<name>``.
+
+    The registry names a section so that a scenario's keys are checked without importing every
+    algorithm's config module; the dataclass's own ``SECTION`` is what it reads back (`Section.of`).
+    The two must be one name, so a record whose name and class disagree is refused here."""
     sections = config_sections()
     if name not in sections:
         raise ValueError(f"no algorithm declares a section controller.{name}")
-    return _section_class(sections[name])
+    cls = _section_class(sections[name])
+    if getattr(cls, "SECTION", None) != name:
+        raise ValueError(f"section controller.{name} is declared as {sections[name]}, whose SECTION is "
+                         f"{getattr(cls, 'SECTION', None)!r}")
+    return cls
 
 
 def check_scenario(scenario: Scenario) -> None:

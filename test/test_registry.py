@@ -63,6 +63,17 @@ def test_sections_belong_to_the_algorithms_and_round_trip():
         load_scenario("queue_qst", ["controller.queue.wrapping=triple"])
 
 
+def test_every_section_is_named_once(monkeypatch):
+    """A section's name lives in the registry record and in its dataclass's SECTION: they agree
+    for every shipped section, and a record that disagrees with its class is refused by name."""
+    for name in registry.config_sections():
+        assert registry.config_section(name).SECTION == name
+    sections = {**registry.config_sections(), "cage": registry.config_sections()["caging"]}
+    monkeypatch.setattr(registry, "config_sections", lambda: sections)
+    with pytest.raises(ValueError, match="controller.cage is declared as .*CagingConfig, whose SECTION is 'caging'"):
+        registry.config_section("cage")
+
+
 def test_the_scenario_module_imports_no_algorithm():
     code = ("import sys, swarm_sim.scenario, swarm_sim.sites, swarm_sim.registry; "
             "print(sorted(m for m in sys.modules if m.split('.')[0] in ('swarm_controllers', 'depot_manager')))")
