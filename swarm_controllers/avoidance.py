@@ -15,7 +15,7 @@ ends, so a symmetric obstacle (a wall met head on) cannot make the robot dither 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -24,6 +24,14 @@ from swarm_sim.scenario import AvoidanceConfig, ScanConfig, Scenario
 from swarm_sim.types import Command
 
 _FULL_CIRCLE_TOLERANCE = 1e-9
+
+
+def ray_window(rays: Iterable[int]) -> slice | list[int]:
+    """Rays `rays` (indices in order) as a slice when they are contiguous, as a sector of a scan
+    is in every sane configuration (angles are monotonic around the heading): a scan array's
+    sector is then one view. An index list covers anything else."""
+    rays = list(rays)
+    return slice(rays[0], rays[-1] + 1) if rays and rays == list(range(rays[0], rays[-1] + 1)) else rays
 
 
 def ray_angles(scan: ScanConfig) -> list[float]:
@@ -62,14 +70,7 @@ class ObstacleAvoidance:
         angles = ray_angles(scan)
         half_front = config.front_fov / 2.0 + 1e-12
         self._front_rays = tuple(i for i, a in enumerate(angles) if abs(a) <= half_front)
-        front = self._front_rays
-        # Contiguous in every sane configuration (angles are monotonic around the heading): a
-        # slice, so a scan array's front sector is one view; an index list covers anything else.
-        self._front: slice | list[int]
-        if front and front == tuple(range(front[0], front[-1] + 1)):
-            self._front = slice(front[0], front[-1] + 1)
-        else:
-            self._front = list(front)
+        self._front = ray_window(self._front_rays)
         # Free space is compared over the forward half-plane only: what lies behind the robot
         # does not matter for where it can turn to and drive.
         self._left = [i for i, a in enumerate(angles) if 0.0 < a <= math.pi / 2 + 1e-12]

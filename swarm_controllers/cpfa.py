@@ -375,9 +375,7 @@ class CpfaBehaviour:
         pose = obs.pose
         if (pose.x - self._leg_x) ** 2 + (pose.y - self._leg_y) ** 2 >= self._step2:
             self._new_leg(obs)
-        if not steering:
-            return _IDLE
-        return steer(remainder(self._heading - pose.yaw, _TWO_PI), inf, self._limits)  # walk the leg
+        return self._walk(obs) if steering else _IDLE
 
     def _walk(self, obs: Observation) -> tuple[float, float]:
         """Along the current leg's heading."""

@@ -59,7 +59,7 @@ from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind, within_range
 from swarm_controllers.api import new_command
-from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
+from swarm_controllers.avoidance import AvoidThenEscape, ray_angles, ray_window
 from swarm_controllers.cpfa import CpfaBehaviour
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_sim.inbound import Reason, Rejections
@@ -157,11 +157,8 @@ class QueueBehaviour:
             for i in np.flatnonzero(np.hypot(*(cells - dock.stop).T) < 1e-6)
         }
         self._exit_lines = {line.name for line in self._layout.exit_lines}
-        front = [i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE]
-        self._front: slice | list[int] = (
-            slice(front[0], front[-1] + 1) if front and front == list(range(front[0], front[-1] + 1)) else front
-        )
-        """The rays of the braking cone (a slice when they are contiguous, as in every sane scan)."""
+        self._front = ray_window(i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE)
+        """The rays of the braking cone."""
         self._brake_range = float(np.float32(BRAKE_RANGE))
         """BRAKE_RANGE as the float32 the scan's ranges are compared with (numpy compares a
         float32 with a Python float in float32), for comparing the rays read as Python floats."""
@@ -216,8 +213,6 @@ class QueueBehaviour:
         cx, cy = self._center
         r = math.hypot(pose.x - cx, pose.y - cy)
         if phase is _FORAGING:
-            if r > self._keep_out and not out:  # out in the open, no replies to send: the CPFA's
-                return self._cpfa_step(obs)  # command as is (what `_forage` returns; most robots)
             if not (carrying and r <= self._keep_out):
                 return self._forage(obs, r, out)
             self._begin_delivery(obs, r, out)
