@@ -52,6 +52,13 @@ def ray_angles(scan: ScanConfig) -> list[float]:
 class ObstacleAvoidance:
     """Turns away from whatever the front sector of the scan sees too close; counts episodes."""
 
+    # Slots: every robot owns one (see `swarm_controllers.cpfa.CpfaBehaviour`).
+    __slots__ = (
+        "_active", "_command", "_distance", "_events", "_front", "_front_rays",
+        "_keep_right", "_left", "_range_max", "_rays", "_right", "_turn_left",
+        "_turn_right", "config", "scan",
+    )
+
     def __init__(
         self, config: AvoidanceConfig, scan: ScanConfig, max_angular: float | None = None,
         *, keep_right: bool = False,
@@ -158,6 +165,11 @@ class AvoidThenEscape:
     without it, a goal just beside an obstacle makes the avoidance turn and the goal turn undo
     each other forever with the robot standing still.
     """
+
+    # Slots: every robot owns one (see `swarm_controllers.cpfa.CpfaBehaviour`).
+    __slots__ = (
+        "_escape", "_escape_left", "_escape_ticks", "_was_avoiding", "avoidance",
+    )
 
     def __init__(self, scenario: Scenario, escape_distance: float, *, keep_right: bool = False) -> None:
         r = scenario.robots

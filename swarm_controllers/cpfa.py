@@ -178,6 +178,19 @@ def informed_search_sigma(omega: float, lambda_id: float, t_search: float) -> fl
 class CpfaBehaviour:
     """One robot running the CPFA. See the module docstring for the rules and their sources."""
 
+    # Slots, not a __dict__: a thousand robots' behaviours are stepped every tick, and compact
+    # objects keep more of them in the CPU's caches between pybullet's passes over the swarm
+    # (1000 robots, ticks 600-800: CPFA 13.5 -> 12.0 ms a tick, Q_MT 16.5 -> 14.8; issue 14).
+    __slots__ = (
+        "_arrival2", "_avoidance", "_blocked2", "_bound", "_carrying", "_dock_r2", "_docks",
+        "_heading", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
+        "_leg_x", "_leg_y", "_limits", "_mode", "_nest", "_nest_r2", "_omega",
+        "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
+        "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
+        "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
+        "_threshold", "_trips", "_update_avoidance", "robot",
+    )
+
     def __init__(
         self, scenario: Scenario, robot: RobotId, rng: np.random.Generator,
         *, keep_out: float | None = None,

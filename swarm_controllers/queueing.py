@@ -128,6 +128,16 @@ def _queues(
 class QueueBehaviour:
     """One robot foraging with the CPFA and delivering through the depot's queues."""
 
+    # Slots, not a __dict__: see `CpfaBehaviour`.
+    __slots__ = (
+        "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
+        "_center", "_cpfa", "_cpfa_step", "_dock_cells", "_entry", "_entry_angles",
+        "_entry_lines", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join",
+        "_keep_out", "_lane", "_last", "_layout", "_leave_to", "_limits", "_line", "_phase",
+        "_query_at", "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail",
+        "_yield_until", "rejections", "robot",
+    )
+
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
         depot, queue = scenario.depot, QueueConfig.of(scenario)
         self.robot = robot

@@ -125,6 +125,21 @@ def _observation_bytes(scenario, robot, stamp, carrying=False):
     }
 
 
+class _InboxLog:
+    """A behaviour that logs the messages of every observation it is stepped on, then steps the
+    real one (behaviours have slots: their methods cannot be replaced on the instance)."""
+
+    def __init__(self, behaviour, inbox):
+        self._behaviour, self._inbox = behaviour, inbox
+
+    def step(self, obs):
+        self._inbox.append(obs.messages)
+        return self._behaviour.step(obs)
+
+    def __getattr__(self, name):
+        return getattr(self._behaviour, name)
+
+
 def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(context):
     scenario = load_scenario("cpfa", SMALL)
     node = ControllerNode("robot_0", ControllerConfig(overrides=SMALL), context=context)
@@ -140,8 +155,7 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
     # robot_0 answers only once both are matched
     laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.heard(topics.PHEROMONES), EVENTS)
     peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
-    original_step = node.behaviour.step
-    node.behaviour.step = lambda obs: (inbox.append(obs.messages), original_step(obs))[1]
+    node.behaviour = _InboxLog(node.behaviour, inbox)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     executor.add_node(peer)
