@@ -131,11 +131,11 @@ class QueueBehaviour:
     # Slots, not a __dict__: see `CpfaBehaviour`.
     __slots__ = (
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
-        "_center", "_cpfa", "_cpfa_step", "_dock_cells", "_entry", "_entry_angles",
-        "_entry_lines", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join",
-        "_keep_out", "_lane", "_last", "_layout", "_leave_to", "_limits", "_line", "_phase",
-        "_query_at", "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail",
-        "_yield_until", "rejections", "robot",
+        "_center", "_cpfa", "_cpfa_step", "_entry", "_entry_angles", "_entry_lines",
+        "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
+        "_last", "_layout", "_leave_to", "_limits", "_line", "_phase", "_query_at",
+        "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
+        "rejections", "robot",
     )
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
@@ -160,12 +160,6 @@ class QueueBehaviour:
         self._entry_angles = np.array(
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
         )
-        self._dock_cells = {
-            (name, i)
-            for name, cells in self._cells.items()
-            for dock in self._layout.docks
-            for i in np.flatnonzero(np.hypot(*(cells - dock.stop).T) < 1e-6)
-        }
         self._exit_lines = {line.name for line in self._layout.exit_lines}
         self._front = ray_window(i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE)
         """The rays of the braking cone."""
