@@ -34,7 +34,7 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import AvoidThenEscape
+from swarm_controllers.avoidance import AvoidThenEscape, ray_window
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
 from swarm_controllers.nest_config import NestConfig, ThresholdConfig
 from swarm_controllers.nest_protocol import NestEvent, NestReport, NestState
@@ -80,8 +80,7 @@ class ThresholdForager:
         self._speed = scenario.robots.max_linear_speed
         self._max_turn = scenario.robots.max_angular_speed
         self._avoid = AvoidThenEscape(scenario, escape_distance=scenario.robots.diameter)
-        front = self._avoid.avoidance.front_rays
-        self._front = slice(front[0], front[-1] + 1) if front == tuple(range(front[0], front[-1] + 1)) else list(front)
+        self._front = ray_window(self._avoid.avoidance.front_rays)
         self._stop_distance = scenario.controller.avoidance.distance
         self._nest_xy = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._settled_r2 = (scenario.depot.radius / 2.0) ** 2
