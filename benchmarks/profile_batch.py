@@ -233,11 +233,11 @@ def profile_run(
         return log
 
     batch_make_servers = batch.make_servers
-    # The behaviours have slots (no instance attribute can shadow a method): their class's step is
-    # timed, for the run only. A throwaway behaviour names the class.
-    behaviour_cls = type(batch.make_behaviour(scenario, "robot_0", behaviour_rng(scenario.seed, "robot_0")))
     targets: list[tuple[Any, str, Any]] = [(batch, "World", make_world), (batch, "PerimeterLog", make_perimeter)]
     if timers is not None:
+        # The behaviours have slots (no instance attribute can shadow a method): their class's
+        # step is timed, for the run only. A throwaway behaviour names the class.
+        behaviour_cls = type(batch.make_behaviour(scenario, "robot_0", behaviour_rng(scenario.seed, "robot_0")))
         targets += [
             (behaviour_cls, "step", wrap(f"behaviours: {behaviour_cls.__name__}.step", behaviour_cls.step)),
             (batch, "make_servers", make_servers),

@@ -180,7 +180,8 @@ class CpfaBehaviour:
 
     # Slots, not a __dict__: a thousand robots' behaviours are stepped every tick, and compact
     # objects keep more of them in the CPU's caches between pybullet's passes over the swarm
-    # (1000 robots, ticks 600-800: CPFA 13.5 -> 12.0 ms a tick, Q_MT 16.5 -> 14.8; issue 14).
+    # (1000 robots, ticks 600-800, alternated runs: Q_MT 16.6 -> 14.7 ms a tick; CPFA and 112
+    # robots within noise; issue 14).
     __slots__ = (
         "_arrival2", "_avoidance", "_blocked2", "_bound", "_carrying", "_dock_r2", "_docks",
         "_heading", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
