@@ -14,12 +14,12 @@ setup(
     python_requires=">=3.10",
     packages=find_packages(include=["swarm_sim*", "swarm_controllers*", "swarm_msgs_py*",
                                     "depot_manager*", "launch_py*"]),
-    package_data={"swarm_sim": ["scenarios/*.yaml"], "launch_py": ["*.xml", "*.json"]},
+    package_data={"swarm_controllers": ["*/scenarios/*.yaml"], "launch_py": ["*.xml", "*.json"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/launch", glob("launch_py/*.launch.py")),
-        (f"share/{PACKAGE}/scenarios", glob("swarm_sim/scenarios/*.yaml")),
+        (f"share/{PACKAGE}/scenarios", glob("swarm_controllers/*/scenarios/*.yaml")),
     ],
     install_requires=[
         "numpy",
@@ -46,15 +46,24 @@ setup(
         "test": ["pytest", "hypothesis", "websockets", "distributed"],
     },
     entry_points={
+        # Every paper registers itself as a third-party plug-in would (swarm_sim.registry).
+        "swarmforage.algorithms": [
+            "core = swarm_sim.world.tasks.registration",
+            "cpfa = swarm_controllers.cpfa.registration",
+            "queue = swarm_controllers.queue.registration",
+            "spiral = swarm_controllers.spiral.registration",
+            "drtm = swarm_controllers.drtm.registration",
+            "caging = swarm_controllers.caging.registration",
+        ],
         "console_scripts": [
             "swarm-run = launch_py.run:main",
             "swarm-batch = swarm_sim.batch:main",
             "swarm-analyze = swarm_sim.analysis.cli:main",
             "swarm-world = swarm_sim.nodes.world_node:main",
             "swarm-controllers = swarm_controllers.controller_node:main",
-            "swarm-center = swarm_controllers.center_node:main",
+            "swarm-center = swarm_controllers.spiral.center_node:main",
             "swarm-depot-manager = depot_manager.node:main",
-            "swarm-nest = swarm_controllers.nest_node:main",
+            "swarm-nest = swarm_controllers.drtm.nest_node:main",
             "swarm-compare = swarm_sim.compare.cli:main",
         ],
     },

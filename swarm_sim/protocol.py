@@ -5,7 +5,7 @@ a ``CHANNEL`` naming who receives it: ``robots`` (every robot controller receive
 what concerns it) or a server's channel (``depot``, ``center``...). `swarm_sim.messaging`
 delivers it one tick later; in the graph over the topics of its message family
 (`swarm_msgs_py.records.MessageFamily`), in the batch runner in process. Each paper keeps its
-messages in its own protocol module (`depot_manager.protocol`, `swarm_controllers.center_protocol`).
+messages in its own protocol module (`depot_manager.protocol`, `swarm_controllers.spiral.protocol`).
 
 Servers are stepped once per tick, after the robots: at tick k a server takes every message
 stamped before k and answers with messages stamped k, which the robots see at tick k+1. A

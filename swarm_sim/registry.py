@@ -6,24 +6,28 @@ an algorithm: its behaviour, its world task, its scenario sections and checks, t
 needs, the message families its robots exchange, the drop zones it works with, its metrics, its
 planned paths and its paper comparison. The launcher, the batch runner, the nodes, the launch
 file, analysis and the comparisons read these records; no other module switches on an
-algorithm's name. The shipped records are in `swarm_sim.algorithms`.
+algorithm's name.
+
+Every paper is a package that registers itself the way a third-party plug-in does: a module
+named in the Python entry-point group ``swarmforage.algorithms`` (`importlib.metadata`, as
+pytest and Gymnasium find their plug-ins) calls `register` / `register_task` when imported.
+The entry points are loaded the first time the registry is read. A registering package ships
+its scenario files in a ``scenarios/`` folder beside its registering module (`scenario_files`).
 
 Records name code by ``"module:attribute"`` strings that are imported when first used, so the
 registry (and the scenario loader that asks it for sections) imports no algorithm package, and
 a behaviour's module loads only when a run uses it.
 
-Plug-ins: a module named in the environment variable ``SWARMFORAGE_PLUGINS`` (comma-separated)
-is imported before the registry is first read and may call `register` / `register_task`; the
-graph's child processes inherit the variable, so a plug-in algorithm runs on the graph too.
 """
 
 from __future__ import annotations
 
 import importlib
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
+from importlib.metadata import entry_points
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -32,7 +36,7 @@ if TYPE_CHECKING:
     from swarm_sim.protocol import Server
     from swarm_sim.scenario import Scenario
 
-PLUGINS_ENV = "SWARMFORAGE_PLUGINS"
+ENTRY_POINT_GROUP = "swarmforage.algorithms"
 
 
 @dataclass(frozen=True)
@@ -121,17 +125,34 @@ class Algorithm:
 
 _ALGORITHMS: dict[str, Algorithm] = {}
 _TASKS: dict[str, TaskSpec] = {}
+_PACKAGES: dict[str, Path] = {}
+"""Entry-point name -> the folder of the module it loaded (where its ``scenarios/`` are)."""
 _loaded = False
 
 
 def _load_entries() -> None:
+    """Import every module of the entry-point group once (sorted by name, so the order of
+    registration does not depend on how the environment lists them)."""
     global _loaded
     if _loaded:
         return
     _loaded = True
-    importlib.import_module("swarm_sim.algorithms")
-    for module in filter(None, (m.strip() for m in os.environ.get(PLUGINS_ENV, "").split(","))):
-        importlib.import_module(module)
+    for entry in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        module = importlib.import_module(entry.value)
+        _PACKAGES[entry.name] = Path(module.__file__).resolve().parent
+
+
+def scenario_files() -> dict[str, Path]:
+    """Scenario name -> its YAML file, over every registered package's ``scenarios/`` folder;
+    ValueError naming both files if two packages ship the same name."""
+    _load_entries()
+    out: dict[str, Path] = {}
+    for folder in _PACKAGES.values():
+        for path in sorted((folder / "scenarios").glob("*.yaml")):
+            if path.stem in out:
+                raise ValueError(f"scenario {path.stem!r} is shipped twice: {out[path.stem]} and {path}")
+            out[path.stem] = path
+    return dict(sorted(out.items()))
 
 
 def register(algorithm: Algorithm) -> Algorithm:

@@ -24,7 +24,6 @@ import yaml
 if TYPE_CHECKING:
     from typing import Self  # Python >= 3.11; annotations only
 
-SCENARIO_DIR = Path(__file__).resolve().parent / "scenarios"
 DEFAULT_SCENARIO = "cpfa"
 """The scenario every command runs unless told otherwise (the CPFA baseline)."""
 
@@ -283,7 +282,7 @@ class LandmarkConfig:
 
 @dataclass(frozen=True)
 class TransportConfig:
-    """World facts of the transport task (`swarm_sim.world.tasks.transport`)."""
+    """World facts of the transport task (`swarm_controllers.caging.task`)."""
 
     object: TargetObjectConfig = field(default_factory=TargetObjectConfig)
     landmarks: LandmarkConfig = field(default_factory=LandmarkConfig)
@@ -505,17 +504,22 @@ def parse_override(text: str) -> tuple[str, Any]:
 
 
 def resolve_path(name_or_path: str) -> Path:
-    """A scenario name (``cpfa``) or a path to a YAML file."""
+    """A scenario name (``cpfa``, shipped by a registered package: `registry.scenario_files`) or a
+    path to a YAML file."""
+    from swarm_sim.registry import scenario_files
+
     path = Path(name_or_path)
     if path.suffix in (".yaml", ".yml") or path.exists():
         if not path.is_file():
             raise ScenarioError(f"scenario file {path} does not exist")
         return path
-    candidate = SCENARIO_DIR / f"{name_or_path}.yaml"
-    if not candidate.is_file():
-        known = ", ".join(sorted(p.stem for p in SCENARIO_DIR.glob("*.yaml")))
-        raise ScenarioError(f"unknown scenario {name_or_path!r} (known: {known})")
-    return candidate
+    try:
+        shipped = scenario_files()
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
+    if name_or_path not in shipped:
+        raise ScenarioError(f"unknown scenario {name_or_path!r} (known: {', '.join(shipped)})")
+    return shipped[name_or_path]
 
 
 def load_scenario(

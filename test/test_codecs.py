@@ -29,7 +29,8 @@ from sensor_msgs.msg import JointState, LaserScan
 from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
-from swarm_msgs_py import clock, diagnostics, gripper, odometry, pheromone, resources, scan, twist
+from swarm_controllers.cpfa import codec as pheromone
+from swarm_msgs_py import clock, diagnostics, gripper, odometry, resources, scan, twist
 from swarm_msgs_py import topics as topic_names
 from swarm_msgs_py.cdr import CodecError, Reader, Writer
 from swarm_msgs_py.diagnostics import Status

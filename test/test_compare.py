@@ -14,14 +14,14 @@ from hypothesis import strategies as st
 from swarm_sim.compare import comparisons
 from swarm_sim.compare.cli import build_parser, main
 from swarm_sim.compare.comparison import Comparison
-from swarm_sim.compare.queue_paper import (
+from swarm_controllers.queue.comparison import (
     PAPER_TABLE_II,
     QUEUE_STRATEGIES,
     queue_plans,
     queue_ttests_md,
     write_queue_report,
 )
-from swarm_sim.compare.spiral_paper import (
+from swarm_controllers.spiral.comparison import (
     PAPER_SPIRAL_CLAIMS,
     SPIRAL_EXPERIMENTS,
     SPIRAL_STRATEGIES,
@@ -457,8 +457,8 @@ def test_headlines_follow_the_means_and_the_tests():
     rows = (rows_for("queue_qse", 48, [10, 11, 12]) + rows_for("queue_qst", 48, [20, 21, 22])
             + rows_for("queue_qme", 48, [30, 31, 32]) + rows_for("queue_qmt", 48, [60, 61, 62])
             + rows_for("queue_cpfa", 48, [40, 41, 42]))
-    from swarm_sim.compare.queue_paper import queue_headlines
-    from swarm_sim.compare.spiral_paper import spiral_headlines
+    from swarm_controllers.queue.comparison import queue_headlines
+    from swarm_controllers.spiral.comparison import spiral_headlines
 
     found = {h.claim: h for h in queue_headlines(rows, [48], QUEUE_STRATEGIES)}
     assert found["Q_MT collects the most resources of all strategies"].holds is True
@@ -475,7 +475,7 @@ def test_headlines_follow_the_means_and_the_tests():
 
 
 def test_table_ii_ordering_checked_pair_by_pair():
-    from swarm_sim.compare.queue_paper import ordering_checks, queue_headlines
+    from swarm_controllers.queue.comparison import ordering_checks, queue_headlines
 
     rng = np.random.default_rng(5)
     means = {"queue_cpfa": 60.0, "queue_qse": 17.0, "queue_qst": 34.0, "queue_qme": 50.0, "queue_qmt": 70.0}

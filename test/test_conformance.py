@@ -11,14 +11,13 @@ import yaml
 
 from swarm_sim import registry
 from swarm_sim.conformance import ConformanceError, check_algorithm, sample_message
-from swarm_sim.scenario import SCENARIO_DIR
 
 
 def _scenario_of(name: str) -> str:
     """The first shipped scenario (by file name) that runs algorithm `name`."""
-    for path in sorted(SCENARIO_DIR.glob("*.yaml")):
+    for stem, path in registry.scenario_files().items():
         if (yaml.safe_load(path.read_text()).get("controller") or {}).get("behaviour") == name:
-            return path.stem
+            return stem
     raise AssertionError(f"no shipped scenario runs the registered algorithm {name!r}")
 
 

@@ -23,7 +23,7 @@ from rclpy.node import Node
 
 from depot_manager.protocol import DepotReport, RadioReply, ReportKind
 from swarm_msgs_py import ack, clock, diagnostics, server_state, topics, twist
-from swarm_msgs_py.depot_protocol import DEPOT, RADIO
+from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.recording import BagError, BagTruncatedWarning, bag_info, read_bag
@@ -249,7 +249,7 @@ def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(
 
 @pytest.mark.parametrize("scenario, module, channel", [
     ("queue_qmt", "depot_manager.node", "depot"),
-    ("mdbsa_d", "swarm_controllers.center_node", "center"),
+    ("mdbsa_d", "swarm_controllers.spiral.center_node", "center"),
 ])
 def test_a_killed_server_ends_the_run_with_a_clear_message(launch, scenario, module, channel):
     run = launch("--scenario", scenario, "--robots", "4", "--duration", "600", "--tick-timeout", "0.5")

@@ -9,10 +9,10 @@ from hypothesis import strategies as st
 
 from depot_manager.protocol import DepotGrant, DepotReport, RadioReply, ReportKind
 from depot_manager.server import DepotServer
-from swarm_controllers.center import CenterServer
-from swarm_controllers.center_protocol import ProgressReport
+from swarm_controllers.spiral.center import CenterServer
+from swarm_controllers.spiral.protocol import ProgressReport
 from swarm_msgs_py import diagnostics
-from swarm_msgs_py.depot_protocol import DEPOT, RADIO
+from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_sim.inbound import Inbound, Reason, Rejections, merged, robot_fields
 from swarm_sim.scenario import load_scenario

@@ -11,7 +11,8 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
-from swarm_msgs_py import diagnostics, gripper, odometry, pheromone, resources, scan, topics, twist
+from swarm_controllers.cpfa import codec as pheromone
+from swarm_msgs_py import diagnostics, gripper, odometry, resources, scan, topics, twist
 from swarm_msgs_py.executor import share_sim_time
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_run

@@ -10,7 +10,7 @@ from rclpy.node import Node
 from rclpy.parameter_client import AsyncParameterClient
 
 from depot_manager.node import DepotManagerNode
-from swarm_controllers.center_node import CenterNode
+from swarm_controllers.spiral.center_node import CenterNode
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_sim.nodes.server_node import ServerNodeConfig
 from test_nodes import SMALL

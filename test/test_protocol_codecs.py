@@ -11,12 +11,12 @@ from rclpy.serialization import deserialize_message
 from std_msgs.msg import Header
 
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind
-from swarm_controllers.center import RegionState
-from swarm_controllers.center_protocol import ProgressReport, RegionAssignment
+from swarm_controllers.spiral.center import RegionState
+from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_msgs_py import ack, server_state
 from swarm_msgs_py.cdr import CodecError
-from swarm_msgs_py.center_protocol import CENTER
-from swarm_msgs_py.depot_protocol import DEPOT, RADIO
+from swarm_controllers.spiral.codec import CENTER
+from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_msgs_py.records import topic_of
 

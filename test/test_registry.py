@@ -1,6 +1,7 @@
 """The algorithm registry: one record per algorithm, read everywhere; a plug-in algorithm (the
-dummy in test/dummy_algorithm: its own behaviour, world task and sense topic, server, message
-family and metric) runs in batch and on the graph by registering itself."""
+dummy in test/plugins/dummy_algorithm, an installed package of its own: behaviour, world task and
+sense topic, server, message family, metric and scenario) is found through its entry point and
+runs like a shipped paper (its graph == batch check is in test_conformance)."""
 
 from __future__ import annotations
 
@@ -16,13 +17,7 @@ from swarm_msgs_py import topics
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
 
-TEST_DIR = Path(__file__).resolve().parent
-DUMMY = str(TEST_DIR / "dummy_algorithm" / "dummy.yaml")
-
-
-def _plugin_env() -> dict[str, str]:
-    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(TEST_DIR), os.environ.get("PYTHONPATH", "")]),
-            registry.PLUGINS_ENV: "dummy_algorithm"}
+REPO = Path(__file__).resolve().parents[1]
 
 
 def test_shipped_records_and_their_wiring():
@@ -81,20 +76,19 @@ def test_the_scenario_module_imports_no_algorithm():
     assert out.stdout.strip() == "[]", out.stderr
 
 
-def test_plugin_algorithm_runs_in_batch_and_on_the_graph_and_conforms(tmp_path):
-    """The dummy touches no file of the tree: its package plus its one register() call."""
-    code = (
-        "from swarm_sim.conformance import check_algorithm; import json, sys; "
-        f"print(json.dumps(check_algorithm({DUMMY!r}, robots=4, duration=20.0, "
-        f"graph_bag=__import__('pathlib').Path({str(tmp_path / 'bag')!r}), "
-        f"domain_id={int(os.environ['ROS_DOMAIN_ID'])})))"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=_plugin_env())
-    assert out.returncode == 0, out.stderr[-3000:]
-    assert json.loads(out.stdout.strip().splitlines()[-1]) == ["ros_free", "determinism", "codecs", "graph_equals_batch"]
-    # the run's own metric, from the bag the graph check recorded
-    summary = subprocess.run([sys.executable, "-m", "swarm_sim.analysis.cli", str(tmp_path / "bag"), "--json", "--no-plot"],
-                             capture_output=True, text=True, timeout=120, env=_plugin_env())
-    result = json.loads(summary.stdout.strip().splitlines()[-1])
+def test_plugin_algorithm_is_found_by_its_entry_point_and_runs():
+    """The dummy is a package of its own, outside every swarmforage package, and ships its scenario."""
+    from importlib.metadata import entry_points
+
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.batch import run_batch
+
+    (entry,) = (e for e in entry_points(group=registry.ENTRY_POINT_GROUP) if e.name == "dummy")
+    assert entry.value == "dummy_algorithm.registration" and "dummy" in registry.known()
+    scenario_file = registry.scenario_files()["dummy"]
+    assert scenario_file.parent.name == "scenarios" and scenario_file.parents[1].name == "dummy_algorithm"
+    for package in ("swarm_sim", "swarm_controllers", "swarm_msgs_py", "depot_manager", "launch_py"):
+        assert not scenario_file.is_relative_to(REPO / package)
+    result = summarize(run_batch(load_scenario("dummy", ["sim.duration=20.0"])).trace)
     assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
     assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults

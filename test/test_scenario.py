@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from swarm_sim.scenario import (
-    SCENARIO_DIR,
     Scenario,
     ScenarioError,
     load_scenario,
@@ -14,10 +13,11 @@ from swarm_sim.scenario import (
     scenario_from_dict,
     scenario_to_dict,
 )
+from swarm_sim import registry
 from swarm_sim.sites import drop_zones
 
 
-@pytest.mark.parametrize("path", sorted(SCENARIO_DIR.glob("*.yaml")), ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", list(registry.scenario_files().values()), ids=lambda p: p.stem)
 def test_shipped_scenarios_load(path):
     scenario = load_scenario(path.stem)
     assert scenario.name == path.stem

@@ -46,8 +46,8 @@ from swarm_controllers.caging.motion import Formation, GoTo, Limits, Motion, Nei
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
-from swarm_sim.world.landmarks import landmarks
-from swarm_sim.world.tasks.transport import OBJECT
+from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.task import OBJECT
 
 Point = tuple[float, float]
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from swarm_controllers.caging.metrics import caging_report, series_of, transport_stage
 from swarm_sim.types import robot_index
-from swarm_sim.world.landmarks import landmarks
+from swarm_controllers.caging.landmarks import landmarks
 
 SNAPSHOTS = 6
 

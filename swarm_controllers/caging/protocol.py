@@ -4,7 +4,7 @@ One frozen dataclass per type; `TYPE` is the paper's type number, `origin` and `
 robot ids. A message the paper sends "to j = 0 .. rho-1, j != i" is one message per
 destination; every robot hears every message (the graph's topics, the batch runner's router)
 and acts only on those addressed to it. On the graph they travel as the CAGING family
-(`swarm_msgs_py.caging_protocol`), one topic per type under ``/caging/``.
+(`swarm_controllers.caging.codec`), one topic per type under ``/caging/``.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ class Recruitment(_Message):
     """T_r* begins with the recruiter's start p_r*^0 [m, world frame] ..."""
     start_y: float
     trajectory: tuple[int, ...]
-    """... then the indices of the landmarks it reached, in order (`swarm_sim.world.landmarks`)."""
+    """... then the indices of the landmarks it reached, in order (`swarm_controllers.caging.landmarks`)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,0 +1,18 @@
+"""The CPFA's registry record (Hecker & Moses 2015), loaded through the ``swarmforage.algorithms``
+entry point: the queue paper's baseline, and the search its queue strategies build on."""
+
+from swarm_sim.registry import Algorithm, register
+
+SECTION = ("cpfa", "swarm_controllers.cpfa.config:CpfaConfig")
+"""``controller.cpfa``: also declared by the algorithms that search as the CPFA does."""
+PHEROMONES = "swarm_controllers.cpfa.codec:PHEROMONES"
+
+register(Algorithm(
+    name="cpfa",
+    paper="Hecker & Moses 2015 (Beyond pheromones); the queue paper's baseline (queue_depot_traffic.md sec. VII)",
+    behaviour="swarm_controllers.cpfa.behaviour:CpfaBehaviour",
+    config=(SECTION,),
+    peers=(PHEROMONES,),
+    deliveries=("depot", "docks"),
+    comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
+))

@@ -1,0 +1,18 @@
+"""The DRTM paper's protocol (`swarm_controllers.drtm.protocol`) on the graph: one record family.
+
+| message | topic | from -> to | QoS |
+|---|---|---|---|
+| NestReport | /nest/reports | robot -> nest | reliable, deep, volatile |
+| NestState | /nest/state | nest -> robots (and ``ros2 topic echo``) | reliable, transient-local |
+
+Both diagnostic_msgs/msg/DiagnosticArray (`swarm_msgs_py.records`): ``ros2 topic echo
+/nest/state`` shows ``food`` (F(t) [tokens]), ``waiting`` (N_W), ``recent_oaes`` (M_T2) and
+``total_oaes`` of every tick.
+"""
+
+from swarm_controllers.drtm.protocol import NestReport, NestState
+from swarm_msgs_py import topics
+from swarm_msgs_py.records import RecordFamily
+
+NEST = RecordFamily("nest", {NestReport: topics.NEST_REPORTS, NestState: topics.NEST_STATE},
+                    latched=(topics.NEST_STATE,))

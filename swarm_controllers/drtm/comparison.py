@@ -1,0 +1,309 @@
+"""The DRTM paper's comparison (Pang et al. 2023, drtm_task_allocation.md): DRTM vs ARTM in the
+comparison experiment (Sec. 3.1) and the four variations of Sec. 4, our runs next to the paper's
+V_f, E_e, M_T, M_v, F_t and net food, the two-sample t-tests of Tables 2 and 4, and the net food
+and OAEs over time of Figs. 5-6 (and 10-17).
+
+A condition is a shipped scenario: ``drtm`` for Sec. 3.1 and one variation file per subsection
+of Sec. 4; DRTM runs ``drtm.yaml``, ARTM ``artm.yaml``, each with the keys in which the
+condition's file differs from ``drtm.yaml`` as overrides, so a condition is written down once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table
+from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
+from swarm_sim.compare.sweep import RunPlan, frozen_fields
+
+DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
+DRTM_LABELS: dict[str, str] = {"drtm": "DRTM", "artm": "ARTM"}
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One experiment of the paper: its section, the scenario that holds it, its figures."""
+
+    section: str
+    scenario: str
+    what: str
+    figures: str
+    table4: str = ""
+    """Its row label in the paper's Table 4 (which numbers Sec. 4's subsections 5.1-5.4)."""
+
+
+DRTM_CONDITIONS: tuple[Condition, ...] = (
+    Condition("3.1", "drtm", "N_f = 20, E_a = 10, N_r = 20, L = 4 m (comparison)", "Figs. 5-6"),
+    Condition("4.1", "drtm_nf25", "N_f = 25", "Figs. 10-11", "5.1"),
+    Condition("4.2", "drtm_ea20", "E_a = 20", "Figs. 12-13", "5.2"),
+    Condition("4.3", "drtm_nr30", "N_r = 30", "Figs. 14-15", "5.3"),
+    Condition("4.4", "drtm_l3", "L = 3 m, d = 1 m", "Figs. 16-17", "5.4"),
+)
+"""The cells of the sweep, in order (cell = index)."""
+
+DRTM_METRICS: dict[str, tuple[str, str, float]] = {
+    "food_deviation": ("V_f", "average deviation of food [tokens]", 1.0),
+    "energy_efficiency": ("E_e", "energy efficiency [%]", 100.0),
+    "oae_total": ("M_T", "obstacle-avoidance events, total", 1.0),
+    "oae_per_robot": ("M_v", "obstacle-avoidance events per robot", 1.0),
+    "food_collected": ("F_t", "food tokens collected", 1.0),
+    "nest_food_final": ("F(T)", "net food in the nest at the end [tokens]", 1.0),
+}
+"""JSON field -> (the paper's symbol, meaning, factor to the paper's unit)."""
+
+PAPER: dict[str, dict[str, dict[str, float]]] = {
+    "3.1": {"drtm": {"food_deviation": 2.55, "energy_efficiency": 11.99, "oae_total": 925.96, "oae_per_robot": 46.30,
+                     "food_collected": 173.76, "nest_food_final": 20.84},
+            "artm": {"food_deviation": 4.74, "energy_efficiency": 9.99, "oae_total": 1148.44, "oae_per_robot": 57.42,
+                     "food_collected": 183.46, "nest_food_final": 18.34}},
+    "4.1": {"drtm": {"food_deviation": 2.90, "energy_efficiency": 13.31, "oae_total": 760.22, "oae_per_robot": 38.01,
+                     "food_collected": 156.90, "nest_food_final": 20.88},
+            "artm": {"food_deviation": 2.92, "energy_efficiency": 11.06, "oae_total": 1053.20, "oae_per_robot": 52.66,
+                     "food_collected": 150.44, "nest_food_final": 16.63}},
+    "4.2": {"drtm": {"food_deviation": 3.06, "energy_efficiency": 10.78, "oae_total": 912.06, "oae_per_robot": 45.60,
+                     "food_collected": 189.14, "nest_food_final": 20.39},
+            "artm": {"food_deviation": 5.18, "energy_efficiency": 8.45, "oae_total": 1152.26, "oae_per_robot": 57.61,
+                     "food_collected": 189.32, "nest_food_final": 15.99}},
+    "4.3": {"drtm": {"food_deviation": 3.17, "energy_efficiency": 8.72, "oae_total": 1203.32, "oae_per_robot": 40.11,
+                     "food_collected": 229.44, "nest_food_final": 19.99},
+            "artm": {"food_deviation": 4.94, "energy_efficiency": 6.67, "oae_total": 1612.26, "oae_per_robot": 53.74,
+                     "food_collected": 236.40, "nest_food_final": 15.77}},
+    "4.4": {"drtm": {"food_deviation": 2.35, "energy_efficiency": 10.74, "oae_total": 1423.08, "oae_per_robot": 71.15,
+                     "food_collected": 165.32, "nest_food_final": 17.75},
+            "artm": {"food_deviation": 4.61, "energy_efficiency": 8.91, "oae_total": 1882.32, "oae_per_robot": 94.12,
+                     "food_collected": 170.90, "nest_food_final": 15.22}},
+}
+"""THE PAPER'S numbers, not ours: means over 50 ARGoS runs of 20 min (Secs. 3.1 and 4.1-4.4;
+E_e in %). Every E_e it gives equals F(T) / F_t."""
+
+PAPER_TTESTS: dict[str, dict[str, tuple[float, float]]] = {
+    "3.1": {"food_collected": (3.1918, 0.0019), "oae_total": (2.2899, 0.0242)},
+    "4.1": {"food_collected": (4.9663, 2.89e-6), "oae_total": (2.7761, 6.59e-3)},
+    "4.2": {"food_collected": (3.2744, 1.46e-3), "oae_total": (2.3803, 0.0192)},
+    "4.3": {"food_collected": (4.7869, 6.00e-6), "oae_total": (3.9267, 1.60e-4)},
+    "4.4": {"food_collected": (2.1899, 0.0310), "oae_total": (2.6984, 8.21e-3)},
+}
+"""THE PAPER'S Tables 2 and 4: (t, two-tailed p) of DRTM vs ARTM, 50 runs each (98 d.o.f.), all
+reported significant; the paper gives no sign convention and every t is positive."""
+
+SERIES: dict[str, str] = {
+    "nest_food_series": "net food in the nest F(t) [tokens]",
+    "oae_series": "obstacle-avoidance events so far",
+    "active_robots_series": "robots foraging (N_r - N_W)",
+}
+
+
+def condition_overrides(condition: Condition) -> tuple[str, ...]:
+    """``key=value`` overrides that turn ``drtm.yaml`` into the condition's scenario (every leaf
+    in which the two differ, but the name and the behaviour)."""
+    from swarm_sim.scenario import load_scenario, scenario_to_dict
+
+    def leaves(data: Any, prefix: str = "") -> dict[str, Any]:
+        if isinstance(data, dict):
+            return {k: v for key, value in data.items() for k, v in leaves(value, f"{prefix}{key}.").items()}
+        return {prefix[:-1]: data}
+
+    base = leaves(scenario_to_dict(load_scenario("drtm")))
+    mine = leaves(scenario_to_dict(load_scenario(condition.scenario)))
+    skip = {"name", "controller.behaviour"}
+    return tuple(f"{k}={json.dumps(v)}" for k, v in sorted(mine.items()) if k not in skip and base.get(k) != v)
+
+
+def drtm_plans(conditions: Sequence[int], strategies: Sequence[str] = DRTM_STRATEGIES, *,
+               duration: float | None = None, overrides: Sequence[str] = ()) -> list[RunPlan]:
+    """Both models in every condition (conditions outer, so a cut sweep has whole conditions)."""
+    fields = frozen_fields({"sim__duration": duration})
+    plans = []
+    for cell in conditions:
+        c = DRTM_CONDITIONS[cell]
+        own = condition_overrides(c)
+        plans.extend(RunPlan(s, cell, (*own, *overrides), fields, (("condition", c.section),)) for s in strategies)
+    return plans
+
+
+def _paper_value(section: str, strategy: str, metric: str) -> float | None:
+    return PAPER.get(section, {}).get(strategy, {}).get(metric)
+
+
+def _ours(rows: Sequence[dict], strategy: str, cell: int, metric: str) -> list[float]:
+    return [v * DRTM_METRICS[metric][2] for v in values_of(rows, strategy, cell, metric)]
+
+
+def drtm_table_md(rows: Sequence[dict], conditions: Sequence[int], strategies: Sequence[str]) -> str:
+    """table.md: per condition, every measure of Sec. 2.4 for both models, ours next to the paper's,
+    and whether DRTM vs ARTM goes the paper's way."""
+    lines = ["# DRTM paper comparison (Pang et al. 2023): tables", "",
+             "`ours` = this simulator, mean ± sample std (n runs); `paper` = **the paper's numbers** (ARGoS, "
+             "50 runs), hard-coded reference data. E_e in %. `same way` says whether DRTM vs ARTM differ in "
+             "the paper's direction (better for DRTM: lower V_f, M_T, M_v; higher E_e, F(T)).", ""]
+    better_low = {"food_deviation", "oae_total", "oae_per_robot"}
+    for cell in conditions:
+        c = DRTM_CONDITIONS[cell]
+        lines += [f"## Sec. {c.section}: {c.what} (scenario `{c.scenario}`)", ""]
+        header = ["measure"] + [f"{DRTM_LABELS[s]} {w}" for s in strategies for w in ("ours", "paper")]
+        if set(strategies) == set(DRTM_STRATEGIES):
+            header.append("same way")
+        body = []
+        for metric, (symbol, meaning, _) in DRTM_METRICS.items():
+            row = [f"{symbol}: {meaning}"]
+            means = {}
+            for s in strategies:
+                st = describe(_ours(rows, s, cell, metric))
+                means[s] = st.mean
+                row += [cell_text(st), fmt(_paper_value(c.section, s, metric))]
+            if len(header) > 1 + 2 * len(strategies):
+                paper = [_paper_value(c.section, s, metric) for s in DRTM_STRATEGIES]
+                ours = [means[s] for s in DRTM_STRATEGIES]
+                if None in paper or not all(math.isfinite(x) for x in ours) or metric == "food_collected":
+                    row.append("—")  # the paper has F_t higher for ARTM in 3 of 5 conditions: no direction
+                else:
+                    row.append("yes" if (ours[0] < ours[1]) == (paper[0] < paper[1]) else "no")
+            body.append(row)
+        lines += md_table(header, body) + [""]
+    return "\n".join(lines)
+
+
+def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:
+    """ttests.md: Tables 2 and 4, two-sample t-tests (scipy ttest_ind, equal variances) of DRTM
+    against ARTM on F_t and M_T, ours next to the paper's."""
+    lines = ["# DRTM paper comparison: two-sample t-tests on F_t and M_T (Tables 2 and 4)", "",
+             "scipy.stats.ttest_ind(DRTM, ARTM), equal variances, two-sided, as the paper (50 + 50 runs, 98 "
+             "d.o.f.). Our t is signed (negative: DRTM's mean is lower); the paper's t are all positive and "
+             "it gives no sign convention. `significant`: *** p<0.001, ** p<0.01, * p<0.05, else no.", ""]
+    body = []
+    for cell in conditions:
+        c = DRTM_CONDITIONS[cell]
+        for metric in ("food_collected", "oae_total"):
+            a, b = values_of(rows, "drtm", cell, metric), values_of(rows, "artm", cell, metric)
+            t, p = pair_test(a, b, "t")
+            paper_t, paper_p = PAPER_TTESTS[c.section][metric]
+            body.append([f"{c.section}" + (f" (Table 4: {c.table4})" if c.table4 else " (Table 2)"),
+                         DRTM_METRICS[metric][0], cell_text(describe(a)), cell_text(describe(b)),
+                         f"{len(a) + len(b) - 2}", fmt(t, 3), fmt_p(p), stars(p, "no"),
+                         fmt(paper_t, 4), fmt_p(paper_p)])
+    lines += md_table(["Sec.", "compare", "DRTM ours", "ARTM ours", "d.o.f.", "t ours", "p ours", "significant",
+                       "t paper", "p paper"], body) + [""]
+    return "\n".join(lines)
+
+
+def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: Sequence[str], key: str,
+                  path: Path, desired: dict[int, float] | None = None) -> Path:
+    """One panel per condition: the mean of `key` over the seeds with a ±1 std band, one colour
+    per model, F_d dashed where given (Figs. 5-6, 10-17)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(conditions), figsize=(4.2 * len(conditions), 3.6), squeeze=False, sharey=True)
+    for ax, cell in zip(axes[0], conditions):
+        c = DRTM_CONDITIONS[cell]
+        for j, s in enumerate(strategies):
+            t, mean, std = mean_series(rows, s, cell, key)
+            if len(t):
+                n = sum(1 for r in rows if r.get("strategy") == s and r.get("cell") == cell and r.get(key))
+                ax.plot(t / 60.0, mean, color=f"C{j}", label=f"{DRTM_LABELS.get(s, s)} (n={n})")
+                ax.fill_between(t / 60.0, mean - std, mean + std, color=f"C{j}", alpha=0.2)
+        if desired and cell in desired:
+            ax.axhline(desired[cell], color="black", linestyle="--", linewidth=1, label="F_d")
+        ax.set(title=f"Sec. {c.section}: {c.what.split(' (')[0]}", xlabel="time [min]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize="small")
+    axes[0][0].set_ylabel(SERIES[key])
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int] | None = None,
+                      strategies: Sequence[str] = DRTM_STRATEGIES) -> list[Path]:
+    """table.md, ttests.md and the time-series figures from result rows."""
+    from swarm_controllers.drtm.config import NestConfig
+    from swarm_sim.scenario import load_scenario
+
+    conditions = sorted({r["cell"] for r in rows if r.get("cell") is not None}) if conditions is None else conditions
+    out.mkdir(parents=True, exist_ok=True)
+    written = [out / "table.md", out / "ttests.md"]
+    written[0].write_text(drtm_table_md(rows, conditions, strategies))
+    written[1].write_text(drtm_ttests_md(rows, conditions))
+    desired = {c: NestConfig.of(load_scenario(DRTM_CONDITIONS[c].scenario)).desired_food for c in conditions}
+    for name, key in (("food.png", "nest_food_series"), ("oae.png", "oae_series"),
+                      ("active.png", "active_robots_series")):
+        written.append(series_figure(rows, conditions, strategies, key, out / name,
+                                     desired if key == "nest_food_series" else None))
+    return written
+
+
+HEADLINES: tuple[tuple[str, str, str, bool], ...] = (
+    ("food_deviation", "DRTM keeps the food closer to F_d (V_f lower than ARTM's)", "Secs. 3.1, 4.1-4.4", True),
+    ("oae_total", "DRTM has fewer obstacle-avoidance events (M_T lower than ARTM's)", "Secs. 3.1, 4.1-4.4; t-tests", True),
+    ("energy_efficiency", "DRTM is more energy-efficient (E_e higher than ARTM's)", "Secs. 3.1, 4.1-4.4", False),
+)
+"""(field, claim, where the paper says it, DRTM better when lower): the paper's headline claims,
+each made for every condition."""
+
+
+def drtm_headlines(rows: Sequence[dict], conditions: Sequence[int]) -> list[Headline]:
+    """Each headline claim checked on the means of every condition run: it holds where DRTM beats
+    ARTM in all of them (None without both models' runs)."""
+    out = []
+    for metric, claim, where, lower in HEADLINES:
+        wins, seen = [], []
+        for cell in conditions:
+            a, b = (describe(values_of(rows, s, cell, metric)).mean for s in DRTM_STRATEGIES)
+            if math.isfinite(a) and math.isfinite(b):
+                seen.append(DRTM_CONDITIONS[cell].section)
+                if (a < b) == lower and a != b:
+                    wins.append(DRTM_CONDITIONS[cell].section)
+        ours = f"DRTM better in {len(wins)}/{len(seen)}: {', '.join(wins) or 'none'}" if seen else "—"
+        out.append(Headline(claim, f"all five ({where})", ours, len(wins) == len(seen) if seen else None))
+    return out
+
+
+def _sections(text: Sequence[str] | None) -> list[int]:
+    known = [c.section for c in DRTM_CONDITIONS]
+    if not text:
+        return list(range(len(known)))
+    unknown = [s for s in text if s not in known]
+    if unknown:
+        raise SystemExit(f"swarm-compare drtm: unknown condition {unknown[0]!r} (known: {', '.join(known)})")
+    return [known.index(s) for s in known if s in text]
+
+
+def _add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--conditions", nargs="+", metavar="SEC",
+                        help="sections to run (default all: " + " ".join(c.section for c in DRTM_CONDITIONS) + ")")
+
+
+def _plans(args: argparse.Namespace, strategies: list[str]) -> list[RunPlan]:
+    return drtm_plans(_sections(args.conditions), strategies, duration=args.duration, overrides=args.overrides)
+
+
+def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, strategies: list[str]) -> list[Path]:
+    return write_drtm_report(rows, out, _sections(args.conditions), strategies)
+
+
+def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
+    return drtm_headlines(rows, _sections(args.conditions))
+
+
+DRTM_COMPARISON = Comparison(
+    name="drtm",
+    help="DRTM paper: DRTM vs ARTM in Secs. 3.1 and 4.1-4.4, tables, t-tests (Tables 2, 4), Figs. 5-6",
+    default_out="results/drtm",
+    strategies=DRTM_STRATEGIES,
+    add_arguments=_add_arguments,
+    plans=_plans,
+    write_report=_write_report,
+    headlines=_headlines,
+)

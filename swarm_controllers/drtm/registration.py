@@ -1,0 +1,38 @@
+"""The DRTM paper's registry records (drtm_task_allocation.md, Pang et al. 2023): its nest task,
+DRTM and the ARTM baseline, both served by the nest."""
+
+from swarm_sim.registry import Algorithm, Metric, ServerSpec, TaskSpec, register, register_task
+
+register_task(TaskSpec(
+    name="nest",
+    core="swarm_controllers.drtm.task:NestTask",
+    sensing="swarm_controllers.drtm.sensing:SENSING",
+    metrics="swarm_sim.analysis.metrics:foraging_metrics",
+))
+
+_SECTIONS = (("nest", "swarm_controllers.drtm.config:NestConfig"),
+             ("threshold", "swarm_controllers.drtm.config:ThresholdConfig"))
+_SERVER = ServerSpec(
+    channel="nest", core="swarm_controllers.drtm.nest:NestServer", node="swarm_controllers.drtm.nest_node",
+    script="swarm-nest", family="swarm_controllers.drtm.codec:NEST",
+    replay="swarm_controllers.drtm.nest:replay_nest_state",
+)
+_METRICS = tuple(
+    Metric(name, f"swarm_controllers.drtm.metrics:{name}", None)
+    for name in ("food_deviation", "energy_efficiency", "oae_total", "food_collected", "nest_food_final",
+                 "nest_food_series", "active_robots_series", "oae_series")
+)
+
+for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
+                             ("artm", "ArtmBehaviour", "ARTM (Castello et al.), the baseline")):
+    register(Algorithm(
+        name=_name,
+        paper=f"drtm_task_allocation.md (Pang et al. 2023) secs. 2-4: {_what}",
+        behaviour=f"swarm_controllers.drtm.behaviour:{_class}",
+        task="nest",
+        config=_SECTIONS,
+        checks=("swarm_controllers.drtm.config:check_nest",),
+        servers=(_SERVER,),
+        metrics=_METRICS,
+        comparison="swarm_controllers.drtm.comparison:DRTM_COMPARISON",
+    ))

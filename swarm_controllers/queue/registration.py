@@ -1,0 +1,26 @@
+"""The queue paper's registry record (queue_depot_traffic.md): the robots' side here, the depot
+manager's server in the top-level `depot_manager` package."""
+
+from swarm_controllers.cpfa.registration import PHEROMONES
+from swarm_controllers.cpfa.registration import SECTION as CPFA_SECTION
+from swarm_sim.registry import Algorithm, Metric, ServerSpec, register
+
+register(Algorithm(
+    name="queue",
+    paper="queue_depot_traffic.md secs. III-V: Q_SE, Q_ST, Q_ME, Q_MT",
+    behaviour="swarm_controllers.queue.behaviour:QueueBehaviour",
+    config=(CPFA_SECTION, ("queue", "depot_manager.config:QueueConfig")),
+    checks=("depot_manager.config:check_queue",),
+    servers=(ServerSpec(
+        channel="depot", core="depot_manager.server:DepotServer", node="depot_manager.node",
+        script="swarm-depot-manager", family="depot_manager.codec:DEPOT",
+        replay="swarm_msgs_py.server_state:replay_depot_state",
+    ),),
+    peers=(PHEROMONES, "depot_manager.codec:RADIO"),
+    deliveries=("docks",),
+    metrics=(
+        Metric("queue_length_mean", "depot_manager.metrics:queue_length_mean", 0.0),
+        Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
+    ),
+    comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
+))

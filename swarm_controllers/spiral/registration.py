@@ -1,0 +1,40 @@
+"""The spiral paper's registry records (mdbsa_spiral_search.md, Lu & Luna 2023): DDSA, and
+MDBSA with centralized (C) and distributed (D) delivery, both served by the center."""
+
+from swarm_sim.registry import Algorithm, Metric, ServerSpec, register
+
+_SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
+_CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
+_METRICS = (Metric("resources_per_robot_per_min",
+                   "swarm_controllers.spiral.metrics:resources_per_robot_per_min", None),)
+_COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
+_CENTER = ServerSpec(
+    channel="center", core="swarm_controllers.spiral.center:CenterServer",
+    node="swarm_controllers.spiral.center_node", script="swarm-center",
+    family="swarm_controllers.spiral.codec:CENTER",
+)
+
+register(Algorithm(
+    name="ddsa",
+    paper="mdbsa_spiral_search.md sec. III (Lu & Luna 2023): DDSA",
+    behaviour="swarm_controllers.spiral.ddsa:DdsaBehaviour",
+    config=(_SECTION,),
+    checks=_CHECKS,
+    metrics=_METRICS,
+    paths="swarm_controllers.spiral.ddsa:planned_paths",
+    comparison=_COMPARISON,
+))
+
+for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
+    register(Algorithm(
+        name=_name,
+        paper=f"mdbsa_spiral_search.md sec. IV (Lu & Luna 2023): MDBSA-{_name[-1].upper()}",
+        behaviour="swarm_controllers.spiral.mdbsa:MdbsaBehaviour",
+        config=(_SECTION,),
+        checks=_CHECKS,
+        servers=(_CENTER,),
+        deliveries=(_delivery,),
+        metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
+        paths="swarm_controllers.spiral.center:planned_paths",
+        comparison=_COMPARISON,
+    ))

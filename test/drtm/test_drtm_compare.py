@@ -1,0 +1,97 @@
+"""``swarm-compare drtm``: its conditions come from the variation scenarios, its report puts our
+runs next to the paper's numbers (synthetic rows, no simulation)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from swarm_sim.compare.cli import main
+from swarm_controllers.drtm.comparison import (
+    DRTM_CONDITIONS,
+    PAPER,
+    condition_overrides,
+    drtm_headlines,
+    drtm_plans,
+    write_drtm_report,
+)
+from swarm_sim.compare.stats import mean_series
+from swarm_sim.scenario import load_scenario, scenario_to_dict
+
+
+def test_each_condition_is_its_scenario_file_as_overrides_of_drtm():
+    assert [condition_overrides(c) for c in DRTM_CONDITIONS] == [
+        (), ("resources.count=25",), ("controller.nest.avoidance_energy=20.0",), ("robots.count=30",),
+        ("arena.size=3.0", "depot.radius=0.5")]
+    for c in DRTM_CONDITIONS:  # ARTM's runs are artm.yaml with the same overrides: the same world
+        for name in ("drtm", "artm"):
+            got = scenario_to_dict(load_scenario(name, condition_overrides(c)))
+            want = scenario_to_dict(load_scenario(c.scenario))
+            assert {**got, "name": None, "controller": {**got["controller"], "behaviour": None}} == \
+                   {**want, "name": None, "controller": {**want["controller"], "behaviour": None}}
+
+
+def test_artm_yaml_is_drtm_yaml_but_for_name_and_behaviour():
+    drtm, artm = (scenario_to_dict(load_scenario(n)) for n in ("drtm", "artm"))
+    assert artm["controller"].pop("behaviour") == "artm" and drtm["controller"].pop("behaviour") == "drtm"
+    assert {**artm, "name": "x"} == {**drtm, "name": "x"}
+
+
+def test_plans_run_both_models_in_every_chosen_condition():
+    plans = drtm_plans([0, 4], duration=60.0, overrides=["seed=1"])
+    assert [(p.strategy, p.cell) for p in plans] == [("drtm", 0), ("artm", 0), ("drtm", 4), ("artm", 4)]
+    assert plans[2].overrides == ("arena.size=3.0", "depot.radius=0.5", "seed=1")  # the user's last
+    assert plans[3].fields == (("sim__duration", 60.0),) and dict(plans[3].extra) == {"condition": "4.4"}
+
+
+def _row(strategy: str, cell: int, seed: int, shift: float) -> dict:
+    food = [[5.0 * k, 5.0 + shift + 0.1 * k] for k in range(5)]
+    return {"strategy": strategy, "cell": cell, "seed": seed, "food_deviation": 3.0 + shift,
+            "energy_efficiency": 0.1 + 0.01 * shift, "oae_total": 900 + 100 * shift + seed,
+            "oae_per_robot": 45.0 + 5 * shift, "food_collected": 170 + seed + 10 * shift,
+            "nest_food_final": 19.0 - shift, "nest_food_series": food,
+            "oae_series": [[5.0 * k, 10 * k] for k in range(5)], "active_robots_series": [[0.0, 0], [5.0, 3]]}
+
+
+def test_report_puts_ours_next_to_the_papers_numbers_with_t_tests(tmp_path):
+    rows = [_row(s, c, seed, shift) for c in (0, 3) for s, shift in (("drtm", 0.0), ("artm", 1.0))
+            for seed in range(4)]
+    written = write_drtm_report(rows, tmp_path, [0, 3])
+    assert [p.name for p in written] == ["table.md", "ttests.md", "food.png", "oae.png", "active.png"]
+    table = (tmp_path / "table.md").read_text()
+    assert "## Sec. 3.1" in table and "## Sec. 4.3" in table and "## Sec. 4.1" not in table
+    assert f"{PAPER['4.3']['artm']['oae_total']:.2f}" in table  # the paper's 1612.26 next to ours
+    assert "| E_e: energy efficiency [%] | 10.00 ± 0.00 (n=4) | 11.99 | 11.00 ± 0.00 (n=4) | 9.99 | no |" in table
+    ttests = (tmp_path / "ttests.md").read_text()
+    assert "| 3.1 (Table 2) | F_t |" in ttests and "| 4.3 (Table 4: 5.3) | M_T |" in ttests
+    assert "3.1918" in ttests and "***" in ttests  # the paper's t, and our clearly separated groups
+
+
+def test_mean_series_over_seeds():
+    rows = [_row("drtm", 0, seed, shift) for seed, shift in enumerate((0.0, 2.0))]
+    t, mean, std = mean_series(rows, "drtm", 0, "nest_food_series")
+    assert t.tolist() == [0.0, 5.0, 10.0, 15.0, 20.0]
+    assert np.allclose(mean, [6.0, 6.1, 6.2, 6.3, 6.4]) and np.allclose(std, np.sqrt(2.0))
+
+
+def test_cli_runs_the_drtm_comparison_with_a_fake_run(tmp_path):
+    calls = []
+
+    def run(job):
+        name, overrides, fields, seed = job
+        calls.append((name, tuple(overrides)))
+        return {**_row(name, 0, seed, 0.0 if name == "drtm" else 1.0), "seed": seed, "scenario": name}
+
+    assert main(["drtm", "--seeds", "3", "--conditions", "4.2", "--out", str(tmp_path)], run=run) == 0
+    assert sorted(set(calls)) == [("artm", ("controller.nest.avoidance_energy=20.0",)),
+                                  ("drtm", ("controller.nest.avoidance_energy=20.0",))]
+    assert "## Sec. 4.2: E_a = 20" in (tmp_path / "table.md").read_text()
+
+
+def test_headlines_count_the_conditions_drtm_wins():
+    rows = [_row(s, c, seed, shift) for c in (0, 1) for s, shift in (("drtm", 0.0), ("artm", 1.0)) for seed in range(3)]
+    rows += [_row("drtm", 2, 0, 1.0), _row("artm", 2, 0, 0.0)]  # condition 4.2: ARTM better
+    found = {h.claim.split(" (")[0]: h for h in drtm_headlines(rows, [0, 1, 2, 3])}
+    assert found["DRTM keeps the food closer to F_d"].ours == "DRTM better in 2/3: 3.1, 4.1"
+    assert found["DRTM keeps the food closer to F_d"].holds is False
+    assert found["DRTM is more energy-efficient"].ours == "DRTM better in 1/3: 4.2"
+    assert drtm_headlines([], [0])[0].holds is None

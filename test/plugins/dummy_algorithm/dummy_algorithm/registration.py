@@ -1,0 +1,18 @@
+"""The dummy algorithm's registry record, loaded through its ``swarmforage.algorithms`` entry
+point: its own behaviour, world task (a beacon, sensed on ``/<robot>/beacon``), server (a ping
+counter), message family (``/dummy/pings``) and metric."""
+
+from swarm_sim.registry import Algorithm, Metric, ServerSpec, TaskSpec, register, register_task
+
+register_task(TaskSpec(name="beacon", core="dummy_algorithm.task:BeaconTask",
+                       sensing="dummy_algorithm.codec:SENSING"))
+register(Algorithm(
+    name="dummy",
+    paper="none: a test of the registry",
+    behaviour="dummy_algorithm.behaviour:DummyBehaviour",
+    task="beacon",
+    servers=(ServerSpec(channel="counter", core="dummy_algorithm.server:CounterServer",
+                        node="dummy_algorithm.node", script="dummy-counter",
+                        family="dummy_algorithm.codec:PINGS", replay="dummy_algorithm.server:replay_pings"),),
+    metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard", None),),
+))
