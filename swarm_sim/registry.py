@@ -40,6 +40,16 @@ ENTRY_POINT_GROUP = "swarmforage.algorithms"
 
 
 @dataclass(frozen=True)
+class Measure:
+    """A result field (`swarm_sim.analysis.metrics.summarize`) that a run's text summary shows
+    (``swarm-analyze``), in the paper's words and unit."""
+
+    field: str
+    unit: str = ""
+    """Printed after the value (``s``, ``%``, ``min``); empty for counts and ratios."""
+
+
+@dataclass(frozen=True)
 class ServerSpec:
     """A node core other than the world and the robots (`swarm_sim.protocol.Server`)."""
 
@@ -75,6 +85,8 @@ class TaskSpec:
     """``module:STATE``: a tuple of `swarm_msgs_py.sensing.StateTopic`, the world-level topics
     the world node publishes from the task's ``state()`` every tick; the batch runner and the
     bag replay keep each as the time series ``RunTrace.series[field]`` (None: none)."""
+    headline: tuple[Measure, ...] = ()
+    """What a run's text summary shows of the task's own fields (before its algorithm's)."""
 
 
 @dataclass(frozen=True)
@@ -121,6 +133,8 @@ class Algorithm:
     figures: str | None = None
     """``module:function`` ``(trace, directory) -> [Path]``: its own pictures of a run, drawn
     by ``swarm-analyze --trajectories`` (None: none)."""
+    headline: tuple[Measure, ...] = ()
+    """The paper's own measures, as a run's text summary shows them (after its task's)."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

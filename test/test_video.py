@@ -15,6 +15,7 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 
+from depot_manager.node import _DOCK as DOCK_COLOUR
 from swarm_sim.analysis.cli import main as analyze
 from swarm_sim.analysis.video import SIZE_PX, render_video, save_frame
 
@@ -50,9 +51,10 @@ def test_gif_frames_show_the_robots_and_the_depot(out_dir, tmp_path):
     assert len(frames) == 3
     png = save_frame(bag, 12.0, tmp_path / "frame.png")
     image = imageio.imread(png)[..., :3].reshape(-1, 3).astype(int)
-    tab_blue, tab_green = np.array([31, 119, 180]), np.array([44, 160, 44])  # a robot state; the docks
+    tab_blue = np.array([31, 119, 180])  # a robot state
+    docks = np.round(255 * np.array(DOCK_COLOUR[:3]))  # drawn in the colour the depot manager gives them
     assert (np.abs(image - tab_blue).sum(axis=1) < 10).sum() > 20
-    assert (np.abs(image - tab_green).sum(axis=1) < 10).sum() > 20
+    assert (np.abs(image - docks).sum(axis=1) < 10).sum() > 20
 
 
 def test_a_dir_with_two_bags_or_none_is_refused_naming_them(out_dir, tmp_path, capsys):

@@ -1,7 +1,7 @@
 """The caging paper's registry records (caging_transport.md, Cardoso, Nedjah & Mourelle): the
 transport task (landmarks, the object) and the caging algorithm."""
 
-from swarm_sim.registry import Algorithm, Metric, TaskSpec, register, register_task
+from swarm_sim.registry import Algorithm, Measure, Metric, TaskSpec, register, register_task
 
 register_task(TaskSpec(
     name="transport",
@@ -29,4 +29,7 @@ register(Algorithm(
     )),
     figures="swarm_controllers.caging.figures:transport_figure",
     comparison="swarm_controllers.caging.comparison:CAGING_COMPARISON",
+    headline=(Measure("search_time_s", "s"), Measure("recruitment_time_s", "s"), Measure("transport_time_s", "s"),
+              Measure("total_time_s", "s"), Measure("cage_held"), Measure("trajectory_error_pct", "%"),
+              Measure("landmarks"), Measure("cage_size")),
 ))

@@ -1,11 +1,14 @@
 """The CPFA's registry record (Hecker & Moses 2015), loaded through the ``swarmforage.algorithms``
 entry point: the queue paper's baseline, and the search its queue strategies build on."""
 
-from swarm_sim.registry import Algorithm, register
+from swarm_sim.registry import Algorithm, Measure, register
 
 SECTION = ("cpfa", "swarm_controllers.cpfa.config:CpfaConfig")
 """``controller.cpfa``: also declared by the algorithms that search as the CPFA does."""
 PHEROMONES = "swarm_controllers.cpfa.codec:PHEROMONES"
+HEADLINE = (Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"),
+            Measure("dropoff_time_mean_s", "s"))
+"""The queue paper's three metrics (sec. VII), which it reports for the CPFA too."""
 
 register(Algorithm(
     name="cpfa",
@@ -15,4 +18,5 @@ register(Algorithm(
     peers=(PHEROMONES,),
     deliveries=("depot", "docks"),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
+    headline=HEADLINE,
 ))

@@ -1,7 +1,7 @@
 """The DRTM paper's registry records (drtm_task_allocation.md, Pang et al. 2023): its nest task,
 DRTM and the ARTM baseline, both served by the nest."""
 
-from swarm_sim.registry import Algorithm, Metric, ServerSpec, TaskSpec, register, register_task
+from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, TaskSpec, register, register_task
 
 register_task(TaskSpec(
     name="nest",
@@ -23,6 +23,10 @@ _METRICS = tuple(
                  "nest_food_series", "active_robots_series", "oae_series")
 )
 
+_HEADLINE = (Measure("food_deviation"), Measure("energy_efficiency"), Measure("oae_total"),
+             Measure("oae_per_robot"), Measure("food_collected"), Measure("nest_food_final"))
+"""The paper's V_f [tokens], E_e, M_T, M_v, F_t [tokens] and F(T) [tokens] (Sec. 3, eqs. (8)-(9))."""
+
 for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
                              ("artm", "ArtmBehaviour", "ARTM (Castello et al.), the baseline")):
     register(Algorithm(
@@ -35,4 +39,5 @@ for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
         servers=(_SERVER,),
         metrics=_METRICS,
         comparison="swarm_controllers.drtm.comparison:DRTM_COMPARISON",
+        headline=_HEADLINE,
     ))

@@ -1,9 +1,9 @@
 """The queue paper's registry record (queue_depot_traffic.md): the robots' side here, the depot
 manager's server in the top-level `depot_manager` package."""
 
-from swarm_controllers.cpfa.registration import PHEROMONES
+from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES
 from swarm_controllers.cpfa.registration import SECTION as CPFA_SECTION
-from swarm_sim.registry import Algorithm, Metric, ServerSpec, register
+from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, register
 
 register(Algorithm(
     name="queue",
@@ -23,4 +23,6 @@ register(Algorithm(
         Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
     ),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
+    headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s"), Measure("deliveries_outside_docks"),
+              Measure("queue_length_mean"), Measure("queue_length_max")),
 ))

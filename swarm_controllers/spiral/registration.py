@@ -1,12 +1,15 @@
 """The spiral paper's registry records (mdbsa_spiral_search.md, Lu & Luna 2023): DDSA, and
 MDBSA with centralized (C) and distributed (D) delivery, both served by the center."""
 
-from swarm_sim.registry import Algorithm, Metric, ServerSpec, register
+from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, register
 
 _SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
 _CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
 _METRICS = (Metric("resources_per_robot_per_min",
                    "swarm_controllers.spiral.metrics:resources_per_robot_per_min", None),)
+_HEADLINE = (Measure("resources_per_robot"), Measure("resources_per_robot_per_min", "/min"),
+             Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"))
+"""The spiral paper's measures (Figs. 6-10): resources per robot, their rate, collision time."""
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.spiral.center:CenterServer",
@@ -23,6 +26,7 @@ register(Algorithm(
     metrics=_METRICS,
     paths="swarm_controllers.spiral.ddsa:planned_paths",
     comparison=_COMPARISON,
+    headline=_HEADLINE,
 ))
 
 for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
@@ -37,4 +41,5 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
         paths="swarm_controllers.spiral.center:planned_paths",
         comparison=_COMPARISON,
+        headline=(*_HEADLINE, Measure("regions")),
     ))

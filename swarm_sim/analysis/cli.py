@@ -15,6 +15,7 @@ from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
+from swarm_sim.analysis.text import summary_lines
 from swarm_sim.analysis.video import render_video
 from swarm_sim.cli import number
 from swarm_sim.recording import BagError, repair_bag
@@ -89,21 +90,7 @@ def main(argv: list[str] | None = None) -> int:
             print(json.dumps(summary))
         else:
             print(f"{bag}:")
-            own = [m.name for m in registry.of(trace.config).metrics]
-            for key in dict.fromkeys(("scenario", "seed", "robots", "mode", "run_ended", "dead_nodes", "sim_seconds",
-                        "wall_seconds",
-                        "resources_delivered", "total_resources", "collision_time_per_robot_s",
-                        "oae_per_robot", "trips_per_robot", "stale_ticks", "clamped_commands",
-                        "resources_collected_pct", "dropoff_time_mean_s", "perimeter_delay_mean_s",
-                        "deliveries_outside_docks",
-                        "queue_length_mean", "queue_length_max", "resources_per_robot",
-                        "foraging_rate_per_min", "regions", "rejected_messages", *own, "plot", "trajectories",
-                        "figures", "video", "video_frames")):
-                if key in summary:
-                    print(f"  {key:28s} {summary[key]}")
-            for m in registry.of(trace.config).metrics if trace.config is not None else ():
-                if not isinstance(summary.get(m.name), (list, dict)):  # the run's own algorithm's fields
-                    print(f"  {m.name:28s} {summary.get(m.name)}")
+            print("\n".join(summary_lines(summary, trace.config)))
     return status
 
 

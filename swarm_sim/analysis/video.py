@@ -4,8 +4,9 @@ One pass over the bag in log-time order keeps the state a frame needs and draws 
 the sim clock passes the next frame time, so memory stays flat however long the run:
 
 - arena walls, drop zones and obstacles from the scenario in the bag's metadata;
-- the depot's lines, docks and owned slots (``/depot/markers``) and the center's regions and
-  planned spirals (``/center/markers``), as their servers last published them;
+- every server's overlay (any recorded ``visualization_msgs/MarkerArray`` topic but the world's,
+  e.g. a depot's lines and docks or a center's regions and planned paths), its line strips and
+  point lists in the colours and sizes the server gave them, as it last published them;
 - resources lying on the ground: the world's last ``/world/markers`` set, minus the pick-ups
   (``/world/events``) since, matched by position;
 - robots at their recorded odometry, true size, with a heading tick, coloured by the behaviour
@@ -55,10 +56,10 @@ class _State:
     carrying: set[str] = field(default_factory=set)
     resources: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     delivered: int = 0
-    lines: dict[str, list[np.ndarray]] = field(default_factory=dict)
-    """Servers' line markers by namespace (entry lines, regions, planned paths)."""
-    points: dict[str, np.ndarray] = field(default_factory=dict)
-    """Servers' point markers by namespace (docks, owned slots)."""
+    lines: dict[tuple[str, str], list[tuple[np.ndarray, tuple[float, ...], float]]] = field(default_factory=dict)
+    """Servers' line strips by (topic, namespace): (points [m], RGBA, width [m]) each."""
+    points: dict[tuple[str, str], tuple[np.ndarray, tuple[float, ...], float, str]] = field(default_factory=dict)
+    """Servers' point lists by (topic, namespace): (points [m], RGBA, size [m], matplotlib marker)."""
 
 
 @dataclass(frozen=True)
@@ -85,8 +86,13 @@ def _xy(marker) -> np.ndarray:
     return np.array([(p.x, p.y) for p in marker.points], dtype=float).reshape(-1, 2)
 
 
-def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int]) -> None:
-    """Fold one recorded message into the state."""
+def _rgba(marker) -> tuple[float, ...]:
+    c = marker.color
+    return tuple(min(max(float(v), 0.0), 1.0) if math.isfinite(v) else 0.5 for v in (c.r, c.g, c.b, c.a))
+
+
+def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int], overlays: frozenset[str]) -> None:
+    """Fold one recorded message into the state; `overlays`: the servers' marker topics."""
     if topic.endswith("/" + topics.ODOM):
         i = robots.get(topic[1:].partition("/")[0])
         if i is not None:
@@ -109,23 +115,18 @@ def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int]) -> No
         for m in _markers(data):
             if m.ns == "resources":
                 state.resources = _xy(m)
-    elif topic in (topics.DEPOT_MARKERS, topics.CENTER_MARKERS):
-        lines: dict[str, list[np.ndarray]] = {}
+    elif topic in overlays:
+        lines: dict[tuple[str, str], list] = {}
         for m in _markers(data):
             if m.type == _LINE_STRIP:
-                lines.setdefault(m.ns, []).append(_xy(m))
+                lines.setdefault((topic, m.ns), []).append((_xy(m), _rgba(m), float(m.scale.x)))
             elif m.type in (_CUBE_LIST, _SPHERE_LIST):
-                state.points[m.ns] = _xy(m)
+                state.points[(topic, m.ns)] = (_xy(m), _rgba(m), float(m.scale.x), "s" if m.type == _CUBE_LIST else "o")
         state.lines.update(lines)
 
 
 class _Canvas:
     """One matplotlib figure whose artists are updated per frame."""
-
-    _LINE_STYLE = {"entry_lines": ("0.2", 0.8), "exit_lines": ("tab:blue", 0.8), "inner_queues": ("tab:purple", 0.8),
-                   "regions": ("0.6", 0.6), "planned_paths": ("0.8", 0.4)}
-    _POINT_STYLE = {"docks": ("tab:green", 30, "s"), "slots_owned": ("black", 8, "o"),
-                    "entry_points": ("0.2", 10, "o"), "exit_points": ("tab:blue", 10, "o")}
 
     def __init__(self, scenario: Scenario, robots: int) -> None:
         import matplotlib
@@ -151,7 +152,8 @@ class _Canvas:
                xticks=[], yticks=[])
         self.server_lines = LineCollection([], linewidths=0.8, zorder=1)
         ax.add_collection(self.server_lines)
-        self.server_points = ax.scatter([], [], s=[], zorder=2)
+        self.server_points: dict[tuple[str, str], object] = {}
+        """A scatter per server point list: markers drawn at the size [m] the server gave them."""
         self.resources = ax.scatter([], [], s=4, color="goldenrod", zorder=3, lw=0)
         d = scenario.robots.diameter
         self.robots = EllipseCollection(np.full(robots, d), np.full(robots, d), np.zeros(robots), units="xy",
@@ -164,6 +166,8 @@ class _Canvas:
         self.title = ax.set_title(f"{scenario.name}  t = 0.0 s", fontsize=10, family="monospace")
         self.legend_states: list[str] = []
         self.fig.tight_layout()
+        self._pt_per_m = ax.transData.get_matrix()[0, 0] * 72.0 / _DPI
+        """Points per metre at this figure's scale (a scatter's size is in points squared)."""
 
     def _colour(self, state: str) -> str:
         if state not in self.legend_states:
@@ -180,18 +184,23 @@ class _Canvas:
 
     def draw(self, state: _State, t: float, robot_names: list[str]) -> np.ndarray:
         segments, colours = [], []
-        for ns, lines in state.lines.items():
-            colour, _ = self._LINE_STYLE.get(ns, ("0.5", 0.5))
-            segments += lines
-            colours += [colour] * len(lines)
+        for key in sorted(state.lines):
+            for xy, rgba, _ in state.lines[key]:
+                segments.append(xy)
+                colours.append(rgba)
         self.server_lines.set_segments(segments)
         self.server_lines.set_color(colours)
-        pts = [(ns, p) for ns, p in state.points.items() if len(p)]
-        if pts:
-            style = [self._POINT_STYLE.get(ns, ("0.5", 6, "o")) for ns, _ in pts]
-            self.server_points.set_offsets(np.concatenate([p for _, p in pts]))
-            self.server_points.set_sizes(np.concatenate([[s[1]] * len(p) for s, (_, p) in zip(style, pts)]))
-            self.server_points.set_color(sum(([s[0]] * len(p) for s, (_, p) in zip(style, pts)), []))
+        for key, artist in self.server_points.items():
+            if key not in state.points:
+                artist.set_offsets(np.zeros((0, 2)))
+        for key in sorted(state.points):
+            xy, rgba, size, shape = state.points[key]
+            if key not in self.server_points:
+                self.server_points[key] = self.ax.scatter([], [], marker=shape, zorder=2, lw=0)
+            artist = self.server_points[key]
+            artist.set_offsets(xy if len(xy) else np.zeros((0, 2)))
+            artist.set_sizes([max(1.0, (size * self._pt_per_m) ** 2)])
+            artist.set_color([rgba])
         self.resources.set_offsets(state.resources if len(state.resources) else np.zeros((0, 2)))
         poses = np.full((len(robot_names), 3), np.nan)
         for i, data in state.odom.items():
@@ -243,6 +252,7 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
     scenario = scenario_from_dict(json.loads(info.metadata["scenario"]))
     names = list(scenario.robot_names)
     robots = {r: i for i, r in enumerate(names)}
+    overlays = frozenset(t for t, i in info.topics.items() if i.type_name == _MARKER_TYPES and t != topics.WORLD_MARKERS)
     state = _State()
     canvas = _Canvas(scenario, len(names))
     done = 0
@@ -254,7 +264,7 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
             if done == len(times):
                 return
             try:
-                _apply(state, m.topic, m.data, robots)
+                _apply(state, m.topic, m.data, robots, overlays)
             except (ValueError, TypeError, AttributeError):
                 continue  # a malformed recorded message: swarm-analyze's metrics count these
         for t in times[done:]:
