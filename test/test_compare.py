@@ -12,7 +12,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from swarm_sim.compare import comparisons
-from swarm_sim.compare.cli import build_parser, main
+from swarm_sim.compare.cli import main
+from swarm_sim.compare.commands import build_parser
 from swarm_sim.compare.comparison import Comparison
 from swarm_controllers.queue.comparison import (
     PAPER_TABLE_II,

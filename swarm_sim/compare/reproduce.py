@@ -20,6 +20,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.commands import build_parser, run_comparison
 from swarm_sim.compare.report import md_table
 from swarm_sim.compare.sweep import RESULTS, RunFunction, read_results
 from swarm_sim.executors import Executor, executor_from_args
@@ -57,8 +58,6 @@ def sweep_argv(name: str, options: Sequence[str], args: argparse.Namespace, out:
 
 def reproduce_all(args: argparse.Namespace, comparisons: Mapping[str, Comparison], *,
                   run: RunFunction | None = None, executor: Executor | None = None) -> int:
-    from swarm_sim.compare.cli import build_parser, run_comparison
-
     parser = build_parser(comparisons)
     reports: list[SweepReport] = []
     try:
