@@ -21,6 +21,8 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
+from swarm_sim.cli import number
+
 LOOPBACK = "127.0.0.1"
 _ADDRESS = re.compile(r"^(tcp|tls|ucx)://[^\s/:]+:\d{1,5}$")
 
@@ -163,8 +165,6 @@ def scheduler_address(text: str) -> str:
 
 def add_executor_arguments(parser: argparse.ArgumentParser) -> None:
     """``--jobs J`` (local pool), ``--scheduler ADDRESS`` or ``--dask-local N`` (Dask)."""
-    from swarm_sim.cli import number
-
     group = parser.add_mutually_exclusive_group()
     group.add_argument("--jobs", type=number(int, 1, 1024), default=1,
                        help="runs in parallel in a local process pool (default 1: in this process)")

@@ -141,19 +141,33 @@ _ALGORITHMS: dict[str, Algorithm] = {}
 _TASKS: dict[str, TaskSpec] = {}
 _PACKAGES: dict[str, Path] = {}
 """Entry-point name -> the folder of the module it loaded (where its ``scenarios/`` are)."""
+_ORIGINS: dict[str, str] = {}
+"""``algorithm:<name>`` / ``task:<name>`` -> the entry point that registered it."""
+_loading = ""
 _loaded = False
 
 
 def _load_entries() -> None:
     """Import every module of the entry-point group once (sorted by name, so the order of
     registration does not depend on how the environment lists them)."""
-    global _loaded
+    global _loaded, _loading
     if _loaded:
         return
     _loaded = True
     for entry in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
-        module = importlib.import_module(entry.value)
+        _loading = entry.name
+        try:
+            module = importlib.import_module(entry.value)
+        finally:
+            _loading = ""
         _PACKAGES[entry.name] = Path(module.__file__).resolve().parent
+
+
+def origin(kind: str, name: str) -> str:
+    """The entry point (a package's registration) that registered algorithm or task `name`
+    (`kind` ``algorithm`` or ``task``); empty if it was registered by a direct call."""
+    _load_entries()
+    return _ORIGINS.get(f"{kind}:{name}", "")
 
 
 def scenario_files() -> dict[str, Path]:
@@ -179,6 +193,7 @@ def register(algorithm: Algorithm) -> Algorithm:
             if dict(other.config).get(name, path) != path:
                 raise ValueError(f"section controller.{name} is already declared as {dict(other.config)[name]}")
     _ALGORITHMS[algorithm.name] = algorithm
+    _ORIGINS[f"algorithm:{algorithm.name}"] = _loading
     return algorithm
 
 
@@ -186,6 +201,7 @@ def register_task(task: TaskSpec) -> TaskSpec:
     if task.name in _TASKS:
         raise ValueError(f"world task {task.name!r} is already registered")
     _TASKS[task.name] = task
+    _ORIGINS[f"task:{task.name}"] = _loading
     return task
 
 

@@ -20,10 +20,12 @@ from typing import Any
 
 import numpy as np
 
+from swarm_controllers.drtm.config import NestConfig
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table
 from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.scenario import load_scenario, scenario_to_dict
 
 DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
 DRTM_LABELS: dict[str, str] = {"drtm": "DRTM", "artm": "ARTM"}
@@ -105,8 +107,6 @@ SERIES: dict[str, str] = {
 def condition_overrides(condition: Condition) -> tuple[str, ...]:
     """``key=value`` overrides that turn ``drtm.yaml`` into the condition's scenario (every leaf
     in which the two differ, but the name and the behaviour)."""
-    from swarm_sim.scenario import load_scenario, scenario_to_dict
-
     def leaves(data: Any, prefix: str = "") -> dict[str, Any]:
         if isinstance(data, dict):
             return {k: v for key, value in data.items() for k, v in leaves(value, f"{prefix}{key}.").items()}
@@ -228,9 +228,6 @@ def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: S
 def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int] | None = None,
                       strategies: Sequence[str] = DRTM_STRATEGIES) -> list[Path]:
     """table.md, ttests.md and the time-series figures from result rows."""
-    from swarm_controllers.drtm.config import NestConfig
-    from swarm_sim.scenario import load_scenario
-
     conditions = sorted({r["cell"] for r in rows if r.get("cell") is not None}) if conditions is None else conditions
     out.mkdir(parents=True, exist_ok=True)
     written = [out / "table.md", out / "ttests.md"]

@@ -11,7 +11,7 @@ from pathlib import Path
 from swarm_sim.cli import scenario_fields
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, label, md_table
-from swarm_sim.compare.stats import all_pairs, cells_of, describe, ordering, pairwise_tests, stars, values_of
+from swarm_sim.compare.stats import all_pairs, cells_of, describe, ordering, pair_test, pairwise_tests, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 QUEUE_STRATEGIES: tuple[str, ...] = ("queue_cpfa", "queue_qse", "queue_qst", "queue_qme", "queue_qmt")
@@ -190,8 +190,6 @@ def queue_ttests_md(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequ
 def ordering_checks(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]
                     ) -> list[tuple[str, list[tuple[int, str, bool | None]]]]:
     """For every pair of Table II's order (and Q_ST = 2 Q_SE): per size (size, text, holds)."""
-    from swarm_sim.compare.stats import pair_test
-
     pct = "resources_collected_pct"
     out = []
     order = [s for s in PAPER_ORDER if s in strategies]

@@ -80,7 +80,8 @@ def read_results(path: Path) -> list[dict[str, Any]]:
 
 
 def _default_run(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
-    from swarm_sim.batch import run_one  # heavy (pybullet, controllers): only when running
+    # lazy: the batch runner loads pybullet and the controllers, which only a run needs
+    from swarm_sim.batch import run_one
 
     return run_one(job)
 

@@ -1,0 +1,247 @@
+"""The tree's shape: each paper's names stay in its own package, no import circles among the
+project's modules, and no function-local import of a project module without a comment saying why.
+
+Walks the source as text (ast and tokenize), the way test_core_is_ros_free walks the packages, so a
+new module is checked without being listed."""
+
+from __future__ import annotations
+
+import ast
+import io
+import tokenize
+from collections.abc import Iterator
+from importlib.metadata import entry_points
+from pathlib import Path
+
+from swarm_sim import registry
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("swarm_sim", "swarm_controllers", "swarm_msgs_py", "depot_manager", "launch_py")
+SHARED = ("swarm_sim", "swarm_msgs_py", "launch_py")
+"""Packages that hold no paper (plus swarm_controllers' own top-level modules)."""
+COMMON_WORDS = {
+    "depot": "the shared core's central place (the scenario's depot section, the `depot` delivery kind) "
+             "as well as the queue paper's server channel",
+    "center": "the spiral paper's server channel, and a plain word (a disc's centre, matplotlib's loc)",
+}
+"""Names a paper uses that are also the shared core's own words, and why."""
+LAZY = "lazy:"
+"""What the comment on (or just above) a function-local import of a project module starts with."""
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            parts = path.relative_to(ROOT).with_suffix("").parts
+            out[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _target(name: str) -> str | None:
+    """The project module an import of `name` loads (its longest known prefix)."""
+    while name:
+        if name in MODULES:
+            return name
+        name = name.rpartition(".")[0]
+    return None
+
+
+def _type_checking(node: ast.AST) -> bool:
+    return isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+
+
+def _imports(tree: ast.Module) -> Iterator[tuple[ast.stmt, str, bool]]:
+    """(statement, imported project module, at module level) for every import outside
+    ``if TYPE_CHECKING:`` blocks."""
+
+    def walk(node: ast.AST, top: bool) -> Iterator[tuple[ast.stmt, str, bool]]:
+        for child in ast.iter_child_nodes(node):
+            if _type_checking(child):
+                continue
+            if isinstance(child, ast.Import):
+                for alias in child.names:
+                    if (t := _target(alias.name)) is not None:
+                        yield child, t, top
+            elif isinstance(child, ast.ImportFrom) and child.level == 0 and child.module:
+                for alias in child.names:
+                    if (t := _target(f"{child.module}.{alias.name}") or _target(child.module)) is not None:
+                        yield child, t, top
+            top_child = top and not isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda))
+            yield from walk(child, top_child)
+
+    yield from walk(tree, True)
+
+
+def _graph() -> dict[str, set[str]]:
+    graph: dict[str, set[str]] = {m: set() for m in MODULES}
+    for module, path in MODULES.items():
+        for _, target, _ in _imports(ast.parse(path.read_text())):
+            if target != module:
+                graph[module].add(target)
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                out.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_circles():
+    assert _cycles(_graph()) == []
+
+
+def test_function_local_imports_of_project_modules_say_why():
+    unexplained = []
+    for module, path in MODULES.items():
+        lines = path.read_text().splitlines()
+        for stmt, target, top in _imports(ast.parse(path.read_text())):
+            here = lines[stmt.lineno - 1]
+            above = lines[stmt.lineno - 2].strip() if stmt.lineno > 1 else ""
+            if not top and f"# {LAZY}" not in here and not above.startswith(f"# {LAZY}"):
+                unexplained.append(f"{module}:{stmt.lineno} imports {target}")
+    assert unexplained == []
+
+
+def _paper_names() -> dict[str, tuple[set[str], set[str]]]:
+    """Per paper (the entry point that registers it), the names only it may use: (names code may
+    not spell as a string: its algorithms, world tasks, config sections, server channels and
+    absolute topics; names it may not use at all: its metric fields). Channels and sections are
+    often plain words (a server's ``center``), so only a string can switch on them."""
+    names: dict[str, tuple[set[str], set[str]]] = {}
+    for a in registry.algorithms():
+        paper = registry.origin("algorithm", a.name)
+        strings, fields = names.setdefault(paper, (set(), set()))
+        strings |= {a.name, *(s for s, _ in a.config), *(s.channel for s in a.servers)}
+        fields |= {m.name for m in a.metrics}
+        families = [registry.resolve(f) for f in (*a.peers, *(s.family for s in a.servers))]
+        strings |= {t for f in families for t in f.topics.values()}
+        if registry.origin("task", a.task) == paper:
+            task = registry.task(a.task)
+            strings.add(task.name)
+            strings |= {t.topic for t in registry.resolve(task.state)} if task.state else set()
+    assert "core" not in names, f"the core registers algorithms: {names.get('core')}"
+    return names
+
+
+def _code_words(path: Path) -> tuple[set[str], set[str]]:
+    """(identifiers, string literals) of a file, docstrings and comments left out."""
+    source = path.read_text()
+    docstrings = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                docstrings.add(body[0].lineno)
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
+            docstrings.add(node.lineno)  # attribute docstrings
+    names, strings = set(), set()
+    for tok in tokenize.generate_tokens(io.StringIO(source).readline):
+        if tok.type == tokenize.NAME:
+            names.add(tok.string)
+        elif tok.type == tokenize.STRING and tok.start[0] not in docstrings:
+            try:
+                value = ast.literal_eval(tok.string)
+            except (ValueError, SyntaxError):
+                continue  # an f-string part
+            if isinstance(value, str):
+                strings.add(value)
+    return names, strings
+
+
+def test_no_paper_name_outside_its_package():
+    papers = _paper_names()
+    assert {"cpfa", "queue", "spiral", "drtm", "caging"} <= set(papers)
+    found = []
+    for module, path in MODULES.items():
+        shared = module.split(".")[0] in SHARED or module.count(".") == 1 and module.startswith("swarm_controllers.")
+        if not shared:
+            continue
+        identifiers, strings = _code_words(path)
+        for paper, (spelt, fields) in papers.items():
+            hits = sorted(((spelt | fields) & strings | fields & identifiers) - set(COMMON_WORDS))
+            if hits:
+                found.append(f"{module}: {paper}'s {', '.join(hits)}")
+    assert found == []
+
+
+def _packages(record: registry.Algorithm) -> set[str]:
+    """The packages an algorithm's record names code in (``swarm_controllers.queue``,
+    ``depot_manager``), shared ones left out."""
+    paths = [record.behaviour, *(p for _, p in record.config), *record.checks, *record.peers,
+             *(x for s in record.servers for x in (s.core, s.family)), *(m.function for m in record.metrics),
+             *(x for x in (record.paths, record.comparison, record.figures) if x)]
+    out = set()
+    for path in paths:
+        parts = path.partition(":")[0].split(".")
+        package = ".".join(parts[:2]) if parts[0] == "swarm_controllers" else parts[0]
+        if parts[0] in PACKAGES and parts[0] not in SHARED:
+            out.add(package)
+    return out
+
+
+def test_a_paper_names_only_itself_and_the_papers_it_builds_on():
+    """A paper's package may use another paper's names only if its records use that paper's code
+    (the queue strategies search as the CPFA does)."""
+    papers = _paper_names()
+    homes = {e.name: e.value.rpartition(".")[0] for e in entry_points(group=registry.ENTRY_POINT_GROUP)}
+    used: dict[str, set[str]] = {}
+    for a in registry.algorithms():
+        used.setdefault(registry.origin("algorithm", a.name), set()).update(_packages(a))
+    owner = {homes[paper]: paper for paper in used}
+    for paper, packages in sorted(used.items()):
+        for package in packages:
+            owner.setdefault(package, paper)  # a package no paper calls home: the one that uses it
+    found = []
+    for module, path in MODULES.items():
+        parts = module.split(".")
+        paper = owner.get(".".join(parts[:2]) if parts[0] == "swarm_controllers" else parts[0])
+        if paper is None:
+            continue
+        allowed = {owner[p] for p in used[paper]} | {paper}
+        identifiers, strings = _code_words(path)
+        for other, (spelt, fields) in papers.items():
+            hits = sorted(((spelt | fields) & strings | fields & identifiers) - set(COMMON_WORDS))
+            if other not in allowed and hits:
+                found.append(f"{module} ({paper}): {other}'s {', '.join(hits)}")
+    assert found == []
+
+
+def test_the_checks_can_fail(tmp_path):
+    assert _cycles({"a": {"b"}, "b": {"a"}, "c": set()}) == [["a", "b"]]
+    bad = tmp_path / "bad.py"
+    bad.write_text('"""doc queue"""\nx = "queue"  # depot\n')
+    assert _code_words(bad) == ({"x"}, {"queue"})
