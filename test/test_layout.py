@@ -13,6 +13,8 @@ from collections.abc import Iterator
 from importlib.metadata import entry_points
 from pathlib import Path
 
+import pytest
+
 from swarm_sim import registry
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -27,6 +29,9 @@ COMMON_WORDS = {
 """Names a paper uses that are also the shared core's own words, and why."""
 LAZY = "lazy:"
 """What the comment on (or just above) a function-local import of a project module starts with."""
+
+
+PENDING = pytest.mark.xfail(strict=True, reason="issue 23: the scenario split and the graph endpoint are on their way")
 
 
 def _modules() -> dict[str, Path]:
@@ -120,10 +125,12 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
+@PENDING
 def test_no_import_circles():
     assert _cycles(_graph()) == []
 
 
+@PENDING
 def test_function_local_imports_of_project_modules_say_why():
     unexplained = []
     for module, path in MODULES.items():
@@ -182,6 +189,7 @@ def _code_words(path: Path) -> tuple[set[str], set[str]]:
     return names, strings
 
 
+@PENDING
 def test_no_paper_name_outside_its_package():
     papers = _paper_names()
     assert {"cpfa", "queue", "spiral", "drtm", "caging"} <= set(papers)
