@@ -31,7 +31,8 @@ from swarm_controllers.spiral.comparison import (
     spiral_plans,
     write_spiral_report,
 )
-from swarm_sim.compare.stats import pairwise_tests, stars, values_of
+from swarm_sim.compare.report import fmt_p
+from swarm_sim.compare.stats import pair_test, pairwise_tests, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, read_results, run_sweep, slim
 from swarm_sim.scenario import load_scenario
 from swarm_sim.world.resources import place_resources
@@ -489,3 +490,11 @@ def test_table_ii_ordering_checked_pair_by_pair():
     lines = {h.claim: h for h in queue_headlines(rows, [48], list(means))}
     assert lines["collection Q_ME < Q_MT"].holds is True
     assert lines["collection CPFA < Q_ME"].holds is False
+
+
+def test_a_t_test_between_groups_that_do_not_vary_is_not_applicable():
+    """scipy gives p = 0 for two constant groups; the reports must say n/a, not ***."""
+    statistic, p = pair_test([1.0, 1.0, 1.0], [2.0, 2.0, 2.0], "t")
+    assert math.isnan(statistic) and fmt_p(p) == "n/a" and stars(p) == "n/a"
+    assert pair_test([1.0, 1.0, 1.5], [2.0, 2.0, 2.0], "t")[1] < 0.05  # one group varies: a real test
+    assert pair_test([1.0, 1.0, 1.0], [2.0, 2.0, 2.0], "u")[1] < 0.05  # a rank test is defined

@@ -74,11 +74,14 @@ class PairTest:
 
 def pair_test(a: Sequence[float], b: Sequence[float], test: str) -> tuple[float, float]:
     """(statistic, p): `t` = scipy ttest_ind (the queue paper's), `u` = two-sided mannwhitneyu
-    (the MDBSA paper's)."""
+    (the MDBSA paper's); NaN for both where the test is undefined (too few runs, or a t-test
+    between two groups that do not vary), which the reports print as ``n/a``."""
     from scipy import stats as st
 
     if (test == "t" and min(len(a), len(b)) < 2) or min(len(a), len(b)) < 1:
         return math.nan, math.nan
+    if test == "t" and max(a) == min(a) and max(b) == min(b):
+        return math.nan, math.nan  # no variance in either group: t is undefined (scipy says p = 0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         if test == "t":
