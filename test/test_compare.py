@@ -498,3 +498,12 @@ def test_a_t_test_between_groups_that_do_not_vary_is_not_applicable():
     assert math.isnan(statistic) and fmt_p(p) == "n/a" and stars(p) == "n/a"
     assert pair_test([1.0, 1.0, 1.5], [2.0, 2.0, 2.0], "t")[1] < 0.05  # one group varies: a real test
     assert pair_test([1.0, 1.0, 1.0], [2.0, 2.0, 2.0], "u")[1] < 0.05  # a rank test is defined
+
+
+def test_reports_of_runs_cut_by_duration_say_so(tmp_path):
+    argv = ["queue", "--robots", "48", "--seeds", "2", "--strategies", "queue_qmt", "--out", str(tmp_path)]
+    assert main(argv, run=FakeRunner()) == 0
+    assert "Runs cut short" not in (tmp_path / "table.md").read_text()
+    assert main([*argv, "--overwrite", "--duration", "60"], run=FakeRunner()) == 0
+    for name in ("table.md", "ttests.md"):
+        assert (tmp_path / name).read_text().startswith("> **Runs cut short**: every run here was limited to 60 s")

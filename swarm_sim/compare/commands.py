@@ -11,6 +11,7 @@ from pathlib import Path
 from swarm_sim import compare
 from swarm_sim.cli import number
 from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.report import note_cut_runs
 from swarm_sim.compare.sweep import FAILED, RESULTS, RunFunction, run_sweep
 from swarm_sim.executors import Executor, add_executor_arguments
 from swarm_sim.scenario import ScenarioError, load_scenario
@@ -85,6 +86,7 @@ def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies:
               file=sys.stderr)
         return 130, []
     written = comparison.write_report(result.rows, out, args, strategies)
+    note_cut_runs(written, args.duration)
     print(f"{len(result.rows)} runs in {path}; wrote {', '.join(p.name for p in written)} in {out}")
     if result.failed:
         print(f"swarm-compare: {len(result.failed)} runs failed (errors in {out / FAILED}; --resume "

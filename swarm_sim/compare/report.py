@@ -26,6 +26,18 @@ def fmt_p(p: float) -> str:
     return f"{p:.2e}" if p < 0.001 else f"{p:.4f}"
 
 
+def note_cut_runs(paths: Sequence[Path], duration: float | None) -> None:
+    """Say at the top of each markdown report that its runs were cut to `duration` sim seconds
+    by ``--duration`` (None: the paper's run lengths, nothing to say)."""
+    if duration is None:
+        return
+    note = (f"> **Runs cut short**: every run here was limited to {duration:g} s of sim time by "
+            "`--duration`, not the paper's run length; its numbers are not the paper's conditions.\n\n")
+    for path in paths:
+        if path.suffix == ".md" and path.is_file():
+            path.write_text(note + path.read_text())
+
+
 def fmt_pct(x: float) -> str:
     """A signed percentage change (``+12.3 %``)."""
     return "—" if not math.isfinite(x) else f"{x:+.1f} %"
