@@ -4,8 +4,13 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
+import sys
 from collections.abc import Callable
 
+import yaml
+
+from swarm_sim.registry import scenario_files
 from swarm_sim.scenario import DEFAULT_SCENARIO
 
 
@@ -26,9 +31,51 @@ def number(kind: type, low: float, high: float = math.inf, *, open_low: bool = F
     return parse
 
 
+_SENTENCE_END = re.compile(r"(?<=[a-z0-9)]{4})\. (?=[A-Z])")
+"""A full stop that ends a sentence: not after an abbreviation (Sec., et al.), not before a number."""
+
+
+def _first_sentence(text: str, width: int = 72) -> str:
+    """The first sentence of the comment block a YAML file opens with, cut to `width`."""
+    comment = []
+    for line in text.splitlines():
+        if not line.startswith("#"):
+            break
+        comment.append(line.lstrip("#").strip())
+    sentence = _SENTENCE_END.split(" ".join(comment))[0].rstrip(".")
+    return sentence if len(sentence) <= width else sentence[: width - 3].rstrip() + "..."
+
+
+def scenario_table() -> list[str]:
+    """One line per shipped scenario: its name, its algorithm, robots, sim seconds and the first
+    sentence of the comment it opens with."""
+    lines = []
+    for name, path in scenario_files().items():
+        text = path.read_text()
+        data = yaml.safe_load(text) or {}
+        about = _first_sentence(text)
+        controller = data.get("controller") or {}
+        robots = (data.get("robots") or {}).get("count", "")
+        duration = (data.get("sim") or {}).get("duration", "")
+        lines.append(f"{name:16s} {controller.get('behaviour', ''):9s} {robots!s:>5s} {duration!s:>7s}  {about}")
+    return [f"{'scenario':16s} {'algorithm':9s} {'robots':>5s} {'sim s':>7s}  about", *lines]
+
+
+class _ListScenarios(argparse.Action):
+    def __init__(self, option_strings, dest, **kwargs) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        print("\n".join(scenario_table()))
+        sys.exit(0)
+
+
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                        help=f"scenario name or YAML path (default: {DEFAULT_SCENARIO})")
+                        help=f"scenario name or YAML path (default: {DEFAULT_SCENARIO}; --list-scenarios "
+                             "shows the shipped ones)")
+    parser.add_argument("--list-scenarios", action=_ListScenarios,
+                        help="list the shipped scenarios (name, algorithm, robots, sim seconds, what it is) and exit")
     parser.add_argument("--robots", type=number(int, 1), help="number of robots (robots.count)")
     parser.add_argument("--duration", type=number(float, 0, open_low=True), help="sim seconds (sim.duration)")
     parser.add_argument("--seed", type=number(int, 0, 2**63 - 1), help="random seed (default: the scenario's)")

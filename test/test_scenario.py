@@ -151,3 +151,20 @@ def test_groups_start_layout_is_the_authors_distribute_blocks():
     assert d[np.triu_indices(50, 1)].min() >= s.robots.start_spacing - 1e-9
     with pytest.raises(ScenarioError, match="robots.start_groups"):
         load_scenario("queue_qmt", ["robots.start_groups=[[5.8, 0.0]]"])
+
+
+def test_the_shipped_scenarios_are_listed(capsys):
+    import argparse
+
+    from swarm_sim.cli import add_scenario_arguments
+
+    parser = argparse.ArgumentParser()
+    add_scenario_arguments(parser)
+    with pytest.raises(SystemExit) as end:
+        parser.parse_args(["--list-scenarios"])
+    assert end.value.code == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [ln.split()[0] for ln in lines[1:]] == list(registry.scenario_files())
+    queue_qmt = next(ln for ln in lines if ln.startswith("queue_qmt "))
+    assert queue_qmt.split()[1:4] == ["queue", "64", "1080.0"] and "Q_MT" in queue_qmt
+    assert max(map(len, lines)) <= 120
