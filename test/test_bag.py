@@ -570,3 +570,16 @@ def test_analysis_skips_and_counts_malformed_messages_and_keeps_the_rest(tmp_pat
         trace = load_run(bag)
     summary = summarize(trace)
     assert summary["malformed_messages"] == 1 and summary["resources_delivered"] == 1
+
+
+def test_a_run_is_one_file_by_default_however_long(tmp_path: Path) -> None:
+    """As ``ros2 bag record`` leaves it; the writer still flushes every second of wall time."""
+    bag = tmp_path / "run"
+    clock = FakeClock()
+    with BagWriter(bag, clock=clock) as w:
+        w.add_topic("/robot_0/cmd_vel", "geometry_msgs/msg/TwistStamped")
+        for i in range(200):
+            clock.t += 10.0  # half an hour of wall time
+            w.write("/robot_0/cmd_vel", i * NS, twist(i))
+    assert [p.name for p in bag.glob("*.mcap")] == ["run_0.mcap"]
+    assert len(list(read_bag(bag))) == 200

@@ -1,9 +1,11 @@
-"""`BagWriter`: a rosbag2 directory of MCAP files, split and flushed on wall time so a killed
-run keeps almost everything (see `swarm_sim.recording`)."""
+"""`BagWriter`: a rosbag2 directory of MCAP files, flushed on wall time so a killed run keeps
+almost everything (see `swarm_sim.recording`): one file per run by default, as ``ros2 bag record``
+leaves it; splitting into several files on wall time stays an option (``split_seconds``)."""
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import threading
 import time
@@ -76,7 +78,7 @@ class BagWriter:
         self,
         path: Path | str,
         *,
-        split_seconds: float = 30.0,
+        split_seconds: float = math.inf,
         flush_seconds: float = 1.0,
         compression: str | None = "zstd",
         metadata: Mapping[str, Any] | None = None,
@@ -87,7 +89,9 @@ class BagWriter:
         Args:
             path: bag directory to create; an existing empty directory is used, a non-empty one
                 is refused.
-            split_seconds: start a new file after this much wall time [s] (math.inf: never).
+            split_seconds: start a new file after this much wall time [s] (math.inf, the default:
+                never; a cut file loses only what was not flushed, and ``--repair`` recovers every
+                complete message before the cut).
             flush_seconds: write the chunk in progress to the OS after this much wall time [s].
             compression: chunk compression, "zstd", "lz4" or "none".
             metadata: custom metadata (scenario, seed, ...), flattened to strings.
