@@ -6,7 +6,7 @@ import dataclasses
 import math
 
 import numpy as np
-import pybullet as p
+from swarm_sim.world.bullet import pybullet as p
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -700,3 +700,13 @@ def test_a_robot_whose_pose_was_reset_gets_its_velocity_set_again(make_world, ho
         w._read_state()
         assert p.getBasePositionAndOrientation(0, physicsClientId=w.client)[1][0] == 0.0  # upright again
     assert not w._kept[0] or _holds_what_was_set(w, 0)
+
+
+def test_no_pybullet_banner_in_our_output():
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-m", "swarm_sim.batch", "--robots", "2", "--duration", "1"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "pybullet build time" not in out.stdout + out.stderr and "delivered" in out.stdout

@@ -37,7 +37,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-import pybullet as p
+from swarm_sim.world.bullet import pybullet as p
 
 from swarm_sim.geometry import yaw_to_quaternion
 from swarm_sim.scenario import ScenarioError

@@ -52,11 +52,10 @@ from itertools import repeat
 from operator import attrgetter
 
 import numpy as np
-import pybullet as p
-
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.observations import observations, with_messages
 from swarm_sim.world.pairs import RobotPairs

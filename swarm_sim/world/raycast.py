@@ -49,6 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_sim.scenario import ScanConfig, Scenario
+from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.pairs import RobotPairs, pairs_in_reach
 
@@ -459,8 +460,6 @@ def cast_scan_pybullet(
     Rays start PYBULLET_START_OFFSET outside the robot's own cylinder (so they cannot hit it) and
     the offset is added back to the range. `num_threads` is rayTestBatch's numThreads.
     """
-    import pybullet as p
-
     origins = np.asarray(origins, dtype=float)
     n = len(origins)
     angle_min, inc = scan_angles(config.rays, config.fov)

@@ -8,7 +8,7 @@ import dataclasses
 import math
 
 import numpy as np
-import pybullet as p
+from swarm_sim.world.bullet import pybullet as p
 import pytest
 
 from swarm_controllers.api import behaviour_rng
