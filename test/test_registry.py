@@ -92,3 +92,84 @@ def test_plugin_algorithm_is_found_by_its_entry_point_and_runs():
     result = summarize(run_batch(load_scenario("dummy", ["sim.duration=20.0"])).trace)
     assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
     assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults
+
+
+def test_world_sections_are_named_once_and_declared_once(monkeypatch):
+    for name in registry.world_sections():
+        assert registry.world_section(name).SECTION == name
+    sections = {**registry.world_sections(), "regionz": registry.world_sections()["regions"]}
+    monkeypatch.setattr(registry, "world_sections", lambda: sections)
+    with pytest.raises(ValueError, match="section regionz is declared as .*RegionConfig, whose SECTION is 'regions'"):
+        registry.world_section("regionz")
+    clash = registry.TaskSpec("other", core="m:C", sensing="m:S", world=(("transport", "elsewhere:Transport"),))
+    with pytest.raises(ValueError, match="section transport is already declared as .*caging.world_config:TransportConfig"):
+        registry.register_task(clash)
+    assert "other" not in registry._TASKS
+
+
+LAYERS = ("swarm_sim/scenario/__init__.py", "swarm_sim/scenario/schema.py", "swarm_sim/scenario/loading.py",
+          "swarm_sim/scenario/validation.py", "swarm_sim/registry.py", "swarm_sim/sites.py")
+
+
+def _imports(path: Path) -> tuple[set[str], list[str]]:
+    """(project modules `path` imports when it runs, project imports inside functions)."""
+    import ast
+
+    tree = ast.parse(path.read_text())
+    at_import, in_functions = set(), []
+
+    def names(node: ast.AST) -> list[str]:
+        if isinstance(node, ast.Import):
+            return [a.name for a in node.names]
+        if isinstance(node, ast.ImportFrom) and node.module:
+            return [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+        return []
+
+    for node in tree.body:  # module level, `if TYPE_CHECKING:` blocks left out
+        if isinstance(node, ast.If) and getattr(node.test, "id", "") == "TYPE_CHECKING":
+            continue
+        at_import.update(n for n in names(node) if n.split(".")[0] == "swarm_sim")
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            in_functions += [n for sub in ast.walk(node) for n in names(sub) if n.split(".")[0] == "swarm_sim"]
+    return at_import, in_functions
+
+
+def test_scenario_registry_and_sites_import_without_circles():
+    """The schema imports nothing of the project; the registry imports the schema for annotations
+    only; validation and loading import the registry; sites imports both; none imports inside a
+    function; the graph has no circle, a package's ``__init__`` included (importing
+    ``swarm_sim.scenario.schema`` from outside runs ``swarm_sim.scenario`` first); each module
+    imports first in a fresh interpreter."""
+    modules = {p.removesuffix(".py").removesuffix("/__init__").replace("/", "."): REPO / p for p in LAYERS}
+
+    def runs(importer: str, target: str) -> set[str]:
+        """What importing `target` from `importer` runs: the target and its packages, but not the
+        importer's own package (it is initialised or initialising already)."""
+        parts = target.split(".")
+        chain = {".".join(parts[:k]) for k in range(1, len(parts) + 1)}
+        return {m for m in chain & set(modules) if not importer.startswith(m + ".")}
+
+    graph = {}
+    for name, path in modules.items():
+        at_import, in_functions = _imports(path)
+        assert in_functions == [], f"{name} imports {in_functions} inside a function"
+        graph[name] = set().union(*(runs(name, t) for t in at_import)) - {name}
+    assert graph["swarm_sim.scenario.schema"] == set()
+    assert graph["swarm_sim.registry"] == set()
+    assert "swarm_sim.registry" not in graph["swarm_sim.sites"] - {"swarm_sim.registry"}
+    state: dict[str, str] = {}
+
+    def visit(node: str, trail: tuple[str, ...]) -> None:
+        assert state.get(node) != "open", f"import circle: {' -> '.join((*trail, node))}"
+        if state.get(node) != "done":
+            state[node] = "open"
+            for nxt in sorted(graph[node]):
+                visit(nxt, (*trail, node))
+            state[node] = "done"
+
+    for name in graph:
+        visit(name, ())
+    for name in modules:
+        out = subprocess.run([sys.executable, "-c", f"import {name}"], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0, out.stderr
