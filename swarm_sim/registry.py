@@ -42,6 +42,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from swarm_msgs_py.topics import heard
+from swarm_sim.protocol import ROBOTS
+from swarm_sim.types import robot_index
+
 if TYPE_CHECKING:
     from swarm_sim.protocol import Server
     from swarm_sim.scenario.schema import DropZoneConfig, Scenario
@@ -362,8 +366,6 @@ def check_scenario(scenario: Scenario) -> None:
 
 def make_behaviour(scenario: Scenario, robot: str, rng: np.random.Generator) -> Any:
     """The behaviour of the scenario's algorithm for `robot`."""
-    from swarm_sim.types import robot_index
-
     robot_index(robot)  # refuse ids that are not robot_<i>
     return resolve(of(scenario).behaviour)(scenario, robot, rng)
 
@@ -383,8 +385,6 @@ def task_factory(scenario: Scenario) -> Callable[..., Any]:
 
 def _channel(cls: type) -> str:
     """The channel a message class travels on (`swarm_sim.protocol.channel_of`)."""
-    from swarm_sim.protocol import ROBOTS
-
     return getattr(cls, "CHANNEL", ROBOTS)
 
 
@@ -392,8 +392,6 @@ def robot_topics(algorithm: Algorithm) -> tuple[dict[str, Any], dict[str, Any]]:
     """(inbound, outbound) topic -> message family of a robot's controller: with each server it
     sends the family's messages on the server's channel and hears the rest; its peer families
     it sends on their topics and hears on the world's relay of them (`peer_topics`)."""
-    from swarm_msgs_py.topics import heard
-
     inbound: dict[str, Any] = {}
     outbound: dict[str, Any] = {}
     for spec in algorithm.servers:

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar
 
+from swarm_controllers.caging.geometry import cage_radius, max_robots, rho_min, theta_min
 from swarm_controllers.caging.world_config import TransportConfig
 from swarm_sim.scenario.schema import Section
 
@@ -67,8 +68,6 @@ def check_caging(scenario: Scenario) -> None:
     """Refuse a caging scenario the paper's conditions rule out, with the numbers: fewer robots
     than rho_min (eq. 1), more than the cage fits (phi = 360 deg / rho < theta_min, eq. 2), a
     landmark grid whose edge cages would hit the walls, sensors that cannot see what they must."""
-    from swarm_controllers.caging.geometry import cage_radius, max_robots, rho_min, theta_min
-
     cfg = CagingConfig.of(scenario)
     for key in ("distance_tolerance", "angle_tolerance", "clearance", "approach_margin", "min_gap",
                 "acceleration_ratio", "call_timeout", "barrier_timeout"):

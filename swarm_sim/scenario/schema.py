@@ -5,10 +5,10 @@ path) loaded into these dataclasses, one per concern (`swarm_sim.scenario.loadin
 (`swarm_sim.scenario.validation`). Every node of the graph and the batch runner load the same
 file with the same overrides, so the depot, the arena or a drop zone is described exactly once.
 
-What a task or an algorithm adds to the world (a movable object, a grid of regions...) is not
-here: it declares its own section in its registry record (`swarm_sim.registry`), a dataclass
-deriving from `WorldSection` (a top-level key of the file) or from `Section` (a key under
-``controller``), and reads it back with ``TheSection.of(scenario)``.
+What a task or an algorithm adds to the world (an object to move, a partition of the arena...)
+is not here: it declares its own section in its registry record (`swarm_sim.registry`), a
+dataclass deriving from `WorldSection` (a top-level key of the file) or from `Section` (a key
+under ``controller``), and reads it back with ``TheSection.of(scenario)``.
 
 This module imports nothing else of the project: the loader builds the declared sections, and a
 section the file does not give is the defaults of the class the caller names in ``of``.
