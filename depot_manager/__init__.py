@@ -1,6 +1,7 @@
 """depot_manager: docks, queue geometry and admission for the central depot.
 
-Implements queue_depot_traffic.md. `geometry` builds the ROS-free queue layouts of its sec. IV
+Implements queue_depot_traffic.md. `docks` places the docks on the depot boundary (and makes the
+``docks`` delivery kind's drop zones); `geometry` builds the ROS-free queue layouts of its sec. IV
 (single spiral queue with inner queues, Figs. 3/6; multi-queue sector serpentines, Figs. 4/7)
 from the scenario's `depot` section (`DepotGeometryConfig.from_scenario`); `draw` renders a
 layout to PNG (`python -m depot_manager.draw --layout single|multi --out FILE.png`);

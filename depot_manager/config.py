@@ -1,15 +1,13 @@
 """The queue strategies' scenario section (``controller.queue``), read by the depot manager and
-by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII)."""
+by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII); its check, that
+the layout fits the depot, is `depot_manager.geometry.check_queue`."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import ClassVar, Literal
 
-from swarm_sim.scenario import Section
-
-if TYPE_CHECKING:
-    from swarm_sim.scenario import Scenario
+from swarm_sim.scenario.schema import Section
 
 
 @dataclass(frozen=True)
@@ -29,15 +27,3 @@ class QueueConfig(Section):
 
     SECTION: ClassVar[str] = "queue"
 
-
-def check_queue(scenario: Scenario) -> None:
-    """The queue layout must fit the scenario's depot (ValueError naming the parameter)."""
-    from depot_manager.geometry import DepotGeometryConfig, make_layout
-
-    q = QueueConfig.of(scenario)
-    try:
-        geometry = DepotGeometryConfig.from_scenario(scenario)
-        geometry.validate()
-        make_layout(q.wrapping, geometry)
-    except ValueError as exc:
-        raise ValueError(f"controller.queue: {exc}") from None

@@ -25,12 +25,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from depot_manager.config import QueueConfig
-from swarm_sim.sites import Dock, docks
+from depot_manager.docks import Dock, docks
+
+if TYPE_CHECKING:
+    from swarm_sim.scenario.schema import Scenario
 
 ARC_STEP = 0.04
 """Maximum waypoint spacing along discretised arcs [m]; chords cut inside an arc by at most
@@ -61,7 +64,7 @@ class DepotGeometryConfig:
     """Arc-length distance between queue slots along a line [m]; None = lane_spacing."""
 
     @classmethod
-    def from_scenario(cls, scenario) -> DepotGeometryConfig:
+    def from_scenario(cls, scenario: Scenario) -> DepotGeometryConfig:
         d = scenario.depot
         return cls(
             depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=d.perimeter_radius,
@@ -507,3 +510,15 @@ def make_layout(
     if kind == "multi":
         return multi_queue_layout(cfg)
     raise ValueError(f"layout kind must be 'single' or 'multi', got {kind!r}")
+
+
+def check_queue(scenario: Scenario) -> None:
+    """The queue layout must fit the scenario's depot (ValueError naming the parameter): the
+    queue strategies' check (`swarm_controllers.queue.registration`)."""
+    q = QueueConfig.of(scenario)
+    try:
+        geometry = DepotGeometryConfig.from_scenario(scenario)
+        geometry.validate()
+        make_layout(q.wrapping, geometry)
+    except ValueError as exc:
+        raise ValueError(f"controller.queue: {exc}") from None

@@ -6,7 +6,9 @@ an algorithm: its behaviour, its world task, its scenario sections and checks, t
 needs, the message families its robots exchange, the drop zones it works with, its metrics, its
 planned paths and its paper comparison. The launcher, the batch runner, the nodes, the launch
 file, analysis and the comparisons read these records; no other module switches on an
-algorithm's name.
+algorithm's name. A `DeliveryKind` record says what a ``depot.delivery`` value means (the drop
+zones it implies), registered by whoever provides it: ``depot`` by the shared core, the others by
+their papers.
 
 Every paper is a package that registers itself the way a third-party plug-in does: a module
 named in the Python entry-point group ``swarmforage.algorithms`` (`importlib.metadata`, as
@@ -17,6 +19,14 @@ its scenario files in a ``scenarios/`` folder beside its registering module (`sc
 Records name code by ``"module:attribute"`` strings that are imported when first used, so the
 registry (and the scenario loader that asks it for sections) imports no algorithm package, and
 a behaviour's module loads only when a run uses it.
+
+Sections: an algorithm declares its ``controller.<section>`` dataclasses (`Algorithm.config`), a
+task or an algorithm the world facts it adds as top-level ``<section>`` dataclasses
+(`TaskSpec.world`, `Algorithm.world`, `swarm_sim.scenario.WorldSection`). The loader accepts a
+registered section in any scenario and builds it; ``TheSection.of(scenario)`` reads it back.
+
+The registry imports the scenario schema for annotations only; the scenario's loader and
+validation import the registry.
 
 """
 
@@ -32,9 +42,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from swarm_msgs_py.topics import heard
+from swarm_sim.protocol import ROBOTS
+from swarm_sim.types import robot_index
+
 if TYPE_CHECKING:
     from swarm_sim.protocol import Server
-    from swarm_sim.scenario import Scenario
+    from swarm_sim.scenario.schema import DropZoneConfig, Scenario
 
 ENTRY_POINT_GROUP = "swarmforage.algorithms"
 
@@ -87,6 +101,27 @@ class TaskSpec:
     bag replay keep each as the time series ``RunTrace.series[field]`` (None: none)."""
     headline: tuple[Measure, ...] = ()
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
+    world: tuple[tuple[str, str], ...] = ()
+    """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
+    section (a `swarm_sim.scenario.WorldSection`)."""
+
+
+@dataclass(frozen=True)
+class DeliveryKind:
+    """What a ``depot.delivery`` value means: where resources are delivered."""
+
+    name: str
+    """What ``depot.delivery`` says."""
+    zones: str
+    """``module:function`` ``(scenario) -> tuple[DropZoneConfig, ...]``: the drop zones it
+    implies (`swarm_sim.sites.drop_zones` adds the scenario's own ``drop_zones``)."""
+    resources_inside: bool = False
+    """Resources may lie inside its zones: the world places them clear of the other drop zones
+    only (`swarm_sim.sites.zones_clear_of_resources`), and one lying in a zone is delivered as
+    soon as it is picked up."""
+    checks: tuple[str, ...] = ()
+    """``module:function`` ``(scenario) -> None`` raising ValueError naming the key at fault:
+    what a scenario delivering this way must satisfy."""
 
 
 @dataclass(frozen=True)
@@ -113,6 +148,9 @@ class Algorithm:
     """The world task it runs in."""
     config: tuple[tuple[str, str], ...] = ()
     """(section, ``module:Dataclass``): its ``controller.<section>`` scenario sections."""
+    world: tuple[tuple[str, str], ...] = ()
+    """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
+    section (a `swarm_sim.scenario.WorldSection`)."""
     checks: tuple[str, ...] = ()
     """``module:function`` ``(scenario) -> None`` raising ValueError naming the key at fault."""
     servers: tuple[ServerSpec, ...] = ()
@@ -120,7 +158,7 @@ class Algorithm:
     """``module:FAMILY``: message families its robots send each other (every robot hears and
     sends all of them)."""
     deliveries: tuple[str, ...] = ("depot",)
-    """The ``depot.delivery`` sites it works with (the drop zones it implies)."""
+    """The ``depot.delivery`` kinds (`DeliveryKind`) it works with."""
     metrics: tuple[Metric, ...] = ()
     paths: str | None = None
     """``module:function`` ``(scenario) -> [(N, 2) waypoints]``: its planned paths, drawn
@@ -139,6 +177,7 @@ class Algorithm:
 
 _ALGORITHMS: dict[str, Algorithm] = {}
 _TASKS: dict[str, TaskSpec] = {}
+_DELIVERIES: dict[str, DeliveryKind] = {}
 _PACKAGES: dict[str, Path] = {}
 """Entry-point name -> the folder of the module it loaded (where its ``scenarios/`` are)."""
 _ORIGINS: dict[str, str] = {}
@@ -183,26 +222,42 @@ def scenario_files() -> dict[str, Path]:
     return dict(sorted(out.items()))
 
 
+def _refuse_redeclared(sections: tuple[tuple[str, str], ...], declared: dict[str, str], where: str) -> None:
+    """ValueError if a section of `sections` is already declared (in `declared`) as another dataclass."""
+    for name, path in sections:
+        if declared.get(name, path) != path:
+            raise ValueError(f"section {where}{name} is already declared as {declared[name]}")
+
+
 def register(algorithm: Algorithm) -> Algorithm:
     """Make `algorithm` known; refuses a second record of the same name or a section name
     already declared with another dataclass."""
     if algorithm.name in _ALGORITHMS:
         raise ValueError(f"algorithm {algorithm.name!r} is already registered")
-    for name, path in algorithm.config:
-        for other in _ALGORITHMS.values():
-            if dict(other.config).get(name, path) != path:
-                raise ValueError(f"section controller.{name} is already declared as {dict(other.config)[name]}")
+    _refuse_redeclared(algorithm.config, _declared_config(), "controller.")
+    _refuse_redeclared(algorithm.world, _declared_world(), "")
     _ALGORITHMS[algorithm.name] = algorithm
     _ORIGINS[f"algorithm:{algorithm.name}"] = _loading
     return algorithm
 
 
 def register_task(task: TaskSpec) -> TaskSpec:
+    """Make `task` known; refuses a second record of the same name or a world section already
+    declared with another dataclass."""
     if task.name in _TASKS:
         raise ValueError(f"world task {task.name!r} is already registered")
+    _refuse_redeclared(task.world, _declared_world(), "")
     _TASKS[task.name] = task
     _ORIGINS[f"task:{task.name}"] = _loading
     return task
+
+
+def register_delivery(kind: DeliveryKind) -> DeliveryKind:
+    """Make delivery kind `kind` known; refuses a second record of the same name."""
+    if kind.name in _DELIVERIES:
+        raise ValueError(f"delivery kind {kind.name!r} is already registered")
+    _DELIVERIES[kind.name] = kind
+    return kind
 
 
 def resolve(path: str) -> Any:
@@ -245,10 +300,25 @@ def task(name: str) -> TaskSpec:
         raise ValueError(f"unknown world task {name!r} (known: {', '.join(sorted(_TASKS))})") from None
 
 
+def _declared_config() -> dict[str, str]:
+    return {name: path for a in _ALGORITHMS.values() for name, path in a.config}
+
+
+def _declared_world() -> dict[str, str]:
+    records = (*_TASKS.values(), *_ALGORITHMS.values())
+    return {name: path for r in records for name, path in r.world}
+
+
 def config_sections() -> dict[str, str]:
     """Every registered ``controller.<section>`` -> its ``module:Dataclass``."""
     _load_entries()
-    return {name: path for a in _ALGORITHMS.values() for name, path in a.config}
+    return _declared_config()
+
+
+def world_sections() -> dict[str, str]:
+    """Every registered top-level world section -> its ``module:Dataclass``."""
+    _load_entries()
+    return _declared_world()
 
 
 @cache
@@ -256,38 +326,69 @@ def _section_class(path: str) -> type:
     return resolve(path)
 
 
-def config_section(name: str) -> type:
-    """The dataclass of section ``controller.<name>``.
+def _declared_class(sections: dict[str, str], name: str, key: str) -> type:
+    """The dataclass declared for section `name` (scenario key `key`).
 
     The registry names a section so that a scenario's keys are checked without importing every
-    algorithm's config module; the dataclass's own ``SECTION`` is what it reads back (`Section.of`).
+    algorithm's config module; the dataclass's own ``SECTION`` is what it reads back (`of`).
     The two must be one name, so a record whose name and class disagree is refused here."""
-    sections = config_sections()
     if name not in sections:
-        raise ValueError(f"no algorithm declares a section controller.{name}")
+        raise ValueError(f"no task or algorithm declares a section {key}")
     cls = _section_class(sections[name])
     if getattr(cls, "SECTION", None) != name:
-        raise ValueError(f"section controller.{name} is declared as {sections[name]}, whose SECTION is "
+        raise ValueError(f"section {key} is declared as {sections[name]}, whose SECTION is "
                          f"{getattr(cls, 'SECTION', None)!r}")
     return cls
 
 
-def check_scenario(scenario: Scenario) -> None:
-    """The algorithm-specific half of loading a scenario: the behaviour is registered, the
-    delivery sites suit it and its own checks pass (ScenarioError naming the key)."""
-    from swarm_sim.scenario import ScenarioError
+def config_section(name: str) -> type:
+    """The dataclass of section ``controller.<name>`` (a `swarm_sim.scenario.Section`)."""
+    return _declared_class(config_sections(), name, f"controller.{name}")
 
+
+def world_section(name: str) -> type:
+    """The dataclass of the top-level world section `name` (a `swarm_sim.scenario.WorldSection`)."""
+    return _declared_class(world_sections(), name, name)
+
+
+def delivery_kinds() -> tuple[str, ...]:
+    """Every registered delivery kind (what ``depot.delivery`` may say)."""
+    _load_entries()
+    return tuple(sorted(_DELIVERIES))
+
+
+def delivery_kind(name: str) -> DeliveryKind:
+    """The record of delivery kind `name`; ValueError naming the key and the known kinds."""
+    _load_entries()
     try:
-        a = of(scenario)
-        if scenario.depot.delivery not in a.deliveries:
-            raise ValueError(
-                f"depot.delivery: {a.name} delivers to {' or '.join(a.deliveries)}, "
-                f"not {scenario.depot.delivery!r}"
-            )
-        for check in a.checks:
-            resolve(check)(scenario)
-    except ValueError as exc:
-        raise ScenarioError(str(exc)) from None
+        return _DELIVERIES[name]
+    except KeyError:
+        raise ValueError(
+            f"depot.delivery: unknown delivery kind {name!r} (known: {', '.join(delivery_kinds())})"
+        ) from None
+
+
+def delivery_zones(scenario: Scenario, kind: str | None = None) -> tuple[DropZoneConfig, ...]:
+    """The drop zones delivery kind `kind` implies in the scenario's world (default: the kind
+    ``depot.delivery`` names), without the scenario's own ``drop_zones`` (`swarm_sim.sites.drop_zones`
+    gives them all)."""
+    return tuple(resolve(delivery_kind(kind or scenario.depot.delivery).zones)(scenario))
+
+
+def check_scenario(scenario: Scenario) -> None:
+    """The registered half of validating a scenario: the delivery kind's checks pass, the
+    behaviour is registered, the delivery kind suits it and its own checks pass (ValueError
+    naming the key; `swarm_sim.scenario.validation` reports it as a ScenarioError)."""
+    for check in delivery_kind(scenario.depot.delivery).checks:
+        resolve(check)(scenario)
+    a = of(scenario)
+    if scenario.depot.delivery not in a.deliveries:
+        raise ValueError(
+            f"depot.delivery: {a.name} delivers to {' or '.join(a.deliveries)}, "
+            f"not {scenario.depot.delivery!r}"
+        )
+    for check in a.checks:
+        resolve(check)(scenario)
 
 
 # --------------------------------------------------------------------------- building cores
@@ -295,8 +396,6 @@ def check_scenario(scenario: Scenario) -> None:
 
 def make_behaviour(scenario: Scenario, robot: str, rng: np.random.Generator) -> Any:
     """The behaviour of the scenario's algorithm for `robot`."""
-    from swarm_sim.types import robot_index
-
     robot_index(robot)  # refuse ids that are not robot_<i>
     return resolve(of(scenario).behaviour)(scenario, robot, rng)
 
@@ -316,8 +415,6 @@ def task_factory(scenario: Scenario) -> Callable[..., Any]:
 
 def _channel(cls: type) -> str:
     """The channel a message class travels on (`swarm_sim.protocol.channel_of`)."""
-    from swarm_sim.protocol import ROBOTS
-
     return getattr(cls, "CHANNEL", ROBOTS)
 
 
@@ -325,8 +422,6 @@ def robot_topics(algorithm: Algorithm) -> tuple[dict[str, Any], dict[str, Any]]:
     """(inbound, outbound) topic -> message family of a robot's controller: with each server it
     sends the family's messages on the server's channel and hears the rest; its peer families
     it sends on their topics and hears on the world's relay of them (`peer_topics`)."""
-    from swarm_msgs_py.topics import heard
-
     inbound: dict[str, Any] = {}
     outbound: dict[str, Any] = {}
     for spec in algorithm.servers:

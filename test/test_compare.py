@@ -22,6 +22,7 @@ from swarm_controllers.queue.comparison import (
     queue_ttests_md,
     write_queue_report,
 )
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_controllers.spiral.comparison import (
     PAPER_SPIRAL_CLAIMS,
     SPIRAL_EXPERIMENTS,
@@ -238,7 +239,7 @@ def test_spiral_plans_load_with_the_papers_settings(experiment, layout):
         s = load_scenario("ddsa", plan.overrides, **dict(plan.fields))
         assert s.arena.size == 8.0 and s.resources.distribution == distribution
         assert (s.depot.radius, s.resources.spacing) == (0.18, 0.15)  # the authors' nest, pitch
-        setting = {"regions": s.regions.count, "robots": s.robots.count,
+        setting = {"regions": RegionConfig.of(s).count, "robots": s.robots.count,
                    "resources": s.resources.count}
         if plan.cell is None:
             assert plan.strategy == "ddsa" and experiment == 1

@@ -81,12 +81,19 @@ def _imports(tree: ast.Module) -> Iterator[tuple[ast.stmt, str, bool]]:
     yield from walk(tree, True)
 
 
+def _runs(importer: str, target: str) -> set[str]:
+    """What importing `target` from `importer` runs: the target and the packages above it (their
+    ``__init__``), but not the importer's own packages (initialised or initialising already)."""
+    parts = target.split(".")
+    chain = {".".join(parts[:k]) for k in range(1, len(parts) + 1)}
+    return {m for m in chain & set(MODULES) if not importer.startswith(m + ".") and m != importer}
+
+
 def _graph() -> dict[str, set[str]]:
     graph: dict[str, set[str]] = {m: set() for m in MODULES}
     for module, path in MODULES.items():
         for _, target, _ in _imports(ast.parse(path.read_text())):
-            if target != module:
-                graph[module].add(target)
+            graph[module] |= _runs(module, target)
     return graph
 
 
@@ -125,9 +132,13 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
-@PENDING
 def test_no_import_circles():
-    assert _cycles(_graph()) == []
+    """No circle, a package's ``__init__`` included; the scenario schema and the registry sit at
+    the bottom (the loader and validation call the registry, never the other way round)."""
+    graph = _graph()
+    assert _cycles(graph) == []
+    assert graph["swarm_sim.scenario.schema"] <= {"swarm_sim"}
+    assert "swarm_sim.scenario" not in graph["swarm_sim.registry"]
 
 
 @PENDING

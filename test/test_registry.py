@@ -92,3 +92,16 @@ def test_plugin_algorithm_is_found_by_its_entry_point_and_runs():
     result = summarize(run_batch(load_scenario("dummy", ["sim.duration=20.0"])).trace)
     assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
     assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults
+
+
+def test_world_sections_are_named_once_and_declared_once(monkeypatch):
+    for name in registry.world_sections():
+        assert registry.world_section(name).SECTION == name
+    sections = {**registry.world_sections(), "regionz": registry.world_sections()["regions"]}
+    monkeypatch.setattr(registry, "world_sections", lambda: sections)
+    with pytest.raises(ValueError, match="section regionz is declared as .*RegionConfig, whose SECTION is 'regions'"):
+        registry.world_section("regionz")
+    clash = registry.TaskSpec("other", core="m:C", sensing="m:S", world=(("transport", "elsewhere:Transport"),))
+    with pytest.raises(ValueError, match="section transport is already declared as .*caging.world_config:TransportConfig"):
+        registry.register_task(clash)
+    assert "other" not in registry._TASKS

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_sim.scenario import ArenaConfig, DepotConfig, ResourceConfig, ScenarioError
-from swarm_sim.sites import drop_zones
+from swarm_sim.sites import drop_zones, zones_clear_of_resources
 from swarm_sim.world.resources import place_one, place_resources, powerlaw_pile_sizes, powerlaw_tiers
 
 ARENA = ArenaConfig(size=12.0)
@@ -196,17 +196,21 @@ def test_every_layout_is_valid(seed, distribution, clusters, side, depot_x, clea
 @pytest.mark.parametrize("seed", range(6))
 def test_the_spiral_algorithms_share_one_layout_per_seed_and_docks_stay_clear(seed):
     """The authors keep food off the nest only, so DDSA, MDBSA-C and MDBSA-D (whose region
-    centres are drop zones) get the same resources for a seed, 64 regions included; a queue
-    dock is still kept one spacing clear (a resource in it would be delivered at pick-up)."""
+    centres are drop zones, of a delivery kind that lets resources lie inside them) get the same
+    resources for a seed, 64 regions included; a queue dock is still kept one spacing clear (a
+    resource in it would be delivered at pick-up)."""
     from swarm_sim.scenario import load_scenario
 
     layouts = []
     for name in ("ddsa", "mdbsa_c", "mdbsa_d"):
         s = load_scenario(name, ["regions.count=64"], seed=seed)
-        layouts.append(place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), drop_zones(s)))
+        layouts.append(place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed),
+                                       zones_clear_of_resources(s)))
     assert np.array_equal(layouts[0], layouts[1]) and np.array_equal(layouts[0], layouts[2])
+    assert len(drop_zones(s)) == 64 and zones_clear_of_resources(s) == ()
     s = load_scenario("queue_qse", seed=seed)
-    zones = drop_zones(s)
+    zones = zones_clear_of_resources(s)
+    assert zones == drop_zones(s) and len(zones) == 4
     xy = place_resources(s.resources, s.arena, s.depot, np.random.default_rng(seed), zones)
     for z in zones:
         d = np.hypot(xy[:, 0] - z.center[0], xy[:, 1] - z.center[1])

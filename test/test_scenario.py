@@ -168,3 +168,102 @@ def test_the_shipped_scenarios_are_listed(capsys):
     queue_qmt = next(ln for ln in lines if ln.startswith("queue_qmt "))
     assert queue_qmt.split()[1:4] == ["queue", "64", "1080.0"] and "Q_MT" in queue_qmt
     assert max(map(len, lines)) <= 120
+
+
+# --------------------------------------------------------------------------- declared world sections
+
+
+def test_world_sections_are_declared_by_their_task_or_algorithm():
+    """``transport`` belongs to the caging paper's task, ``regions`` to the MDBSA records; the
+    loader builds them from their top-level keys and ``of`` reads them back (defaults if absent)."""
+    from swarm_controllers.caging.world_config import TransportConfig
+    from swarm_controllers.spiral.regions import RegionConfig
+
+    assert registry.world_sections() == {
+        "regions": "swarm_controllers.spiral.regions:RegionConfig",
+        "transport": "swarm_controllers.caging.world_config:TransportConfig",
+    }
+    assert dict(registry.task("transport").world) == {"transport": registry.world_sections()["transport"]}
+    assert {name for name in ("mdbsa_c", "mdbsa_d", "ddsa") if registry.algorithm(name).world} == {"mdbsa_c", "mdbsa_d"}
+    caging = load_scenario("caging", ["transport.object.radius=0.35"])
+    assert TransportConfig.of(caging).object.radius == 0.35
+    assert scenario_to_dict(caging)["transport"]["object"]["radius"] == 0.35  # at the top level, as in the file
+    assert scenario_from_dict(scenario_to_dict(caging)) == caging
+    cpfa = load_scenario("cpfa")
+    assert cpfa.sections == () and "transport" not in scenario_to_dict(cpfa)
+    assert TransportConfig.of(cpfa) == TransportConfig() and RegionConfig.of(cpfa) == RegionConfig()
+    assert RegionConfig.of(load_scenario("mdbsa_d")).center_radius == 0.15  # what mdbsa_d.yaml says
+    # any registered section is accepted in any scenario (an older bag's metadata carries them all)
+    assert RegionConfig.of(load_scenario("ddsa", ["regions.count=64"])).count == 64
+    again = cpfa.with_section("regions", RegionConfig(count=4))
+    assert RegionConfig.of(again).count == 4 and again.sections == (("regions", RegionConfig(count=4)),)
+
+
+@pytest.mark.parametrize(("name", "override", "message"), [
+    ("caging", "transport.object.radius=-1", "transport.object.radius: must be positive"),
+    ("caging", "transport.object.floor_friction=-0.1", "transport.object.floor_friction: must not be negative"),
+    ("caging", "transport.landmarks.step=0", "transport.landmarks.step: must be positive"),
+    ("caging", "transport.object.radius=big", "transport.object.radius: expected a number, got 'big'"),
+    ("caging", "transport.colour=red", "unknown key transport.colour (known keys: landmarks, object)"),
+    ("caging", "transport=3", "transport: expected a mapping"),
+    ("mdbsa_d", "regions.count=5", "regions.count: 5 is not a power of 4"),
+    ("cpfa", "regions.count=5", "regions.count: 5 is not a power of 4"),
+    ("mdbsa_c", "regions.center_radius=0", "regions.center_radius: must be positive"),
+    ("cpfa", "region.count=4", "unknown key region (known keys: arena, controller, depot, drop_zones, "
+                               "name, obstacles, regions, resources, robots, seed, sensors, sim, transport)"),
+    ("cpfa", "sections=[]", "unknown key sections"),
+])
+def test_a_bad_value_in_a_declared_world_section_is_refused_naming_the_key(name, override, message):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(name, [override])
+    assert str(info.value).startswith(message) and "\n" not in str(info.value), str(info.value)
+
+
+def test_a_scenario_file_with_a_bad_world_section_gets_one_line(tmp_path):
+    text = registry.scenario_files()["caging"].read_text()
+    assert "  landmarks: {step: 0.5," in text
+    path = tmp_path / "bad_caging.yaml"
+    path.write_text(text.replace("  landmarks: {step: 0.5,", "  landmarks: {step: -0.5,", 1))
+    with pytest.raises(ScenarioError, match=r"^transport.landmarks.step: must be positive$"):
+        load_scenario(str(path))
+
+
+# --------------------------------------------------------------------------- delivery kinds
+
+
+def test_delivery_kinds_are_registered_by_whoever_provides_them():
+    assert set(registry.delivery_kinds()) >= {"depot", "docks", "region_centers"}
+    assert registry.delivery_kind("depot").zones.startswith("swarm_sim.")
+    assert registry.delivery_kind("docks").zones.startswith("depot_manager.")
+    assert registry.delivery_kind("region_centers").zones.startswith("swarm_controllers.spiral.")
+    assert registry.delivery_kind("region_centers").resources_inside
+    assert not registry.delivery_kind("docks").resources_inside
+    with pytest.raises(ValueError, match="delivery kind 'docks' is already registered"):
+        registry.register_delivery(registry.delivery_kind("docks"))
+    s = load_scenario("queue_cpfa")
+    zones = drop_zones(s)
+    assert [z.name for z in zones] == [f"dock_{k}" for k in range(4)]
+    assert all((z.radius, z.dwell) == (s.depot.dock_radius, s.depot.unload_time) for z in zones)
+    assert [z.name for z in registry.delivery_zones(load_scenario("cpfa"), "docks")] == [f"dock_{k}" for k in range(4)]
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ("depot.delivery=nowhere", "depot.delivery: unknown delivery kind 'nowhere' (known: depot, docks, "),
+    ("depot.delivery=3", "depot.delivery: expected a string, got 3"),
+    ("depot.delivery=docks", None),  # the CPFA baseline also delivers at the docks (queue_cpfa)
+    ("depot.delivery=region_centers", "depot.delivery: cpfa delivers to depot or docks, not 'region_centers'"),
+])
+def test_an_unknown_or_unsuitable_delivery_kind_is_refused_naming_the_key(override, message):
+    if message is None:
+        assert load_scenario("cpfa", [override]).depot.delivery == "docks"
+        return
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("cpfa", [override])
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_a_delivery_kinds_own_checks_run():
+    """The docks kind needs its perimeter inside the arena; the depot kind does not."""
+    with pytest.raises(ScenarioError, match="depot.perimeter_radius: a perimeter of 6.5 m does not fit"):
+        load_scenario("queue_cpfa", ["depot.perimeter_radius=6.5"])
+    assert load_scenario("cpfa", ["depot.perimeter_radius=6.5"]).depot.perimeter_radius == 6.5

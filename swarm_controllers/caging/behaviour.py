@@ -48,6 +48,7 @@ from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.task import OBJECT
+from swarm_controllers.caging.world_config import TransportConfig
 
 Point = tuple[float, float]
 
@@ -74,7 +75,7 @@ class CagingBehaviour:
         self.rho = len(self.robots)
         self._rng = rng
         cfg = self.config = CagingConfig.of(scenario)
-        obj, w = scenario.transport.object, scenario.robots.diameter
+        obj, w = TransportConfig.of(scenario).object, scenario.robots.diameter
         self.d = cfg.distance_tolerance
         limits = Limits(scenario.robots.max_linear_speed, scenario.robots.max_angular_speed, scenario.sim.dt,
                         math.radians(cfg.angle_tolerance))

@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar
 
 from swarm_controllers.caging.geometry import cage_radius, max_robots, rho_min, theta_min
-from swarm_sim.scenario import Section
+from swarm_controllers.caging.world_config import TransportConfig
+from swarm_sim.scenario.schema import Section
 
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
@@ -72,7 +73,7 @@ def check_caging(scenario: Scenario) -> None:
                 "acceleration_ratio", "call_timeout", "barrier_timeout"):
         if not getattr(cfg, key) > 0:
             raise ValueError(f"controller.caging.{key}: must be positive")
-    obj, robots = scenario.transport.object, scenario.robots
+    obj, robots = TransportConfig.of(scenario).object, scenario.robots
     rho = robots.count
     need = rho_min(obj.mass, robots.mass, cfg.acceleration_ratio)
     if rho < math.ceil(need - 1e-9):
@@ -86,7 +87,7 @@ def check_caging(scenario: Scenario) -> None:
             f"(eq. 2; at most {most} robots)")
     half = scenario.arena.size / 2
     reach = cage_radius(obj.radius, robots.diameter, cfg.clearance) + robots.diameter / 2
-    extent = scenario.transport.landmarks.extent
+    extent = TransportConfig.of(scenario).landmarks.extent
     if max(extent) / 2 + reach > half:
         raise ValueError(f"transport.landmarks.extent: a cage around an edge landmark of the {list(extent)} m "
                          f"grid reaches {max(extent) / 2 + reach:.2f} m from the centre, past the walls at {half} m")

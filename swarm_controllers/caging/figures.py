@@ -11,6 +11,7 @@ import numpy as np
 from swarm_controllers.caging.metrics import caging_report, series_of, transport_stage
 from swarm_sim.types import robot_index
 from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.world_config import TransportConfig
 
 SNAPSHOTS = 6
 
@@ -45,7 +46,7 @@ def transport_figure(trace, directory: Path) -> list[Path]:
         moving = (obj_t >= stage.start_s) & (obj_t <= stage.end_s)
         ax.plot(obj[moving, 0], obj[moving, 1], color="tab:red", lw=1.5, label="object's centre")
     if len(obj):
-        ax.add_patch(plt.Circle(obj[0], scenario.transport.object.radius, fill=False, color="tab:red", ls=":"))
+        ax.add_patch(plt.Circle(obj[0], TransportConfig.of(scenario).object.radius, fill=False, color="tab:red", ls=":"))
     ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]", xlim=(-half, half), ylim=(-half, half),
            title=f"{trace.scenario} seed {trace.seed}: error {_fmt(report.trajectory_error_pct)} %, "
                  f"cage held: {report.cage_held}")
@@ -62,7 +63,7 @@ def transport_figure(trace, directory: Path) -> list[Path]:
 def _snapshots(fig, grid, scenario, stage, obj_t, obj, rob_t, robots) -> None:
     import matplotlib.pyplot as plt
 
-    r, w = scenario.transport.object.radius, scenario.robots.diameter
+    r, w = TransportConfig.of(scenario).object.radius, scenario.robots.diameter
     members = [robot_index(x) for x in stage.cage]
     index = {round(t, 6): k for k, t in enumerate(rob_t)}
     for n, t in enumerate(np.linspace(stage.start_s, stage.end_s, SNAPSHOTS)):

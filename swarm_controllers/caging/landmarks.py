@@ -16,7 +16,8 @@ from functools import cache
 
 import numpy as np
 
-from swarm_sim.scenario import LandmarkConfig, Scenario
+from swarm_controllers.caging.world_config import LandmarkConfig, TransportConfig
+from swarm_sim.scenario import Scenario
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,5 +64,5 @@ def _grid(step: float, extent: tuple[float, float]) -> Landmarks:
 
 def landmarks(scenario: Scenario) -> Landmarks:
     """The scenario's landmark grid (built once per step and extent)."""
-    c = scenario.transport.landmarks
+    c = TransportConfig.of(scenario).landmarks
     return _grid(c.step, tuple(c.extent))

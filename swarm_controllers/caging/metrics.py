@@ -32,6 +32,7 @@ from swarm_controllers.caging.config import CagingConfig
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_sim.types import NS_PER_S, robot_index
 from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.world_config import TransportConfig
 
 CONTACT_BOUND = 5.0
 """[s]: the longest a gap the object could pass through may stay open while the cage still counts
@@ -174,7 +175,7 @@ def _cage_held(trace, scenario, cage: list[str], times: np.ndarray, obj: np.ndar
     robot_times, robot_positions = series_of(trace, "robots")
     at = {round(t, 6): p for t, p in zip(robot_times, robot_positions)}
     members = [robot_index(r) for r in cage]
-    widest = 2.0 * scenario.transport.object.radius + scenario.robots.diameter
+    widest = 2.0 * TransportConfig.of(scenario).object.radius + scenario.robots.diameter
     """Adjacent robots' centres this far apart leave a gap the object passes through."""
     open_since: float | None = None
     for t, center in zip(times, obj):

@@ -1,5 +1,5 @@
 """The caging paper's registry records (caging_transport.md, Cardoso, Nedjah & Mourelle): the
-transport task (landmarks, the object) and the caging algorithm."""
+transport task (landmarks, the object: its ``transport`` world section) and the caging algorithm."""
 
 from swarm_sim.registry import Algorithm, Measure, Metric, TaskSpec, register, register_task
 
@@ -8,6 +8,7 @@ register_task(TaskSpec(
     core="swarm_controllers.caging.task:TransportTask",
     sensing="swarm_controllers.caging.sensing:SENSING",
     state="swarm_controllers.caging.sensing:STATE",
+    world=(("transport", "swarm_controllers.caging.world_config:TransportConfig"),),
 ))
 
 register(Algorithm(

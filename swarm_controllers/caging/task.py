@@ -43,6 +43,7 @@ from swarm_sim.geometry import yaw_to_quaternion
 from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import Pose2D
 from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.world_config import TransportConfig
 
 if TYPE_CHECKING:
     from swarm_sim.world.core import World
@@ -79,14 +80,14 @@ class TransportTask:
         self._world = world
         self._cid = world.client
         self.landmarks = landmarks(s)
-        obj = s.transport.object
+        obj = TransportConfig.of(s).object
         self.radius, self.mass, self._mu = obj.radius, obj.mass, obj.floor_friction
         self._w = s.robots.diameter
         self._z0 = s.robots.height / 2
         self._proximity = s.sensors.proximity
         self._position_range = s.sensors.position_range
         rng = np.random.default_rng(seeds[0])
-        half = np.array(s.transport.landmarks.extent, dtype=float) / 2
+        half = np.array(TransportConfig.of(s).landmarks.extent, dtype=float) / 2
         center = rng.uniform(-half, half)
         world.place_robots(self._starts(rng, half, center))
         shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=self.radius, height=s.robots.height,

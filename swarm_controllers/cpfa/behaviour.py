@@ -91,8 +91,8 @@ from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
 from swarm_sim.messaging import per_inbox
+from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
-from swarm_sim.sites import scenario_docks
 from swarm_sim.types import (
     NS_PER_S,
     BehaviourStatus,
@@ -234,8 +234,9 @@ class CpfaBehaviour:
         self._site_clearance2 = (nest_radius + margin) ** 2
         self._keep_out2 = -1.0 if keep_out is None else keep_out**2
         docks_mode = keep_out is None and scenario.depot.delivery == "docks"
-        self._docks = [(float(k.stop[0]), float(k.stop[1])) for k in scenario_docks(scenario)] if docks_mode else []
-        """Dock stops a carrier returns to [m, world frame] (empty: the depot centre)."""
+        self._docks = [z.center for z in delivery_zones(scenario)] if docks_mode else []
+        """Dock stops a carrier returns to: the zones the docks delivery implies [m, world frame]
+        (empty: the depot centre)."""
         self._dock_r2 = scenario.depot.dock_radius**2
 
         self._state = CpfaState.DEPARTING

@@ -1,16 +1,23 @@
-"""The queue paper's registry record (queue_depot_traffic.md): the robots' side here, the depot
+"""The queue paper's registry records (queue_depot_traffic.md): the ``docks`` delivery kind (its
+docks in `depot_manager.docks`) and the queue strategies, the robots' side here, the depot
 manager's server in the top-level `depot_manager` package."""
 
 from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES
 from swarm_controllers.cpfa.registration import SECTION as CPFA_SECTION
-from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, register
+from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, ServerSpec, register, register_delivery
+
+register_delivery(DeliveryKind(
+    name="docks",
+    zones="depot_manager.docks:dock_zones",
+    checks=("depot_manager.docks:check_docks",),
+))
 
 register(Algorithm(
     name="queue",
     paper="queue_depot_traffic.md secs. III-V: Q_SE, Q_ST, Q_ME, Q_MT",
     behaviour="swarm_controllers.queue.behaviour:QueueBehaviour",
     config=(CPFA_SECTION, ("queue", "depot_manager.config:QueueConfig")),
-    checks=("depot_manager.config:check_queue",),
+    checks=("depot_manager.geometry:check_queue",),
     servers=(ServerSpec(
         channel="depot", core="depot_manager.server:DepotServer", node="depot_manager.node",
         script="swarm-depot-manager", family="depot_manager.codec:DEPOT",

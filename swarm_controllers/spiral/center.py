@@ -66,6 +66,7 @@ from swarm_controllers.spiral.geometry import (
     region_side,
     segments_overlap_collinear,
 )
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, RobotId, robot_index
 
@@ -315,7 +316,7 @@ def region_bounds(scenario: Scenario) -> list[tuple[np.ndarray, np.ndarray]]:
     regions, none walked twice), and a wall keeps the same margin as in DDSA.
     """
     sp = SpiralConfig.of(scenario)
-    size, regions = scenario.arena.size, scenario.regions.count
+    size, regions = scenario.arena.size, RegionConfig.of(scenario).count
     half_side = region_side(regions, size) / 2.0 - sp.gap / 2.0
     wall = size / 2.0 - sp.arena_margin
     return [(np.maximum(c - half_side, -wall), np.minimum(c + half_side, wall))
@@ -390,7 +391,7 @@ def region_paths(scenario: Scenario) -> list[SpiralPath]:
     spiral (tested for 4, 16 and 64 regions).
     """
     sp = SpiralConfig.of(scenario)
-    centers = region_centers(scenario.regions.count, scenario.arena.size)
+    centers = region_centers(RegionConfig.of(scenario).count, scenario.arena.size)
     redundant = scenario.sensors.resource_detection_radius - sp.gap / 2.0
     return [SpiralPath(region_spiral(c, lo, hi, sp.gap, redundant))
             for c, (lo, hi) in zip(centers, region_bounds(scenario))]
@@ -502,4 +503,4 @@ def planned_paths(scenario: Scenario) -> list[np.ndarray]:
 
 def region_count(trace) -> int:
     """The run's number of regions N_R (a JSON result field of MDBSA runs)."""
-    return trace.config.regions.count
+    return RegionConfig.of(trace.config).count

@@ -13,6 +13,7 @@ import sys
 from swarm_controllers.spiral.center import region_paths
 from swarm_controllers.spiral.protocol import CENTER
 from swarm_controllers.spiral.geometry import region_centers, region_side
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_msgs_py import markers, server_state, topics
 from swarm_msgs_py.qos import STATE_LATCHED
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig, run_server
@@ -31,7 +32,7 @@ class CenterNode(ServerNode):
             topics.type_of(topics.CENTER_MARKERS), topics.CENTER_MARKERS, STATE_LATCHED
         )
         self._last_state = None
-        regions, size = self.scenario.regions.count, self.scenario.arena.size
+        regions, size = RegionConfig.of(self.scenario).count, self.scenario.arena.size
         half = region_side(regions, size) / 2
         squares = [
             [(x - half, y - half), (x + half, y - half), (x + half, y + half), (x - half, y + half), (x - half, y - half)]

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from swarm_sim.sites import region_centers  # noqa: F401 - re-exported: the planners' region grid
+from swarm_controllers.spiral.regions import region_centers  # noqa: F401 - re-exported: the planners' region grid
 
 DEFAULT_GAP = 0.18
 """Distance g between adjacent spiral lines [m] (paper Sec. IV)."""

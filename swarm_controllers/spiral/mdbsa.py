@@ -84,6 +84,7 @@ from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.ddsa import LaneAvoidance
 from swarm_controllers.motion import DriveLimits, go_to_point_twist
 from swarm_controllers.spiral.geometry import SpiralPath
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, Pose2D, RobotId
@@ -163,7 +164,7 @@ class MdbsaBehaviour:
         self._center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
-        self._idle_r2 = float(scenario.regions.center_radius) ** 2
+        self._idle_r2 = float(RegionConfig.of(scenario).center_radius) ** 2
         self._limits = DriveLimits.from_scenario(scenario)
         self._avoidance = LaneAvoidance(scenario)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)

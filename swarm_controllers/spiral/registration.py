@@ -1,7 +1,8 @@
 """The spiral paper's registry records (mdbsa_spiral_search.md, Lu & Luna 2023): DDSA, and
-MDBSA with centralized (C) and distributed (D) delivery, both served by the center."""
+MDBSA with centralized (C) and distributed (D) delivery, both served by the center and both
+declaring the ``regions`` world section; MDBSA-D's ``region_centers`` delivery kind."""
 
-from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, register
+from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, ServerSpec, register, register_delivery
 
 _SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
 _CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
@@ -11,11 +12,18 @@ _HEADLINE = (Measure("resources_per_robot"), Measure("resources_per_robot_per_mi
              Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"))
 """The spiral paper's measures (Figs. 6-10): resources per robot, their rate, collision time."""
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
+_REGIONS = ("regions", "swarm_controllers.spiral.regions:RegionConfig")
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.spiral.center:CenterServer",
     node="swarm_controllers.spiral.center_node", script="swarm-center",
     family="swarm_controllers.spiral.codec:CENTER",
 )
+
+register_delivery(DeliveryKind(
+    name="region_centers",
+    zones="swarm_controllers.spiral.regions:region_center_zones",
+    resources_inside=True,
+))
 
 register(Algorithm(
     name="ddsa",
@@ -36,6 +44,7 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         behaviour="swarm_controllers.spiral.mdbsa:MdbsaBehaviour",
         config=(_SECTION,),
         checks=_CHECKS,
+        world=(_REGIONS,),
         servers=(_CENTER,),
         deliveries=(_delivery,),
         metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),

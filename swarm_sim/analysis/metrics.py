@@ -13,8 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
-from swarm_sim.sites import drop_zones, scenario_docks
+from swarm_sim.sites import drop_zones
 from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 
@@ -173,7 +174,7 @@ def deliveries_outside_docks(trace: RunTrace) -> int | None:
     """Drops farther than the dock radius from every dock stop (None without a scenario)."""
     if trace.config is None:
         return None
-    stops = np.array([k.stop for k in scenario_docks(trace.config)])
+    stops = np.array([z.center for z in delivery_zones(trace.config, "docks")])
     radius = trace.config.depot.dock_radius + 1e-6
     return sum(
         1 for d in trace.drops if np.min(np.hypot(stops[:, 0] - d.x, stops[:, 1] - d.y)) > radius

@@ -4,8 +4,9 @@ Every placement draws only from the `numpy.random.Generator` it is given, so the
 the same layout. All positions are [m, world frame]. A position is *valid* when it keeps
 ``resources.margin`` from the walls (``|x|, |y| <= L/2 - margin``) and lies at least
 ``resources.min_depot_clearance`` outside the depot disc, and at least one ``spacing`` outside
-every other drop zone (docks, extra zones): a resource inside a zone would count as delivered the
-moment it is picked up. MDBSA region centres are the exception, as in the authors' code (`_keep_out`).
+every drop zone it is given to keep clear: a resource inside a zone would count as delivered the
+moment it is picked up. Which zones those are is the caller's (`swarm_sim.sites.zones_clear_of_resources`:
+a delivery kind may let resources lie inside its zones).
 
 Distributions:
 
@@ -30,7 +31,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from swarm_sim.scenario import ArenaConfig, DepotConfig, DropZoneConfig, ResourceConfig, ScenarioError
+from swarm_sim.scenario.schema import ArenaConfig, DepotConfig, DropZoneConfig, ResourceConfig, ScenarioError
 
 MAX_ATTEMPTS = 4096
 """Random candidate positions per cluster/pile (drawn in batches) before a layout restarts."""
@@ -50,23 +51,14 @@ Disc = tuple[float, float, float]
 
 
 def _keep_out(cfg: ResourceConfig, depot: DepotConfig, zones: Sequence[DropZoneConfig]) -> list[Disc]:
-    """The depot disc widened by min_depot_clearance, and every other drop zone widened by
-    spacing, except:
-
-    - the depot's own drop zone keeps min_depot_clearance, as the key says (with a clearance
-      below one spacing the zone's disc would otherwise decide);
-    - MDBSA region centres keep nothing: the authors keep food off the nest only
-      (``DSA_loop_functions::IsOutOfBounds`` checks ``IsCollidingWithNest``, MARSLab-UTRGV/
-      Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, branch luki-dev, Distributed/
-      source/DSA/DSA_loop_functions.cpp), so DDSA, MDBSA-C and MDBSA-D get the same layout
-      for a seed, and a resource lying in a region centre is delivered as soon as it is
-      picked up, as their ``IsInTheRegion`` does. (Keeping 64 such discs clear also left no
-      room for the larger piles.)"""
+    """The depot disc widened by min_depot_clearance, and every zone of `zones` widened by
+    spacing, except the depot's own drop zone: it keeps min_depot_clearance, as the key says
+    (with a clearance below one spacing the zone's disc would otherwise decide)."""
     disc = (float(depot.center[0]), float(depot.center[1]), depot.radius)
     discs = [(disc[0], disc[1], depot.radius + cfg.min_depot_clearance)]
     for z in zones:
         own = (float(z.center[0]), float(z.center[1]), z.radius)
-        if z.kind == "region_center" or (z.kind == "depot" and own == disc):
+        if z.kind == "depot" and own == disc:
             continue
         discs.append((own[0], own[1], z.radius + cfg.spacing))
     return discs
@@ -227,7 +219,7 @@ def place_resources(
     zones: Sequence[DropZoneConfig] = (),
 ) -> np.ndarray:
     """Initial resource positions, (cfg.count, 2) [m, world frame], deterministic per `rng`;
-    `zones`: the drop zones to keep clear (`swarm_sim.sites.drop_zones`).
+    `zones`: the drop zones to keep clear (`swarm_sim.sites.zones_clear_of_resources`).
 
     Raises ScenarioError naming the key when the layout cannot be placed.
     """

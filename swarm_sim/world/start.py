@@ -1,7 +1,7 @@
 """Where the robots stand at tick 0 (``robots.start_layout``) [m, world frame].
 
 Only the `depot_random` layout draws from the generator it is given (after the start headings,
-so a `grid` run draws exactly what it always did). `swarm_sim.scenario.validate` has already
+so a `grid` run draws exactly what it always did). `swarm_sim.scenario.validation` has already
 refused layouts that cannot fit.
 """
 
@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from swarm_sim.scenario import Scenario, ScenarioError
+from swarm_sim.scenario.schema import Scenario, ScenarioError
 
 START_ATTEMPTS = 10_000
 """Candidate positions drawn per robot before a `depot_random` start gives up."""

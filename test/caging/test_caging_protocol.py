@@ -21,6 +21,7 @@ from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S, STOP, BehaviourStatus, Observation, Pose2D, robot_index
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.task import CagingSense
+from swarm_controllers.caging.world_config import TransportConfig
 
 SMALL = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=200"]
 """Six robots (the paper's smallest swarm) on a 2 x 2 m grid: the whole protocol in ~3 min of sim."""
@@ -68,7 +69,7 @@ def test_every_run_follows_the_protocol(seed):
     assert all(v == start for t, v in objects if t <= t_go)
 
     # type 1 only after the recruiter is placed, one robot at a time, each once
-    r, w, c = s.transport.object.radius, s.robots.diameter, 0.01
+    r, w, c = TransportConfig.of(s).object.radius, s.robots.diameter, 0.01
     order = [m.destination for m in summons]
     assert len(order) == len(set(order)) == len(robots) - 1
     positioned = {m.origin: m.stamp_ns for m in messages if isinstance(m, Positioned)}

@@ -25,6 +25,7 @@ from swarm_controllers.spiral.center import (
 from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, MdbsaBehaviour, MdbsaState
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_controllers.spiral.geometry import (
     mdbsa_path,
     region_centers,
@@ -66,7 +67,7 @@ def test_scenarios_are_experiment_1_with_16_regions():
     ddsa = load_scenario("ddsa")
     for s, name in ((C, "mdbsa_c"), (D, "mdbsa_d")):
         assert s.controller.behaviour == name
-        assert s.regions.count == 16
+        assert RegionConfig.of(s).count == 16
         assert (s.arena, s.robots, s.resources, s.sim) == (ddsa.arena, ddsa.robots, ddsa.resources, ddsa.sim)
     assert C.depot.delivery == "depot"
     assert [z.name for z in drop_zones(C)] == ["depot"]
@@ -76,7 +77,7 @@ def test_scenarios_are_experiment_1_with_16_regions():
     zones = drop_zones(D)
     assert [z.name for z in zones] == [f"region_{i}" for i in range(16)]
     np.testing.assert_allclose([z.center for z in zones], region_centers(16, 8.0))
-    assert all(z.radius == D.regions.center_radius for z in zones)
+    assert all(z.radius == RegionConfig.of(D).center_radius for z in zones)
 
 
 def test_a_scenario_with_the_wrong_drop_zones_is_refused():
@@ -286,7 +287,7 @@ def test_idle_robots_stop_at_a_region_center_for_good_and_keep_avoiding_in_place
         c = u.step()
         assert c.messages == ()
     assert b.state is MdbsaState.IDLE
-    assert math.hypot(u.x - spot[0], u.y - spot[1]) <= C.regions.center_radius
+    assert math.hypot(u.x - spot[0], u.y - spot[1]) <= RegionConfig.of(C).center_radius
     assert math.hypot(u.x, u.y) > SpiralConfig.of(C).center_range
     events = b.obstacle_avoidance_events
     c = u.step(ranges=np.full_like(CLEAR, 0.1))
@@ -402,7 +403,7 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
     last = {r: region for _, r, state, region, _ in log if state is MdbsaState.SEARCHING}
     for r, (x, y, _) in pose.items():
         cx, cy = server.paths[last[r]].start
-        assert math.hypot(x - cx, y - cy) <= SMALL.regions.center_radius
+        assert math.hypot(x - cx, y - cy) <= RegionConfig.of(SMALL).center_radius
     walks = {(r, region, d) for _, r, state, region, d in log
              if state is MdbsaState.SEARCHING}
     assert {region for _, region, _ in walks} == {0, 1, 2, 3}

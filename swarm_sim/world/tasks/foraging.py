@@ -1,7 +1,7 @@
 """The foraging task: resources on the ground, grippers, drop zones (ARGoS foraging loop functions).
 
-What it places: the scenario's resources (`swarm_sim.world.resources`), kept clear of every drop
-zone (`swarm_sim.sites.drop_zones`). What robots additionally sense (`ForagingSense`): the
+What it places: the scenario's resources (`swarm_sim.world.resources`), kept clear of the drop
+zones (`swarm_sim.sites.zones_clear_of_resources`). What robots additionally sense (`ForagingSense`): the
 resources within the detection radius, nearest first, and whether the gripper holds one. Its
 bookkeeping after each tick, robots in index order: a carrying robot that has stayed inside a
 drop zone for the zone's dwell time drops its resource there (a `DropEvent`; respawn if the
@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from swarm_sim.sites import drop_zones
+from swarm_sim.sites import drop_zones, zones_clear_of_resources
 from swarm_sim.types import DropEvent, PickupEvent, RobotId
 from swarm_sim.world.jit import kernel
 from swarm_sim.world.resources import place_one, place_resources
@@ -59,6 +59,7 @@ class ForagingTask:
         rng_resources, self._rng_respawn = (np.random.default_rng(x) for x in seeds)
         n = len(world.robots)
         self._zones = zones = drop_zones(s)
+        self._keep_clear = zones_clear_of_resources(s)
         self._zone_xy = np.array([z.center for z in zones], dtype=float).reshape(-1, 2)
         self._zone_r2 = np.array([z.radius**2 for z in zones])
         self._zone_dwell_ns = np.array([round(z.dwell * 1e9) for z in zones], dtype=np.int64)
@@ -72,7 +73,7 @@ class ForagingTask:
         self._grid_corner = -s.arena.size / 2 - self._cell  # the lower left corner of cell (0, 0)
         self._ground_version = 0
         # Every resource ever placed keeps its index; `_on_ground` says where it is.
-        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, zones)
+        self._res_xy = place_resources(s.resources, s.arena, s.depot, rng_resources, self._keep_clear)
         self._on_ground = np.ones(len(self._res_xy), dtype=bool)
         self._carrying = np.full(n, -1, dtype=np.int64)
         self._inside_ticks = np.zeros((n, len(zones)), dtype=np.int64)
@@ -183,7 +184,7 @@ class ForagingTask:
                 self.resources_delivered += 1
                 stats[name].deliveries += 1
                 if s.resources.respawn:
-                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy, self._zones)
+                    new = place_one(s.resources, s.arena, s.depot, self._rng_respawn, self._ground_xy, self._keep_clear)
                     self._res_xy = np.vstack([self._res_xy, new[None, :]])
                     self._on_ground = np.append(self._on_ground, True)
                     changed = True

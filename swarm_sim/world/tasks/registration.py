@@ -1,8 +1,8 @@
-"""The shared core's one registry record, loaded through the ``swarmforage.algorithms`` entry
-point like every paper's: the foraging task (resources, drop zones, pick-up and delivery), the
-world logic that most algorithms run in."""
+"""The shared core's registry records, loaded through the ``swarmforage.algorithms`` entry point
+like every paper's: the foraging task (resources, drop zones, pick-up and delivery), the world
+logic that most algorithms run in, and the ``depot`` delivery kind (anywhere in the depot disc)."""
 
-from swarm_sim.registry import Measure, TaskSpec, register_task
+from swarm_sim.registry import DeliveryKind, Measure, TaskSpec, register_delivery, register_task
 
 register_task(TaskSpec(
     name="foraging",
@@ -11,3 +11,5 @@ register_task(TaskSpec(
     metrics="swarm_sim.analysis.metrics:foraging_metrics",
     headline=(Measure("resources_delivered"), Measure("total_resources")),
 ))
+
+register_delivery(DeliveryKind(name="depot", zones="swarm_sim.sites:depot_zones"))

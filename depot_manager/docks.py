@@ -1,0 +1,77 @@
+"""The docks on the depot boundary (queue_depot_traffic.md sec. III, Fig. 2) and the ``docks``
+delivery kind they make (registered in `swarm_controllers.queue.registration`): resources are
+delivered only at a dock, after T_unload there.
+
+ROS-free world facts computed from the scenario's ``depot`` section (``docks``, ``dock_radius``,
+``dock_distance``, ``unload_time``, ``perimeter_radius``); the queue geometry
+(`depot_manager.geometry`), the CPFA baseline's carriers (through their drop zones) and the
+metrics take their docks from here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from swarm_sim.scenario.schema import DropZoneConfig, Scenario
+
+
+@dataclass(frozen=True, eq=False)
+class Dock:
+    """A dock on the depot boundary (queue paper, green square of Fig. 2)."""
+
+    index: int
+    angle: float
+    """Bearing from the depot centre [rad, world frame, CCW from +x]."""
+    position: np.ndarray
+    """Point on the depot boundary [m, world frame]."""
+    stop: np.ndarray
+    """Where an unloading robot's centre waits, one robot radius outside [m, world frame]."""
+
+
+def polar(center: np.ndarray, r: np.ndarray | float, phi: np.ndarray | float) -> np.ndarray:
+    """Points at distance `r` and bearing `phi` [rad] from `center` [m, world frame]."""
+    r_a, phi_a = np.broadcast_arrays(np.asarray(r, float), np.asarray(phi, float))
+    pts = np.stack([r_a * np.cos(phi_a), r_a * np.sin(phi_a)], axis=-1)
+    return pts + center
+
+
+def docks(center: tuple[float, float], depot_radius: float, robot_diameter: float, count: int,
+          stop_radius: float | None = None) -> tuple[Dock, ...]:
+    """`count` docks evenly spaced on the depot boundary, CCW from +x (queue paper Fig. 2); a
+    robot unloads with its centre one robot radius outside the boundary, or `stop_radius` [m]
+    from the centre when given (``depot.dock_distance``)."""
+    c = np.asarray(center, dtype=float)
+    if stop_radius is None:
+        stop_radius = depot_radius + robot_diameter / 2.0
+    out = []
+    for k in range(count):
+        a = 2 * math.pi * k / count
+        out.append(Dock(k, a, polar(c, depot_radius, a), polar(c, stop_radius, a)))
+    return tuple(out)
+
+
+def scenario_docks(scenario: Scenario) -> tuple[Dock, ...]:
+    """The scenario's docks (``depot.docks`` on the depot disc)."""
+    d = scenario.depot
+    return docks(d.center, d.radius, scenario.robots.diameter, d.docks, d.dock_distance)
+
+
+def dock_zones(scenario: Scenario) -> tuple[DropZoneConfig, ...]:
+    """The ``docks`` delivery kind's zones: one per dock stop, of radius ``depot.dock_radius``,
+    where a carrier stays ``depot.unload_time`` before its resource is dropped."""
+    d = scenario.depot
+    return tuple(
+        DropZoneConfig(f"dock_{k.index}", (float(k.stop[0]), float(k.stop[1])), d.dock_radius, d.unload_time, "dock")
+        for k in scenario_docks(scenario)
+    )
+
+
+def check_docks(scenario: Scenario) -> None:
+    """A scenario delivering at the docks needs its perimeter inside the arena (ValueError
+    naming the key)."""
+    d, half = scenario.depot, scenario.arena.size / 2
+    if not (abs(d.center[0]) + d.perimeter_radius <= half and abs(d.center[1]) + d.perimeter_radius <= half):
+        raise ValueError(f"depot.perimeter_radius: a perimeter of {d.perimeter_radius} m does not fit in the arena")

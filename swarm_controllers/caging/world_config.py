@@ -1,0 +1,59 @@
+"""The transport task's world facts (caging_transport.md sec. 3): the scenario's ``transport``
+section, declared by the transport task's registry record (`swarm_controllers.caging.registration`):
+the target object and the landmark grid."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+from swarm_sim.scenario.schema import WorldSection
+
+
+@dataclass(frozen=True)
+class TargetObjectConfig:
+    """The transport task's cylindrical target object (caging paper sec. 3)."""
+
+    radius: float = 0.3
+    """r_object [m]."""
+    mass: float = 0.3
+    """M [kg]."""
+    floor_friction: float = 0.4
+    """Coulomb friction coefficient mu between the object and the floor: every physics substep
+    the object's planar speed drops by mu g dt and its spin by (4/3) mu g dt / r (a uniformly
+    pressed disc). The paper gives none; 0.4 is a plausible plastic-on-floor value."""
+
+
+@dataclass(frozen=True)
+class LandmarkConfig:
+    """The transport task's landmarks: a square grid centred on the arena (caging paper sec. 3,
+    Alg. 2); a landmark's neighbourhood eta is the up to eight grid neighbours around it."""
+
+    step: float = 0.5
+    """Grid step [m] (the paper's two discretisations: 0.5 and 1 m)."""
+    extent: tuple[float, float] = (8.0, 7.0)
+    """Width and height [m] of the rectangle the grid spans, corner landmarks included. The
+    paper reports 255 landmarks for step 0.5 m and 72 for 1 m in its 10 x 10 m arena; an
+    8 x 7 m grid is the one rectangle of whole metres that gives both (17 x 15 and 9 x 8), and
+    it leaves 1 m to the walls, room for a cage around a landmark on its edge."""
+
+
+@dataclass(frozen=True)
+class TransportConfig(WorldSection):
+    """World facts of the transport task (`swarm_controllers.caging.task`)."""
+
+    object: TargetObjectConfig = field(default_factory=TargetObjectConfig)
+    landmarks: LandmarkConfig = field(default_factory=LandmarkConfig)
+
+    SECTION: ClassVar[str] = "transport"
+
+    def check(self) -> None:
+        for ok, message in (
+            (self.object.radius > 0, "transport.object.radius: must be positive"),
+            (self.object.mass > 0, "transport.object.mass: must be positive"),
+            (self.object.floor_friction >= 0, "transport.object.floor_friction: must not be negative"),
+            (self.landmarks.step > 0, "transport.landmarks.step: must be positive"),
+            (min(self.landmarks.extent) >= 0, "transport.landmarks.extent: must not be negative"),
+        ):
+            if not ok:
+                raise ValueError(message)
