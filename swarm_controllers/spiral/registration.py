@@ -10,8 +10,7 @@ _METRICS = (Metric("resources_per_robot_per_min",
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.spiral.center:CenterServer",
-    node="swarm_controllers.spiral.center_node", script="swarm-center",
-    family="swarm_controllers.spiral.codec:CENTER",
+    family="swarm_controllers.spiral.codec:CENTER", outputs="swarm_controllers.spiral.codec:OUTPUTS",
 )
 
 register(Algorithm(
