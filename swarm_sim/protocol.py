@@ -9,7 +9,10 @@ messages in its own protocol module (`depot_manager.protocol`, `swarm_controller
 
 Servers are stepped once per tick, after the robots: at tick k a server takes every message
 stamped before k and answers with messages stamped k, which the robots see at tick k+1. A
-robot's request therefore gets its answer two ticks after it was sent.
+robot's request therefore gets its answer two ticks after it was sent. What a server publishes
+besides its messages (its ``state()`` on state topics, what it draws as `Lines` and `Points`)
+and the run-trace series read off it are declared with its registry record
+(`swarm_msgs_py.server_outputs.ServerOutputs`).
 """
 
 from __future__ import annotations

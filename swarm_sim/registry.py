@@ -23,8 +23,9 @@ a behaviour's module loads only when a run uses it.
 from __future__ import annotations
 
 import importlib
+import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 from functools import cache
 from importlib.metadata import entry_points
 from pathlib import Path
@@ -58,6 +59,18 @@ class ServerSpec:
     off what it publishes, the same in batch runs and bag replays (None: nothing)."""
     name: str = ""
     """Its node's name on the graph ('': the channel)."""
+    node: InitVar[str | None] = None
+    script: InitVar[str | None] = None
+    replay: InitVar[str | None] = None
+    """Deprecated and ignored: a plug-in's record written when each server had a node module and
+    console script of its own, and a replay function beside its ``series()``, still loads (with
+    a FutureWarning) but its server publishes and records only what `outputs` declares."""
+
+    def __post_init__(self, node: str | None, script: str | None, replay: str | None) -> None:
+        if node or script or replay:
+            warnings.warn(f"ServerSpec({self.channel!r}): node=, script= and replay= are ignored (every server runs "
+                          "in swarm_sim.nodes.server_node; declare its state, markers and series in outputs=)",
+                          FutureWarning, stacklevel=3)
 
     @property
     def node_name(self) -> str:

@@ -20,8 +20,9 @@ from swarm_sim.scenario import (
     ScenarioError,
     load_scenario,
 )
-from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
+from swarm_sim.types import Command, DropEvent, Observation, PheromoneMessage, PickupEvent, Pose2D
 from swarm_sim.world import World
+from swarm_sim.world.observations import with_messages
 
 
 def scenario(robots: int = 4, **fields) -> Scenario:
@@ -207,9 +208,6 @@ def test_observations_carry_no_messages_and_the_batch_runner_adds_its_inbox(make
     """The world sends and carries no messages; the batch runner hands every behaviour the
     tick's inbox in a copy of its observation (`with_messages`): the same observation with the
     very same inbox tuple put in, as ``dataclasses.replace`` would give."""
-    from swarm_sim.types import PheromoneMessage
-    from swarm_sim.world.observations import with_messages
-
     inbox = (PheromoneMessage(0, 1.0, 2.0), PheromoneMessage(0, -1.0, 0.5))
     w = make_world(scenario(3))
     w.reset()
