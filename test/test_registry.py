@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from swarm_msgs_py import topics
+from swarm_msgs_py.server_outputs import SeriesLog, ServerOutputs, Series
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
 
@@ -92,3 +93,20 @@ def test_plugin_algorithm_is_found_by_its_entry_point_and_runs():
     result = summarize(run_batch(load_scenario("dummy", ["sim.duration=20.0"])).trace)
     assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
     assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults
+
+
+def test_a_server_is_found_by_its_channel_and_built_from_its_record():
+    """The generic server node (``swarm-server --channel ...``) needs nothing but the channel."""
+    depot = registry.server("depot")
+    assert depot in registry.algorithm("queue").servers and depot.node_name == "depot_manager"
+    assert registry.server("center").node_name == "center"  # the same record for MDBSA-C and -D
+    with pytest.raises(ValueError, match="no algorithm registers a server on channel 'moon' \\(known: .*depot"):
+        registry.server("moon")
+    with pytest.warns(FutureWarning, match="node=, script= and replay= are ignored"):
+        old = registry.ServerSpec(channel="x", core="m:C", node="m.node", script="x-node", family="m:F")
+    assert old == registry.ServerSpec(channel="x", core="m:C", family="m:F")
+    with pytest.raises(ValueError, match="a series reads /nowhere"):
+        SeriesLog([registry.ServerSpec("nest", "m:C", depot.family, "test_registry:_BAD_OUTPUTS")], {})
+
+
+_BAD_OUTPUTS = ServerOutputs(series=(Series("/nowhere", lambda value: {}),))
