@@ -242,6 +242,7 @@ def profile_run(
             (behaviour_cls, "step", wrap(f"behaviours: {behaviour_cls.__name__}.step", behaviour_cls.step)),
             (batch, "make_servers", make_servers),
             (batch, "Router", make_router),
+            (batch, "with_messages", wrap("routing: inbox into observations", batch.with_messages)),
             (batch, "_collect_events", wrap("bookkeeping: events + trace", batch._collect_events)),
             (batch, "_record_state", wrap("bookkeeping: events + trace", batch._record_state)),
             (world_core, "p", _TimedPybullet(world_core.p, timers)),

@@ -7,5 +7,6 @@ from the scenario's `depot` section (`DepotGeometryConfig.from_scenario`); `draw
 layout to PNG (`python -m depot_manager.draw --layout single|multi --out FILE.png`);
 `admission` is the ROS-free slot authority (joins, grants, FCFS with the counter-clockwise tie
 rule, keep-clear intersections, inner-queue and dock rules); `server` wraps it as a
-`swarm_sim.protocol.Server`; `node` puts it on the graph (`swarm-depot-manager`).
+`swarm_sim.protocol.Server` (the generic server node puts it on the graph: ``swarm-server
+--channel depot``; `codec` declares its messages, state and markers).
 """

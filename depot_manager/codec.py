@@ -7,11 +7,32 @@
 | RadioQuery, RadioReply | /radio | robot -> robots (receivers keep what is in range) |
 
 All diagnostic_msgs/msg/DiagnosticArray (`swarm_msgs_py.records`), reliable, deep, volatile.
+
+Besides its messages the depot manager publishes (`OUTPUTS`) its state on ``/depot/state``
+whenever it changes and its markers on ``/depot/markers`` (every line, dock, entry and exit
+point, and which slots are owned) after a change at most once per `MARKER_PERIOD` of sim time,
+both reliable + transient-local; the run trace's ``queue_lengths`` (robots queued per entry
+line, a point whenever they change) is read from the state.
 """
 
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply
+from depot_manager.server import MARKER_PERIOD, draw
 from swarm_msgs_py import topics
+from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
+from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState, Series
+from swarm_msgs_py.server_state import DepotView, decode_depot_state, encode_depot_state
 
 DEPOT = RecordFamily("depot", {DepotReport: topics.DEPOT_REPORTS, DepotGrant: topics.DEPOT_GRANTS})
 RADIO = RecordFamily("radio", {RadioQuery: topics.RADIO, RadioReply: topics.RADIO})
+
+
+def _queue_lengths(depot: DepotView) -> dict[str, tuple[int, ...]]:
+    return {"queue_lengths": tuple(n for _, n in depot.queues)}
+
+
+OUTPUTS = ServerOutputs(
+    state=(ServerState(topics.DEPOT_STATE, TYPE_NAME, "depot", encode_depot_state, decode_depot_state),),
+    markers=ServerMarkers(topics.DEPOT_MARKERS, draw, MARKER_PERIOD),
+    series=(Series(topics.DEPOT_STATE, _queue_lengths, on_change=True),),
+)

@@ -7,26 +7,44 @@ ROS-free. Each tick the server applies the reports in the order given, then lets
 refused join. Reports that cannot be applied (unknown robot, a cell not on the robot's route,
 an unknown kind, ...) are ignored and counted in `rejections`: one robot's bad report must not
 stop the depot. A robot the world declared dead (`robot_lost`) leaves the depot: its dock, inner
-queue and slots are freed and its later reports refused. `history` keeps the entry-line queue lengths over time for the metrics.
+queue and slots are freed and its later reports refused.
+
+Its `state` is what ``/depot/state`` carries (the queues, docks and owned slots; the run trace's
+``queue_lengths`` series is read from it, `depot_manager.codec.OUTPUTS`), and `draw` what
+``/depot/markers`` shows.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from depot_manager.admission import DepotAdmission
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
+from swarm_msgs_py.server_state import DepotView
 from swarm_sim.inbound import Reason, Rejections
+from swarm_sim.protocol import Drawing, Lines, Points
 from swarm_sim.types import NS_PER_S
+
+MARKER_PERIOD = 1.0
+"""Sim seconds between slot-occupancy marker updates."""
+
+_ENTRY = (0.1, 0.1, 0.1, 0.9)
+_EXIT = (0.1, 0.3, 0.9, 0.9)
+_INNER = (0.6, 0.2, 0.8, 0.9)
+_DOCK = (0.1, 0.7, 0.2, 1.0)
+_FREE = (0.7, 0.7, 0.7, 0.5)
+_OWNED = (0.9, 0.1, 0.1, 0.9)
 
 
 class DepotServer:
     """Depot manager core, stepped once per tick (see `swarm_sim.protocol`)."""
 
     def __init__(self, scenario, *, lookahead: int = 8) -> None:
-        queue = QueueConfig.of(scenario)
+        self.queue = queue = QueueConfig.of(scenario)
         self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
         self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule)
         self.robots = frozenset(scenario.robot_names)
@@ -34,13 +52,13 @@ class DepotServer:
         """Reports that could not be applied, by reason (the last one's detail kept)."""
         self.lost: set[str] = set()
         """Robots declared dead."""
-        self.history: list[tuple[float, tuple[int, ...]]] = []
-        """(t [s], robots per entry line), appended whenever the queue lengths change."""
         self._last: dict[str, bool] = {}
 
-    def series(self) -> dict[str, list[tuple[float, tuple[int, ...]]]]:
-        """The run trace's ``queue_lengths``: (t [s], robots queued per entry line) on change."""
-        return {"queue_lengths": list(self.history)}
+    def state(self) -> dict[str, DepotView]:
+        """``depot``: the queues, docks, inner queues and owned slots now."""
+        s = self.admission.snapshot()
+        return {"depot": DepotView(tuple(zip(s.entry_lines, s.entry_queue_lengths)), s.dock_occupants,
+                                   s.inner_queue_counts, s.occupied)}
 
     def robot_lost(self, robot: str, stamp_ns: int) -> None:
         """`robot` was declared dead: free everything it holds, refuse what it sends later."""
@@ -85,8 +103,24 @@ class DepotServer:
                 line, cell = changed.get(r) or adm.grant(r)
                 out.append(DepotGrant(stamp_ns, r, line, cell, last[r]))
         self._last = last
-        lengths = adm.entry_queue_lengths()
-        if not self.history or self.history[-1][1] != lengths:
-            self.history.append((t, lengths))
         out.sort(key=lambda g: g.robot)  # stable: a refusal stays before its robot's grant
         return tuple(out)
+
+
+def draw(server: DepotServer, stamp_ns: int) -> Drawing:
+    """Every line, dock, entry and exit point of the layout, and which slots are owned."""
+    layout, adm = server.layout, server.admission
+    owned = {(line, cell) for line, cell, _ in adm.snapshot().occupied}
+    cells = [(line, i, p) for line in adm.lines() for i, p in enumerate(adm.cells(line))]
+    free = np.array([p for line, i, p in cells if (line, i) not in owned]).reshape(-1, 2)
+    taken = np.array([p for line, i, p in cells if (line, i) in owned]).reshape(-1, 2)
+    return (
+        Lines("entry_lines", [ln.points for ln in layout.entry_lines], _ENTRY, 0.01),
+        Lines("exit_lines", [ln.points for ln in layout.exit_lines], _EXIT, 0.01),
+        Lines("inner_queues", [ln.points for ln in layout.inner_queues], _INNER, 0.01),
+        Points("docks", 0, np.array([d.stop for d in layout.docks]), _DOCK, server.queue.lane_spacing, cubes=True),
+        Points("entry_points", 0, layout.entry_points, _ENTRY, 0.08),
+        Points("exit_points", 0, layout.exit_points, _EXIT, 0.08),
+        Points("slots_free", 0, free, _FREE, 0.04),
+        Points("slots_owned", 0, taken, _OWNED, 0.06),
+    )

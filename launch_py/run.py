@@ -40,9 +40,9 @@ from launch_py.dds import (
     robot_profile,
     server_profile,
 )
-from launch_py.lifetime import die_with_parent
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
 from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
@@ -196,7 +196,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
         children += [start(label, [*cmd, *common], robots_env) for label, cmd in controllers]
-        children += [start(f"server {spec.channel} ({spec.script})", [*python, spec.node, *common]) for spec in servers]
+        children += [start(f"server {spec.channel} ({spec.node_name})",
+                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, *common])
+                     for spec in servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)
         while world.poll() is None:

@@ -3,8 +3,8 @@
     ros2 launch swarmforage swarm.launch.py robots:=16 scenario:=cpfa seed:=0 bag:=bags/run1
 
 Starts the world node (which records the bag), one controller process hosting every robot's
-controller node and the servers the scenario needs (center, depot manager; console scripts on
-PATH). `swarm-run` does the same without ros2launch; nothing in the tests needs this.
+controller node and a server node (``swarm-server --channel ...``) for each server the scenario
+needs (center, depot manager; console scripts on PATH). `swarm-run` does the same without ros2launch; nothing in the tests needs this.
 """
 
 from launch import LaunchDescription
@@ -25,7 +25,8 @@ def _nodes(context):
 
     servers = registry.of(load_scenario(scenario, [f"robots.count={robots}"])).servers
     return [
-        *[ExecuteProcess(cmd=[spec.script, *common], output="screen") for spec in servers],
+        *[ExecuteProcess(cmd=["swarm-server", "--channel", spec.channel, *common], output="screen")
+          for spec in servers],
         ExecuteProcess(cmd=["swarm-controllers", "--robots",
                             *[f"robot_{i}" for i in range(robots)], *common], output="screen"),
         ExecuteProcess(cmd=["swarm-world", *common, "--bag", bag], output="screen"),

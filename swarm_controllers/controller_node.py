@@ -33,35 +33,25 @@ import os
 import signal
 import sys
 import time
-from collections import defaultdict
-from dataclasses import dataclass
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from launch_py.lifetime import die_with_parent, set_process_name
 from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim import registry
-from swarm_sim.inbound import Inbound, Rejections, merged, total
-from swarm_sim.messaging import Mailbox
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
+from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
+from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
+from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import Observation, robot_index
 
-
-@dataclass(frozen=True)
-class ControllerConfig:
-    scenario: str = DEFAULT_SCENARIO
-    """Scenario name or YAML path (the same one the world loads)."""
-    overrides: tuple[str, ...] = ()
-    seed: int = 0
-    startup_timeout: float = 60.0
-    """Wall seconds to wait for every peer and server to be matched before answering anyway."""
+ControllerConfig = EndpointConfig
+"""A controller node's parameters: scenario, overrides, seed and how long `connect` waits."""
 
 
 class ControllerNode(Node):
@@ -90,12 +80,6 @@ class ControllerNode(Node):
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
         self._sense_topics = tuple((t.field, t.name) for t in self.sensing.topics)
-        self.mailbox = Mailbox()
-        self.rejections = Rejections()
-        self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
-                               self.get_logger().warning)
-        self._published_rejections = 0
-        """Messages dropped so far, as last published on ``/diagnostics``."""
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
@@ -108,20 +92,7 @@ class ControllerNode(Node):
         self._expected = len(decoders)
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
-        inbound, outbound = registry.robot_topics(algorithm)
-        self._inbound_subs = {
-            topic: self.create_subscription(
-                topics.import_type(family.type_name), topic,
-                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
-                EVENTS, raw=True,
-            )
-            for topic, family in inbound.items()
-        }
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
-                          for t, f in outbound.items()}
-
-        self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
-        """Message class -> the topic this robot sends it on."""
+        self.endpoint = Endpoint(self, self.scenario, *registry.robot_topics(algorithm))
         for name, (type_name, decode) in decoders.items():
             self.create_subscription(
                 topics.import_type(type_name), name,
@@ -130,8 +101,6 @@ class ControllerNode(Node):
         self._cmd_pub = None
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
-        self._diagnostics_pub = self.create_publisher(
-            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
 
     def connect(self) -> bool:
         """Create the ``cmd_vel`` publisher once every exchange topic is matched (or the start-up
@@ -139,8 +108,7 @@ class ControllerNode(Node):
         if self._cmd_pub is not None:
             return True
         # One peer on each: a server, or the world relaying what robots send each other.
-        missing = [t for t, sub in self._inbound_subs.items() if sub.get_publisher_count() < 1]
-        missing += [t for t, (_, pub) in self._outbound.items() if pub.get_subscription_count() < 1]
+        missing = self.endpoint.unmatched(1)
         if missing and time.monotonic() < self._connect_by:
             return False
         if missing:
@@ -164,53 +132,34 @@ class ControllerNode(Node):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
-        self.inbound.now_ns = self.inbound.released_ns = stamp_ns
+        messages = self.endpoint.take(stamp_ns)
         _, pose, v, w = self._latest[topics.ODOM]
         sensed = self.sensing.sense(**{field: self._latest[name][1] for field, name in self._sense_topics})
         obs = Observation(
             robot=self.robot, stamp_ns=stamp_ns, pose=pose, linear_velocity=v, angular_velocity=w,
-            ranges=self._latest[topics.SCAN][1], sensed=sensed, messages=self.mailbox.take_before(stamp_ns),
+            ranges=self._latest[topics.SCAN][1], sensed=sensed, messages=messages,
         )
         command = self.behaviour.step(obs)
         if command.messages:
-            self._send(stamp_ns, command.messages)
+            self.endpoint.send(stamp_ns, command.messages)
         status = self.behaviour.status(stamp_ns)
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
-        core = getattr(self.behaviour, "rejections", None)
-        if (dropped := total(self.rejections, core)) != self._published_rejections:
-            self._published_rejections = dropped
-            self._diagnostics_pub.publish(diagnostics.encode_rejections(
-                stamp_ns, self.get_fully_qualified_name(), merged(self.rejections, core)))
+        self.endpoint.report.publish(stamp_ns, self.behaviour)
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
-
-    def _send(self, stamp_ns: int, messages: tuple[object, ...]) -> None:
-        """The behaviour's outgoing messages, on the topics of their families."""
-        by_topic: dict[str, list] = defaultdict(list)
-        for message in messages:
-            topic = self._topic_of.get(type(message))
-            if topic is None:
-                raise TypeError(f"{self.robot}: this algorithm sends no {type(message).__name__}")
-            by_topic[topic].append(message)
-        for topic, group in by_topic.items():
-            family, pub = self._outbound[topic]
-            for data in family.encode(stamp_ns, group):
-                pub.publish(data)
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool]:
     parser = argparse.ArgumentParser(prog="swarm-controllers", description=__doc__.splitlines()[0])
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
-    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
-    parser.add_argument("--seed", type=int, default=0)
+    add_endpoint_arguments(parser)
     parser.add_argument("--fork", action="store_true", help="one process per robot, forked from this one")
     args, ros_args = parser.parse_known_args(argv)
-    return args.robots, ControllerConfig(args.scenario, tuple(args.overrides), args.seed), ros_args, args.fork
+    return args.robots, endpoint_config(args), ros_args, args.fork
 
 
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,

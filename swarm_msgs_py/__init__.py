@@ -61,7 +61,8 @@ QoS (`qos`): observations, commands, /clock and acks use SENSOR_LOCKSTEP (best e
 the lockstep barrier re-sends what was lost);
 markers, robot stats and assignment/state topics STATE_LATCHED (reliable, transient-local,
 depth 1); events, status and pheromones EVENTS (reliable, keep-last 1000).
-Names and types as data: `topics`.
+Names and types as data: `topics`. A server's state and markers topics, and the run-trace
+series read off what it publishes, are declared with its registry record (`server_outputs`).
 """
 
 from swarm_msgs_py.cdr import CodecError

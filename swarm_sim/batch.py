@@ -1,11 +1,13 @@
 """In-process batch runner: the graph's core objects stepped without DDS, for sweeps.
 
 It plays the roles the graph splits over nodes, in the same order: observations of tick k go
-to every behaviour together with the messages stamped before k, the commands come back, the
-servers (center, depot manager) handle their messages stamped before k, the world steps. Same
-scenario and seed as a lockstep graph run -> same trajectories and metrics (tested in
-test/test_determinism.py). With ``sim.stop_when_finished`` a run ends early once every behaviour
-says it is finished (sweeps); the world task's state is kept every tick as the trace's series.
+to every behaviour, each with the messages stamped before k from the router (as a controller node
+hands its behaviour its mailbox's), the commands come back, the servers (center, depot manager)
+handle their messages stamped before k, the world steps. Same scenario and seed as a lockstep
+graph run -> same trajectories and metrics (tested in test/test_determinism.py). With
+``sim.stop_when_finished`` a run ends early once every behaviour says it is finished (sweeps). The
+world task's state is kept every tick as the trace's series, and the servers' series are read off
+what they publish, as a bag replay reads them (`swarm_msgs_py.server_outputs.SeriesLog`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from operator import attrgetter, call
 import numpy as np
 
 from swarm_controllers.api import behaviour_rng
+from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
@@ -34,6 +37,7 @@ from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
+from swarm_sim.world.observations import with_messages
 
 
 @dataclass
@@ -89,6 +93,9 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
     spec = task(algorithm.task).state
     state_topics = resolve(spec) if spec else ()
     keep = tuple(cls for path in algorithm.peers for cls in resolve(path).topics) if algorithm.trace_peers else ()
+    series = SeriesLog(algorithm.servers, trace.series)
+    # The servers whose published state a series reads: asked for their state every tick.
+    watched = {s.channel: StateWatch(outputs_of(s).state) for s in algorithm.servers if s.channel in series.reads_state}
     try:
         obs = world.reset()
         _record_state(world, state_topics, trace)
@@ -96,19 +103,26 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
-            answers = list(map(call, steps, obs.values()))  # the world's dict is in robot order
-            for message in chain.from_iterable(map(_MESSAGES, answers)):
+            # Each behaviour's inbox: every message stamped before this tick has been posted (the
+            # robots' and servers' of the last tick); every robot gets the same tuple.
+            inbox = router.take_before(ROBOTS, world.t_ns)
+            seen = obs.values() if not inbox else [with_messages(o, inbox) for o in obs.values()]
+            answers = list(map(call, steps, seen))  # the world's dict is in robot order
+            sent = list(chain.from_iterable(map(_MESSAGES, answers)))
+            for message in sent:
                 router.post(message)
                 if keep and isinstance(message, keep):
                     trace.messages.append(message)
+            series.sent(sent)
             for channel, server in servers.items():
-                for message in server.step(world.t_ns, router.take_before(channel, world.t_ns)):
+                answered = server.step(world.t_ns, router.take_before(channel, world.t_ns))
+                for message in answered:
                     router.post(message)
+                series.sent(answered)
+                if channel in watched:
+                    series.published(world.t_ns, watched[channel].changed(server.state()))
             last_step_ns = world.t_ns
-            # The next tick's inbox, handed out with its observations: every message stamped
-            # before it has been posted by now (the robots' and servers' of this tick).
-            inbox = router.take_before(ROBOTS, world.t_ns + world.dt_ns)
-            obs = world.step(dict(zip(robots, answers)), inbox)
+            obs = world.step(dict(zip(robots, answers)))
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
             if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):
@@ -123,8 +137,6 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
         trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
-        for server in servers.values():
-            trace.series.update(server.series())
         trace.messages.sort(key=delivery_order)
     finally:
         world.close()

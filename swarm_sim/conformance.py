@@ -6,9 +6,9 @@
   task, metrics, paths, message families, sense codecs) imports with rclpy and every ``*_msgs``
   package blocked, and a short batch run works that way;
 - **determinism**: two batch runs with the same seed give identical results and trajectories;
-- **codecs**: every message class of its families and its task's sense survive encode/decode
-  unchanged (messages built from their field types, senses and task states taken from a real
-  world);
+- **codecs**: every message class of its families, its task's sense and its servers' state
+  topics survive encode/decode unchanged (messages built from their field types, senses and task
+  states taken from a real world, server states from its cores after a first tick);
 - **graph_equals_batch** (optional): a lockstep run on the ROS graph (``swarm-run``) gives the
   batch run's trajectories and metrics for the same seed.
 
@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from swarm_msgs_py.server_outputs import outputs_of
 from swarm_sim import registry
 from swarm_sim.scenario import Scenario, load_scenario
 
@@ -68,7 +69,7 @@ def core_paths(algorithm: registry.Algorithm) -> list[str]:
     task = registry.task(algorithm.task)
     paths = [algorithm.behaviour, *(p for _, p in algorithm.config), *algorithm.checks,
              *(s.core for s in algorithm.servers), *(s.family for s in algorithm.servers),
-             *(s.replay for s in algorithm.servers if s.replay), *algorithm.peers,
+             *(s.outputs for s in algorithm.servers if s.outputs), *algorithm.peers,
              *(m.function for m in algorithm.metrics), task.core, task.sensing]
     paths += [p for p in (algorithm.paths, algorithm.comparison, algorithm.figures, task.metrics, task.state) if p]
     return paths
@@ -183,6 +184,14 @@ def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
             stamp, value = st.decode(st.encode(t_ns, state[st.field]))
             if stamp != t_ns or value != state[st.field]:
                 _fail("codecs", f"state {st.field} on {st.topic} came back as {value!r}")
+    for spec in algorithm.servers:
+        core = registry.resolve(spec.core)(scenario)
+        core.step(0, ())
+        for st in outputs_of(spec).state:
+            value = core.state()[st.field]
+            stamp, decoded = st.decode(st.encode(1_700_000_003, value))
+            if stamp != 1_700_000_003 or decoded != value:
+                _fail("codecs", f"server {spec.channel}'s state {st.field} on {st.topic} came back as {decoded!r}")
 
 
 def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch_summary: dict[str, Any],

@@ -9,13 +9,19 @@ messages in its own protocol module (`depot_manager.protocol`, `swarm_controller
 
 Servers are stepped once per tick, after the robots: at tick k a server takes every message
 stamped before k and answers with messages stamped k, which the robots see at tick k+1. A
-robot's request therefore gets its answer two ticks after it was sent.
+robot's request therefore gets its answer two ticks after it was sent. What a server publishes
+besides its messages (its ``state()`` on state topics, what it draws as `Lines` and `Points`)
+and the run-trace series read off it are declared with its registry record
+(`swarm_msgs_py.server_outputs.ServerOutputs`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Protocol
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
 
 from swarm_sim.types import PheromoneMessage
 
@@ -41,11 +47,39 @@ class Server(Protocol):
         messages to send, stamped `stamp_ns`."""
         ...
 
-    def series(self) -> dict[str, list[tuple[float, Any]]]:
-        """Time series for the run trace, by name: (t [s], value) whenever it changed."""
-        ...
-
-    # Optional, found with getattr by the server node:
+    # Optional, found with getattr:
     #   rejections: swarm_sim.inbound.Rejections -- messages the core refused, by class and reason;
     #   robot_lost(robot, stamp_ns) -> None -- the world declared `robot` dead: free what it held
-    #   and refuse its later messages (graph runs only: in batch every robot answers every tick).
+    #   and refuse its later messages (graph runs only: in batch every robot answers every tick);
+    #   state() -> {field: value} -- the values its registry record's state topics carry
+    #   (`swarm_msgs_py.server_state.ServerState`), asked after every step.
+
+
+@dataclass(frozen=True)
+class Lines:
+    """Polylines a server draws (its node publishes them as LINE_STRIP markers, id = position)."""
+
+    ns: str
+    lines: Sequence[np.ndarray]
+    """Each (n, 2) [m, world frame]."""
+    color: tuple[float, float, float, float]
+    """r, g, b, a in [0, 1]."""
+    width: float
+
+
+@dataclass(frozen=True)
+class Points:
+    """A point set a server draws (one SPHERE_LIST marker, or CUBE_LIST with `cubes`)."""
+
+    ns: str
+    id: int
+    points: np.ndarray
+    """(n, 2) [m, world frame]."""
+    color: tuple[float, float, float, float]
+    size: float
+    """[m]."""
+    cubes: bool = False
+
+
+Drawing = Sequence[Lines | Points]
+"""What a server's markers function returns, ROS-free (`swarm_msgs_py.server_state.ServerMarkers`)."""

@@ -65,22 +65,27 @@ class Measure:
 
 @dataclass(frozen=True)
 class ServerSpec:
-    """A node core other than the world and the robots (`swarm_sim.protocol.Server`)."""
+    """A node core other than the world and the robots (`swarm_sim.protocol.Server`); on the
+    graph it runs in the generic server node (``swarm-server --channel <channel>``,
+    `swarm_sim.nodes.server_node`), built from this record alone."""
 
     channel: str
     """The channel its inbound messages travel on; also its name on ``/lockstep/ack``."""
     core: str
     """``module:Class``, built as ``Class(scenario)``."""
-    node: str
-    """Module of its ROS node, started as ``python -m node`` (it has a ``main``)."""
-    script: str
-    """The node's console script (what the launch file starts)."""
     family: str
     """``module:FAMILY``: the message family (`swarm_msgs_py.records.MessageFamily`) it speaks
     with the robots: it hears the family's messages on its channel and sends the others."""
-    replay: str | None = None
-    """``module:function`` ``(topic, data) -> [(series, t [s], value), ...]``: what its
-    recorded state topics add to a run trace's ``series`` (None: nothing)."""
+    outputs: str | None = None
+    """``module:OUTPUTS`` (`swarm_msgs_py.server_outputs.ServerOutputs`): what its node publishes
+    besides the family's messages (state topics, markers) and the run trace's time series read
+    off what it publishes, the same in batch runs and bag replays (None: nothing)."""
+    name: str = ""
+    """Its node's name on the graph ('': the channel)."""
+
+    @property
+    def node_name(self) -> str:
+        return self.name or self.channel
 
 
 @dataclass(frozen=True)
@@ -398,6 +403,18 @@ def make_behaviour(scenario: Scenario, robot: str, rng: np.random.Generator) -> 
     """The behaviour of the scenario's algorithm for `robot`."""
     robot_index(robot)  # refuse ids that are not robot_<i>
     return resolve(of(scenario).behaviour)(scenario, robot, rng)
+
+
+def server(channel: str) -> ServerSpec:
+    """The server registered on `channel` (by any algorithm); ValueError naming the known
+    channels, or the algorithms that register different servers on it."""
+    found = {s: a.name for a in algorithms() for s in a.servers if s.channel == channel}
+    if not found:
+        known = sorted({s.channel for a in algorithms() for s in a.servers})
+        raise ValueError(f"no algorithm registers a server on channel {channel!r} (known: {', '.join(known)})")
+    if len(found) > 1:
+        raise ValueError(f"channel {channel!r}: different servers registered by {', '.join(sorted(found.values()))}")
+    return next(iter(found))
 
 
 def make_servers(scenario: Scenario) -> dict[str, Server]:

@@ -1,9 +1,20 @@
-"""Shared test set-up: every ROS-using test runs on loopback and a private domain."""
+"""Shared test set-up: every ROS-using test runs on loopback and a private domain, and the test
+plug-ins of this tree are the ones imported."""
 
 from __future__ import annotations
 
 import os
 import random
+import sys
+from pathlib import Path
+
+# The test plug-ins (test/plugins/*) are found through the entry points of their installed copy
+# (scripts/test installs them editable); the modules those entry points name are imported from
+# this tree, in this process and in the processes the tests start, even when the installed copy
+# is another checkout's (a git worktree sharing one virtual environment).
+_PLUGINS = [str(p) for p in sorted((Path(__file__).parent / "plugins").iterdir()) if (p / "pyproject.toml").exists()]
+sys.path[:0] = _PLUGINS
+os.environ["PYTHONPATH"] = os.pathsep.join([*_PLUGINS, *filter(None, [os.environ.get("PYTHONPATH")])])
 
 # Before anything imports rclpy: loopback only (sockets bound to 127.0.0.1, launch_py.dds), and
 # a domain no other run on this machine uses.

@@ -1,5 +1,5 @@
-"""`ros2 param list/get` on every node: the controller, depot-manager and center nodes serve the
-standard parameter services (as the world does). A client node asks them
+"""`ros2 param list/get` on every node: the controller node and the server node (as the depot
+manager and as the center) serve the standard parameter services (as the world does). A client node asks them
 over DDS what ``ros2 param list`` and ``ros2 param get`` ask: ListParameters and GetParameters."""
 
 from __future__ import annotations
@@ -9,10 +9,8 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter_client import AsyncParameterClient
 
-from depot_manager.node import DepotManagerNode
-from swarm_controllers.spiral.center_node import CenterNode
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
-from swarm_sim.nodes.server_node import ServerNodeConfig
+from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig
 from test_nodes import SMALL
 
 
@@ -25,9 +23,10 @@ def _spin_until(executor, future, timeout=20.0):
 @pytest.mark.parametrize("make, name, seed", [
     (lambda ctx: ControllerNode("robot_1", ControllerConfig("cpfa", SMALL, 7), context=ctx),
      "/robot_1/controller", 7),
-    (lambda ctx: DepotManagerNode(ServerNodeConfig("queue_qmt", ("robots.count=2",), 5), context=ctx),
+    (lambda ctx: ServerNode("depot", ServerNodeConfig("queue_qmt", ("robots.count=2",), 5), context=ctx),
      "/depot_manager", 5),
-    (lambda ctx: CenterNode(ServerNodeConfig("mdbsa_d", ("robots.count=2",), 3), context=ctx), "/center", 3),
+    (lambda ctx: ServerNode("center", ServerNodeConfig("mdbsa_d", ("robots.count=2",), 3), context=ctx),
+     "/center", 3),
 ], ids=["controller", "depot_manager", "center"])
 def test_param_list_and_get_answer_on_every_node(context, make, name, seed):
     node = make(context)

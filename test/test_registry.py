@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from swarm_msgs_py import topics
+from swarm_msgs_py.server_outputs import SeriesLog, ServerOutputs, Series
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
 
@@ -105,3 +106,17 @@ def test_world_sections_are_named_once_and_declared_once(monkeypatch):
     with pytest.raises(ValueError, match="section transport is already declared as .*caging.world_config:TransportConfig"):
         registry.register_task(clash)
     assert "other" not in registry._TASKS
+
+
+def test_a_server_is_found_by_its_channel_and_built_from_its_record():
+    """The generic server node (``swarm-server --channel ...``) needs nothing but the channel."""
+    depot = registry.server("depot")
+    assert depot in registry.algorithm("queue").servers and depot.node_name == "depot_manager"
+    assert registry.server("center").node_name == "center"  # the same record for MDBSA-C and -D
+    with pytest.raises(ValueError, match="no algorithm registers a server on channel 'moon' \\(known: .*depot"):
+        registry.server("moon")
+    with pytest.raises(ValueError, match="a series reads /nowhere"):
+        SeriesLog([registry.ServerSpec("nest", "m:C", depot.family, "test_registry:_BAD_OUTPUTS")], {})
+
+
+_BAD_OUTPUTS = ServerOutputs(series=(Series("/nowhere", lambda value: {}),))

@@ -20,8 +20,9 @@ from swarm_sim.scenario import (
     ScenarioError,
     load_scenario,
 )
-from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
+from swarm_sim.types import Command, DropEvent, Observation, PheromoneMessage, PickupEvent, Pose2D
 from swarm_sim.world import World
+from swarm_sim.world.observations import with_messages
 
 
 def scenario(robots: int = 4, **fields) -> Scenario:
@@ -203,25 +204,20 @@ def test_time_advances_one_tick_per_step(make_world):
 
 
 
-def test_observations_carry_the_messages_handed_to_step(make_world):
-    """The batch runner's inbox goes out in the observations the world builds: the same objects
-    as the message-less ones with the messages put in, and asking again gives them again."""
-    from swarm_sim.types import PheromoneMessage
-
+def test_observations_carry_no_messages_and_the_batch_runner_adds_its_inbox(make_world):
+    """The world sends and carries no messages; the batch runner hands every behaviour the
+    tick's inbox in a copy of its observation (`with_messages`): the same observation with the
+    very same inbox tuple put in, as ``dataclasses.replace`` would give."""
     inbox = (PheromoneMessage(0, 1.0, 2.0), PheromoneMessage(0, -1.0, 0.5))
-    a, b = make_world(scenario(3)), make_world(scenario(3))
-    a.reset(), b.reset()
-    plain = a.step({}, ())
-    carrying = b.step({}, inbox)
-    assert list(carrying) == list(plain)
-    for r, o in carrying.items():
-        assert o.messages is inbox
-        assert o == dataclasses.replace(plain[r], messages=inbox)
-    assert b.observe(inbox) == carrying and b.observe(tuple(inbox)) == carrying
-    assert b.observe() == plain and all(o.messages == () for o in b.observe().values())
-    assert a.observe(inbox) == carrying  # cached without messages, asked with them
-    later = b.step({})
-    assert all(o.messages == () for o in later.values())
+    w = make_world(scenario(3))
+    w.reset()
+    plain = w.step({})
+    assert all(o.messages == () for o in plain.values()) and w.observe() == plain
+    for o in plain.values():
+        carrying = with_messages(o, inbox)
+        assert carrying.messages is inbox and carrying == dataclasses.replace(o, messages=inbox)
+        assert o.messages == ()  # the world's own observation is left as it was
+
 
 def test_a_robot_drives_forward_at_the_commanded_speed(make_world):
     w = make_world(scenario(1))

@@ -8,11 +8,22 @@
 Both diagnostic_msgs/msg/DiagnosticArray (`swarm_msgs_py.records`): ``ros2 topic echo
 /nest/state`` shows ``food`` (F(t) [tokens]), ``waiting`` (N_W), ``recent_oaes`` (M_T2) and
 ``total_oaes`` of every tick.
+
+The run trace's nest series are read off the states the nest sends (`OUTPUTS`), a point per
+tick: ``nest_food`` F(t) [tokens], ``nest_waiting`` N_W and ``nest_oaes`` the OAEs heard so far.
 """
 
 from swarm_controllers.drtm.protocol import NestReport, NestState
 from swarm_msgs_py import topics
 from swarm_msgs_py.records import RecordFamily
+from swarm_msgs_py.server_outputs import ServerOutputs, Series
 
 NEST = RecordFamily("nest", {NestReport: topics.NEST_REPORTS, NestState: topics.NEST_STATE},
                     latched=(topics.NEST_STATE,))
+
+
+def _nest_series(state: NestState) -> dict[str, float]:
+    return {"nest_food": state.food, "nest_waiting": state.waiting, "nest_oaes": state.total_oaes}
+
+
+OUTPUTS = ServerOutputs(series=(Series(topics.NEST_STATE, _nest_series),))

@@ -1,9 +1,9 @@
 """The DRTM paper's performance measures (Sec. 2.4) as JSON result fields.
 
 Pure functions of a `RunTrace`: the nest's series (``nest_food``, ``nest_waiting``,
-``nest_oaes``; from `swarm_controllers.drtm.nest.NestServer.series` in batch, from the recorded
-``/nest/state`` in a bag), the world's deliveries and the robots' OAE counters, so a batch run
-and the bag of a graph run give the same numbers.
+``nest_oaes``; read off the states the nest sends, `swarm_controllers.drtm.codec.OUTPUTS`: live
+in batch, from the recorded ``/nest/state`` in a bag), the world's deliveries and the robots'
+OAE counters, so a batch run and the bag of a graph run give the same numbers.
 """
 
 from __future__ import annotations

@@ -14,7 +14,8 @@ Each tick (stamp t_k) the server applies the reports stamped before t_k, in orde
 the tick just ended [t_{k-1}, t_k): `step_energy` per robot in S_S or S_R, C_rate dt / 60 tokens
 for the nest. A robot that reported LEFT at t_{k-1} is charged for that tick; one that reported
 DEPOSITED at t_{k-1} is not (it was waiting when the tick began). Then it answers every robot
-with `NestState` (F(t_k), N_W, M_T2, total OAEs); robots see it at t_{k+1}.
+with `NestState` (F(t_k), N_W, M_T2, total OAEs); robots see it at t_{k+1}. The run trace's
+nest series are read off these states (`swarm_controllers.drtm.codec.OUTPUTS`).
 """
 
 from __future__ import annotations
@@ -89,8 +90,6 @@ class NestServer:
         """Reports that could not be applied, by reason."""
         self.lost: set[str] = set()
         """Robots the world declared dead."""
-        self.history: list[NestState] = []
-        """Every state sent, in order."""
 
     def robot_lost(self, robot: str, stamp_ns: int) -> None:
         """`robot` was declared dead: it no longer forages, its later reports are refused."""
@@ -109,7 +108,6 @@ class NestServer:
             recent.popleft()
         state = NestState(stamp_ns, self.ledger.food, len(self.robots) - len(self.active), len(recent),
                           self.ledger.avoidances)
-        self.history.append(state)
         return (state,)
 
     def _apply(self, m: NestReport, stamp_ns: int) -> None:
@@ -127,30 +125,3 @@ class NestServer:
         elif m.event is NestEvent.AVOIDED:
             self.ledger.avoid()
             self._recent.append(m.stamp_ns)
-
-    def series(self) -> dict[str, list[tuple[float, float]]]:
-        """The run trace's nest series (`state_series`)."""
-        return state_series(self.history)
-
-
-def state_series(states: Sequence[NestState]) -> dict[str, list[tuple[float, float]]]:
-    """(t [s], value) per state: ``nest_food`` F(t) [tokens], ``nest_waiting`` N_W and
-    ``nest_oaes`` the OAEs heard so far (the batch runner and bag replay build the same)."""
-    out: dict[str, list[tuple[float, float]]] = {"nest_food": [], "nest_waiting": [], "nest_oaes": []}
-    for s in states:
-        t = s.stamp_ns / NS_PER_S
-        out["nest_food"].append((t, s.food))
-        out["nest_waiting"].append((t, s.waiting))
-        out["nest_oaes"].append((t, s.total_oaes))
-    return out
-
-
-def replay_nest_state(topic: str, data: bytes) -> list[tuple[str, float, float]]:
-    """A recorded ``/nest/state`` message as points of the nest series; other topics add nothing."""
-    from swarm_controllers.drtm.codec import NEST
-    from swarm_msgs_py.topics import NEST_STATE
-
-    if topic != NEST_STATE:
-        return []
-    return [(name, t, v) for s in NEST.decode(data) if isinstance(s, NestState)
-            for name, points in state_series([s]).items() for t, v in points]

@@ -13,9 +13,8 @@ register_task(TaskSpec(
 _SECTIONS = (("nest", "swarm_controllers.drtm.config:NestConfig"),
              ("threshold", "swarm_controllers.drtm.config:ThresholdConfig"))
 _SERVER = ServerSpec(
-    channel="nest", core="swarm_controllers.drtm.nest:NestServer", node="swarm_controllers.drtm.nest_node",
-    script="swarm-nest", family="swarm_controllers.drtm.codec:NEST",
-    replay="swarm_controllers.drtm.nest:replay_nest_state",
+    channel="nest", core="swarm_controllers.drtm.nest:NestServer", family="swarm_controllers.drtm.codec:NEST",
+    outputs="swarm_controllers.drtm.codec:OUTPUTS",
 )
 _METRICS = tuple(
     Metric(name, f"swarm_controllers.drtm.metrics:{name}", None)

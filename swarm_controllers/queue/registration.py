@@ -19,9 +19,8 @@ register(Algorithm(
     config=(CPFA_SECTION, ("queue", "depot_manager.config:QueueConfig")),
     checks=("depot_manager.geometry:check_queue",),
     servers=(ServerSpec(
-        channel="depot", core="depot_manager.server:DepotServer", node="depot_manager.node",
-        script="swarm-depot-manager", family="depot_manager.codec:DEPOT",
-        replay="swarm_msgs_py.server_state:replay_depot_state",
+        channel="depot", core="depot_manager.server:DepotServer", family="depot_manager.codec:DEPOT",
+        outputs="depot_manager.codec:OUTPUTS", name="depot_manager",
     ),),
     peers=(PHEROMONES, "depot_manager.codec:RADIO"),
     deliveries=("docks",),

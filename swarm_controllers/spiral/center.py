@@ -1,8 +1,9 @@
 """Region assignment of the MDBSA center (Lu & Luna, CRV 2023, Sec. IV; ../shared/papers/mdbsa_spiral_search.md).
 
-ROS-free core of the center node (`center_node.py`): `RegionAssigner` (the book-keeping below),
-`CenterServer` (the assigner behind the `swarm_sim.protocol` messages, end of file) and
-`region_paths` (the regions' spirals, shared with the MDBSA behaviours). The center is a hub
+ROS-free core of the center (its node is the generic server node, `swarm_sim.nodes.server_node`):
+`RegionAssigner` (the book-keeping below), `CenterServer` (the assigner behind the
+`swarm_sim.protocol` messages, with the ``/center/state`` it publishes, end of file), `draw` (its
+regions and planned spirals) and `region_paths` (the regions' spirals, shared with the MDBSA behaviours). The center is a hub
 robots talk to only while they are at it: there a robot reports how far it walked
 (`report_progress`) and, when its walk is over (or at the start), asks for a new one (`request`). Deterministic: no rng, every tie goes to the lowest
 region id; `t` [s, sim time] is only recorded, never used to decide.
@@ -58,7 +59,9 @@ import numpy as np
 
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
+from swarm_msgs_py.server_state import RegionView
 from swarm_sim.inbound import Reason, Rejections
+from swarm_sim.protocol import Drawing, Lines
 from swarm_controllers.spiral.geometry import (
     SpiralPath,
     mdbsa_leg_steps,
@@ -432,18 +435,20 @@ class CenterServer:
         self.rejections = Rejections()
         """Reports dropped: sent out of range, from an unknown or dead robot, about an unknown region."""
         self.lost: set[RobotId] = set()
+        self.regions, self.arena_size = scenario.regions.count, scenario.arena.size
 
     def snapshot(self) -> list[RegionState]:
         """Per-region state (walkers, covered arc lengths, remaining) for publishing."""
         return self.assigner.snapshot()
 
+    def state(self) -> dict[str, tuple[RegionView, ...]]:
+        """``regions``: every region's walkers and progress, as ``/center/state`` carries them."""
+        return {"regions": tuple(RegionView(s.region, s.length, s.remaining, s.finished, s.walkers, s.covered)
+                                 for s in self.assigner.snapshot())}
+
     def in_range(self, x: float, y: float) -> bool:
         """Whether a robot at (x, y) [m, world frame] can talk to the center."""
         return math.hypot(x - self._center[0], y - self._center[1]) <= self._range
-
-    def series(self) -> dict[str, list]:
-        """No time series for the run trace (the center's state is recorded on /center/state)."""
-        return {}
 
     def robot_lost(self, robot: RobotId, stamp_ns: int) -> None:
         """`robot` was declared dead: free its region's walker slot, refuse its later reports."""
@@ -494,6 +499,21 @@ class CenterServer:
         return RegionAssignment(stamp_ns=stamp_ns, robot=robot, region=a.region,
                                 direction=a.direction, s0=float(a.s0), stop_s=float(a.stop_s),
                                 shared=a.shared)
+
+
+_REGION = (0.6, 0.6, 0.6, 1.0)
+_PATH = (0.2, 0.6, 1.0, 0.8)
+
+
+def draw(server: CenterServer, stamp_ns: int) -> Drawing:
+    """The regions' squares and their planned spirals (static: drawn once)."""
+    half = region_side(server.regions, server.arena_size) / 2
+    squares = [
+        [(x - half, y - half), (x + half, y - half), (x + half, y + half), (x - half, y + half), (x - half, y - half)]
+        for x, y in region_centers(server.regions, server.arena_size)
+    ]
+    return (Lines("regions", squares, _REGION, 0.02),
+            Lines("planned_paths", [p.waypoints for p in server.paths], _PATH, 0.01))
 
 
 def planned_paths(scenario: Scenario) -> list[np.ndarray]:

@@ -6,10 +6,23 @@
 | RegionAssignment | /center/assignments | center -> robots |
 
 Both diagnostic_msgs/msg/DiagnosticArray (`swarm_msgs_py.records`), reliable, deep, volatile.
+
+Besides its messages the center publishes (`OUTPUTS`) the regions' walkers and progress on
+``/center/state`` whenever they change, and the regions and their planned spirals on
+``/center/markers`` once (both reliable + transient-local).
 """
 
+from swarm_controllers.spiral.center import draw
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_msgs_py import topics
+from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
+from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState
+from swarm_msgs_py.server_state import decode_center_state, encode_center_state
 
 CENTER = RecordFamily("center", {ProgressReport: topics.CENTER_REPORTS, RegionAssignment: topics.CENTER_ASSIGNMENTS})
+
+OUTPUTS = ServerOutputs(
+    state=(ServerState(topics.CENTER_STATE, TYPE_NAME, "regions", encode_center_state, decode_center_state),),
+    markers=ServerMarkers(topics.CENTER_MARKERS, draw),
+)

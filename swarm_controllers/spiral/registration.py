@@ -15,8 +15,7 @@ _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
 _REGIONS = ("regions", "swarm_controllers.spiral.regions:RegionConfig")
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.spiral.center:CenterServer",
-    node="swarm_controllers.spiral.center_node", script="swarm-center",
-    family="swarm_controllers.spiral.codec:CENTER",
+    family="swarm_controllers.spiral.codec:CENTER", outputs="swarm_controllers.spiral.codec:OUTPUTS",
 )
 
 register_delivery(DeliveryKind(

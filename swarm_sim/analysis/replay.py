@@ -15,6 +15,7 @@ import numpy as np
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
 from swarm_sim.messaging import delivery_order
@@ -43,7 +44,8 @@ def load_run(path: Path | str) -> RunTrace:
     )
     trace.server_stale = _server_stale(path, str(meta.get("server_stale_ticks", "{}")))
     algorithm = registry.of(scenario)
-    replayers = [registry.resolve(s.replay) for s in algorithm.servers if s.replay]
+    servers = SeriesLog(algorithm.servers, trace.series)  # the servers' series, as the batch runner reads them
+    server_topics = servers.topics
     spec = registry.task(algorithm.task).state
     state = {st.topic: st for st in (registry.resolve(spec) if spec else ())}
     peers = {}  # topic -> message family, for algorithms whose metrics read the protocol
@@ -85,10 +87,8 @@ def load_run(path: Path | str) -> RunTrace:
                 trace.series.setdefault(st.field, []).append((stamp / NS_PER_S, value))
             elif m.topic in peers:
                 trace.messages.extend(peers[m.topic].decode(m.data))
-            elif replayers and not m.topic.startswith("/robot_"):
-                for replay in replayers:  # the servers' recorded state (a few messages per tick)
-                    for name, t, value in replay(m.topic, m.data):
-                        trace.series.setdefault(name, []).append((t, value))
+            elif m.topic in server_topics:
+                servers.replay(m.topic, m.data)
         except ValueError as exc:  # a malformed message on the bus was recorded as sent
             trace.malformed[m.topic] = trace.malformed.get(m.topic, 0) + 1
             if trace.malformed[m.topic] == 1:

@@ -1,11 +1,17 @@
-"""Base of the center and depot-manager nodes: a `swarm_sim.protocol.Server` core on the graph.
+"""The server node: any registered server (`swarm_sim.registry.ServerSpec`) on the graph.
 
-On each ``/clock`` tick k the node hands the core the messages stamped before k (from its
-inbound topic), publishes the core's answers stamped k (one DiagnosticArray per topic), lets
-the subclass publish state and markers, and acknowledges tick k on ``/lockstep/ack`` so the
-world's lockstep barrier knows the answers are out. A repeated tick (the world re-sends
-``/clock`` when an ack is late) is only acknowledged again. This is exactly what the batch
-runner does in process, so graph and batch runs agree.
+``swarm-server --channel depot --scenario queue_qmt ...`` runs the server the scenario's
+algorithm registers on that channel, built from its registry record alone: its core, its message
+family (`swarm_sim.nodes.endpoint.Endpoint`) and its declared outputs
+(`swarm_msgs_py.server_outputs.ServerOutputs`: state topics and markers, reliable +
+transient-local). The node is named as the record says (``depot_manager``, ``center``, ...).
+
+On each ``/clock`` tick k the node hands the core the messages stamped before k, publishes the
+core's answers stamped k (one DiagnosticArray per topic), then the core's state values that
+changed and, when due, its markers, and acknowledges tick k on ``/lockstep/ack`` so the world's
+lockstep barrier knows the answers are out. A repeated tick (the world re-sends ``/clock`` when
+an ack is late) is only acknowledged again. This is exactly what the batch runner does in
+process, so graph and batch runs agree.
 
 Inbound messages are untrusted (`swarm_sim.inbound`); what is dropped, here or by the core, is
 counted on ``/diagnostics``. The node also hears the world's ``node_down`` events and, at the
@@ -21,111 +27,98 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from collections import defaultdict
-from dataclasses import dataclass
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, diagnostics, topics
+from swarm_msgs_py import ack, diagnostics, markers, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED, family_qos
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.server_outputs import MARKER_ARRAY, StateWatch, outputs_of
 from swarm_sim import registry
-from swarm_sim.inbound import Inbound, Reason, Rejections, merged, total
-from swarm_sim.messaging import Mailbox
-from swarm_sim.protocol import Server
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
-from swarm_sim.types import NodeDownEvent
+from swarm_sim.inbound import Reason
+from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
+from swarm_sim.protocol import Drawing, Lines, Server
+from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.types import NS_PER_S, NodeDownEvent
+
+ServerNodeConfig = EndpointConfig
+"""A server node's parameters: scenario, overrides, seed and how long it waits for the robots."""
 
 
-@dataclass(frozen=True)
-class ServerNodeConfig:
-    scenario: str = DEFAULT_SCENARIO
-    """Scenario name or YAML path (the same one the world loads)."""
-    overrides: tuple[str, ...] = ()
-    seed: int = 0
-    startup_timeout: float = 60.0
-    """Wall seconds to wait for the robots' publishers and subscribers before going on."""
+def encode_drawing(drawing: Drawing, stamp_ns: int) -> bytes:
+    """A server's drawing as a MarkerArray, every marker stamped `stamp_ns`."""
+    out = []
+    for d in drawing:
+        if isinstance(d, Lines):
+            out += markers.line_markers(d.ns, d.lines, d.color, d.width, stamp_ns)
+        else:
+            out += markers.point_markers(d.ns, d.id, d.points, d.color, d.size, stamp_ns, cubes=d.cubes)
+    return markers.serialize_markers(out)
 
 
 class ServerNode(Node):
-    """A registered server (`swarm_sim.registry.ServerSpec`) on the graph; subclasses name
-    their `CHANNEL` and may publish state and markers."""
+    """The server of `channel` (see the module docstring)."""
 
-    CHANNEL = ""
-    """The server's channel, as its registry record names it."""
-
-    def __init__(self, name: str, config: ServerNodeConfig | None = None, **kwargs) -> None:
-        super().__init__(
-            name, parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs,
-        )
+    def __init__(self, channel: str, config: ServerNodeConfig | None = None, **kwargs) -> None:
+        self.spec = spec = registry.server(channel)
+        super().__init__(spec.node_name, parameter_overrides=[Parameter("use_sim_time", value=True)], **kwargs)
         self.config = cfg = declare_config(self, ServerNodeConfig, config)
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
-        specs = [s for s in registry.of(self.scenario).servers if s.channel == self.CHANNEL]
-        if not specs:
-            raise ValueError(f"{self.scenario.controller.behaviour} registers no {self.CHANNEL!r} server")
-        self.server: Server = registry.resolve(specs[0].core)(self.scenario)
-        self.mailbox = Mailbox()
-        self.rejections = Rejections()
-        self.inbound = Inbound(self.scenario.robot_names, self.scenario.dt_ns, self.rejections,
-                               self.get_logger().warning)
-        self._published_rejections = 0
-        """Messages dropped so far, as last published on ``/diagnostics``."""
+        if spec not in registry.of(self.scenario).servers:
+            raise ValueError(f"{self.scenario.controller.behaviour} registers no {channel!r} server")
+        self.server: Server = registry.resolve(spec.core)(self.scenario)
+        self.endpoint = Endpoint(self, self.scenario, *registry.server_topics(spec))
         self.lost: list[str] = []
         """Robots the world declared dead, not yet told to the core."""
         self._done = -1
-        inbound, outbound = registry.server_topics(specs[0])
-        self._inbound = [
-            self.create_subscription(
-                topics.import_type(f.type_name), t,
-                lambda data, t=t, f=f: self.inbound.post_all(t, f, data, self.mailbox.post), EVENTS, raw=True,
-            )
-            for t, f in inbound.items()
-        ]
-        self._outbound = {t: (f, self.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
-                          for t, f in outbound.items()}
-        self._topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,
                                  SENSOR_LOCKSTEP, raw=True)
         self.create_subscription(topics.type_of(topics.WORLD_EVENTS), topics.WORLD_EVENTS, self._on_world_events,
                                  EVENTS, raw=True)
-        self._diagnostics_pub = self.create_publisher(
-            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
         self._ack_pub = None
-
-    def publish_state(self, stamp_ns: int) -> None:
-        """Subclasses publish the core's state and markers after each tick."""
+        outputs = outputs_of(spec)
+        self._state = StateWatch(outputs.state)
+        self._state_pubs = {st.topic: self.create_publisher(topics.import_type(st.type_name), st.topic, STATE_LATCHED)
+                            for st in outputs.state}
+        self._markers = outputs.markers
+        self._markers_pub = None
+        self._markers_at = -1
+        """When the markers were last drawn [ns] (-1: never)."""
+        if self._markers is not None:
+            self._markers_pub = self.create_publisher(topics.import_type(MARKER_ARRAY), self._markers.topic,
+                                                      STATE_LATCHED)
+            if self._markers.period is None:  # a static drawing, once
+                self._draw(0)
 
     def wait_for_robots(self, executor) -> None:
         """Spin until every robot's publisher and subscribers are matched, then announce
         readiness by creating the ack publisher."""
         robots = self.scenario.robots.count
         deadline = time.monotonic() + self.config.startup_timeout
-        while time.monotonic() < deadline and (
-            any(sub.get_publisher_count() < robots for sub in self._inbound)
-            or any(pub.get_subscription_count() < robots for _, pub in self._outbound.values())
-        ):
+        while time.monotonic() < deadline and self.endpoint.unmatched(robots):
             executor.spin_once(timeout_sec=0.1)
         self._ack_pub = self.create_publisher(
             topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP
         )
 
     def _on_world_events(self, data: bytes) -> None:
+        inbound = self.endpoint.inbound
         try:
             _, events = diagnostics.decode_events(data)
         except ValueError as exc:
-            self.inbound.reject(topics.WORLD_EVENTS, Reason.MALFORMED, str(exc)[:200])
+            inbound.reject(topics.WORLD_EVENTS, Reason.MALFORMED, str(exc)[:200])
             return
         for e in events:
             if isinstance(e, NodeDownEvent) and e.kind == "robot":
-                if e.node in self.inbound.robots:
+                if e.node in inbound.robots:
                     self.lost.append(e.node)
                 else:
-                    self.inbound.reject(topics.WORLD_EVENTS, Reason.UNKNOWN_ROBOT, f"node_down for {e.node[:40]!r}")
+                    inbound.reject(topics.WORLD_EVENTS, Reason.UNKNOWN_ROBOT, f"node_down for {e.node[:40]!r}")
 
     def _on_clock(self, data: bytes) -> None:
         if self._ack_pub is None:
@@ -133,50 +126,53 @@ class ServerNode(Node):
         try:
             stamp = clock_codec.decode_clock(data)
         except ValueError as exc:
-            self.inbound.reject(topics.CLOCK, Reason.MALFORMED, str(exc)[:200])
+            self.endpoint.inbound.reject(topics.CLOCK, Reason.MALFORMED, str(exc)[:200])
             return
         if stamp > self._done:
-            self.inbound.now_ns = self.inbound.released_ns = stamp
+            messages = self.endpoint.take(stamp)
             for robot in self.lost:
                 if hasattr(self.server, "robot_lost"):
                     self.server.robot_lost(robot, stamp)
                 self.get_logger().warning(f"{robot} was declared dead: freed what it held")
             self.lost = []
-            out = self.server.step(stamp, self.mailbox.take_before(stamp))
-            by_topic: dict[str, list] = defaultdict(list)
-            for m in out:
-                by_topic[self._topic_of[type(m)]].append(m)
-            for topic, messages in by_topic.items():
-                family, pub = self._outbound[topic]
-                for data in family.encode(stamp, messages):
-                    pub.publish(data)
-            self.publish_state(stamp)
-            core = getattr(self.server, "rejections", None)
-            if (dropped := total(self.rejections, core)) != self._published_rejections:
-                self._published_rejections = dropped
-                self._diagnostics_pub.publish(diagnostics.encode_rejections(
-                    stamp, self.get_fully_qualified_name(), merged(self.rejections, core)))
+            self.endpoint.send(stamp, self.server.step(stamp, messages))
+            self._publish_state(stamp)
+            self.endpoint.report.publish(stamp, self.server)
             self._done = stamp
         if stamp == self._done:
-            self._ack_pub.publish(ack.encode_ack(self.CHANNEL, stamp))
+            self._ack_pub.publish(ack.encode_ack(self.spec.channel, stamp))
+
+    def _publish_state(self, stamp_ns: int) -> None:
+        """The state values that changed, then the markers if they are due."""
+        if not self._state_pubs:
+            return
+        changed = self._state.changed(self.server.state())
+        for st, value in changed:
+            self._state_pubs[st.topic].publish(st.encode(stamp_ns, value))
+        period = self._markers.period if self._markers is not None else None
+        if changed and period is not None and (self._markers_at < 0 or stamp_ns - self._markers_at >= period * NS_PER_S):
+            self._draw(stamp_ns)
+
+    def _draw(self, stamp_ns: int) -> None:
+        self._markers_at = stamp_ns
+        self._markers_pub.publish(encode_drawing(self._markers.draw(self.server, stamp_ns), stamp_ns))
 
 
-def parse_args(prog: str, argv: list[str]) -> tuple[ServerNodeConfig, list[str]]:
-    parser = argparse.ArgumentParser(prog=prog)
-    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
-    parser.add_argument("--seed", type=int, default=0)
+def parse_args(argv: list[str]) -> tuple[str, ServerNodeConfig, list[str]]:
+    parser = argparse.ArgumentParser(prog="swarm-server", description=__doc__.splitlines()[0])
+    parser.add_argument("--channel", required=True, help="the server's channel, e.g. depot, center, nest")
+    add_endpoint_arguments(parser)
     args, ros_args = parser.parse_known_args(argv)
-    return ServerNodeConfig(args.scenario, tuple(args.overrides), args.seed), ros_args
+    return args.channel, endpoint_config(args), ros_args
 
 
-def run_server(node_class: type[ServerNode], prog: str, argv: list[str] | None = None) -> int:
-    """A server node's `main`: one node in its own process, spun until shut down."""
-    config, ros_args = parse_args(prog, sys.argv[1:] if argv is None else argv)
-    rclpy.init(args=[prog, *ros_args])
+def main(argv: list[str] | None = None) -> int:
+    """One server node in its own process, spun until shut down."""
+    channel, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    rclpy.init(args=["swarm-server", *ros_args])
     node = None
     try:
-        node = node_class(config)
+        node = ServerNode(channel, config)
         executor = make_executor()
         executor.add_node(node)
         node.wait_for_robots(executor)
@@ -189,3 +185,7 @@ def run_server(node_class: type[ServerNode], prog: str, argv: list[str] | None =
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

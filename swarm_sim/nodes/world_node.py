@@ -1,18 +1,21 @@
 """The world node: puts the `World` core on the ROS graph, owns sim time, records the run.
 
-Lockstep (default): for each tick k it publishes ``/clock`` and every robot's observations
-stamped k, waits until every live controller has answered with a ``cmd_vel`` stamped k and
-every server the scenario needs (center, depot manager) with a ``/lockstep/ack`` stamped k (a
-controller silent for `tick_timeout` wall seconds is counted stale and keeps its last command),
-then steps the core. A node stale `dead_after` ticks in a row is declared dead for good
+Every tick k it publishes ``/clock``, every robot's observations stamped k (odometry, scan and
+the world task's sense topics) and the task's state topics, then waits for the robots' commands
+and the servers' acks (`swarm_sim.nodes.world_loop`: lockstep by default, or free-running) and
+steps the core. A node stale `dead_after` ticks in a row is declared dead for good
 (`swarm_sim.nodes.lockstep`), with a ``node_down`` event on ``/world/events``: a dead robot
 stands still to the end and the servers free what it held; a dead server ends the run there
-(the bag says ``ended: server <channel> died``). Free-running (`realtime`): steps every dt / real_time_factor wall
-seconds with whatever commands have arrived.
+(the bag says ``ended: server <channel> died``).
 
-Observations (and the world task's state topics, e.g. the caging object's pose) are encoded
-straight to CDR bytes, published raw and written to the bag as the same bytes. Topics published by other nodes are discovered and recorded too (like
-``ros2 bag record -a``), stamped with the sim time at which they arrive.
+Its parts, each in its own module: the loop (`world_loop`), the recorder hooks
+(`world_recording`: the world's own bytes and every other node's topics go into the bag), the
+relay of what robots send each other (`peer_relay`) and what it shows besides the observations
+(`world_outputs`: events, stats, markers, diagnostics, live view). This module holds the node
+itself: its observation publishers, its intake of commands and acks, and its command line.
+
+Observations (and the task's state topics, e.g. the caging object's pose) are encoded straight
+to CDR bytes, published raw and written to the bag as the same bytes.
 """
 
 from __future__ import annotations
@@ -23,7 +26,6 @@ import signal
 import sys
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException
@@ -32,32 +34,22 @@ from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py import diagnostics, markers, odometry, scan, topics, twist
+from swarm_msgs_py import odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import number
 from swarm_sim.inbound import Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
-from swarm_sim.nodes.recorder import Recorder
-from swarm_sim.scenario import (
-    DEFAULT_SCENARIO,
-    Scenario,
-    load_scenario,
-    scenario_to_dict,
-)
+from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
+from swarm_sim.nodes.world_outputs import WorldOutputs
+from swarm_sim.nodes.world_recording import WorldRecording
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
 from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
-
-
-_IMPORTED = time.monotonic()
-"""When this module's imports were done (start-up lines count from here)."""
-
-
-class Interrupted(Exception):
-    """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
 
 @dataclass(frozen=True)
@@ -105,12 +97,16 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recorder = self._open_recorder(cfg.bag) if cfg.bag or cfg.foxglove_port >= 0 else None
+        self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns)
+        self.recorder = self.recording.recorder
+        """The bag (and live view) writer; None when the run records nothing."""
+        self.rejections = Rejections()
+        """Commands, acks and robots' messages dropped: malformed, for another tick, from a dead
+        or unknown node."""
 
-        self._clock_pub = self._publisher(topics.CLOCK, SENSOR_LOCKSTEP)
-        self._events_pub = self._publisher(topics.WORLD_EVENTS, EVENTS)
-        self._stats_pub = self._publisher(topics.WORLD_ROBOT_STATS, STATE_LATCHED)
-        self._markers_pub = self._publisher(topics.WORLD_MARKERS, STATE_LATCHED)
+        self._clock_pub = self.recording.publisher(topics.CLOCK, SENSOR_LOCKSTEP)
+        self.outputs = WorldOutputs(self, self.recording, self.scenario, self.rejections,
+                                    stats_period=cfg.stats_period, markers_period=cfg.markers_period)
         algorithm = registry.of(self.scenario)
         self.sensing: Sensing = registry.resolve(registry.task(algorithm.task).sensing)
         """The task's sense topics, published next to odometry and scan."""
@@ -120,10 +116,11 @@ class WorldNode(Node):
         state = registry.task(algorithm.task).state
         self.state_topics = registry.resolve(state) if state else ()
         """The task's world-level state topics (`swarm_msgs_py.sensing.StateTopic`), every tick."""
-        self._state_pubs = [self._publisher(st.topic, SENSOR_LOCKSTEP, st.type_name) for st in self.state_topics]
+        self._state_pubs = [self.recording.publisher(st.topic, SENSOR_LOCKSTEP, st.type_name)
+                            for st in self.state_topics]
         self._obs_pubs = {
             r: {
-                name: self._publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP, type_name)
+                name: self.recording.publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP, type_name)
                 for name, type_name in obs_types.items()
             }
             for r in self.robots
@@ -135,13 +132,6 @@ class WorldNode(Node):
         """Server channels (center, depot) the barrier waits for besides the robots."""
         self.server_stale_ticks = dict.fromkeys(self.servers, 0)
         """Lockstep ticks each server (by channel) did not acknowledge in time."""
-        self.rejections = Rejections()
-        """Commands and acks dropped: malformed, for another tick, from a dead or unknown node."""
-        self._published_rejections: dict = {}
-        # Latched and not recorded by the world itself: every node publishes its counts here and
-        # the recorder records them all (its own included) through one subscription.
-        self._diagnostics_pub = self.create_publisher(
-            topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
         self.barrier = LockstepBarrier((*self.robots, *self.servers), cfg.dead_after)
         self.down: list[NodeDownEvent] = []
         """Nodes declared dead, in order."""
@@ -151,66 +141,29 @@ class WorldNode(Node):
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
-            self._record_topic(topic, topics.type_string(topic))
+            self.recording.add(topic, topics.type_string(topic))
             self._cmd_subs[robot] = self.create_subscription(
                 topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
         if self.servers:
-            self._record_topic(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK))
+            self.recording.add(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK))
             self._ack_sub = self.create_subscription(
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
         self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
-        self._relays = {}
-        """Peer topic -> publisher on ``heard(topic)``: the world relays what robots send each
-        other, like a radio medium (`_on_peer`)."""
-        self._relayed: list[tuple[str, bytes]] = []
-        for topic, family in registry.peer_topics(algorithm).items():
-            msg_type = topics.import_type(family.type_name)
-            self._record_topic(topic, family.type_name)
-            if self.recorder is not None:
-                self.recorder.skipped.add(topics.heard(topic))  # the relay's copies: recorded once, as sent
-            self._relays[topic] = self.create_publisher(msg_type, topics.heard(topic), EVENTS)
-            self.create_subscription(msg_type, topic, lambda data, t=topic, f=family: self._on_peer(t, f, data),
-                                     EVENTS, raw=True)
-        self._next_discovery = 0.0
+        self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
+        self.loop = WorldLoop(self)
 
-    # ------------------------------------------------------------------ plumbing
+    stop_requested = False
+    """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
 
-    def _publisher(self, topic: str, qos, type_name: str | None = None):
-        type_name = type_name or topics.type_string(topic)
-        self._record_topic(topic, type_name, latched=qos is STATE_LATCHED)
-        return self.create_publisher(topics.import_type(type_name), topic, qos)
+    def run(self, executor: Executor) -> None:
+        """The whole run (`swarm_sim.nodes.world_loop`)."""
+        self.loop.run(executor)
 
-    def _record_topic(self, topic: str, type_name: str, latched: bool = False) -> None:
-        if self.recorder is not None:
-            self.recorder.add(topic, type_name, latched)
-
-    def _record(self, topic: str, data: bytes) -> None:
-        if self.recorder is not None:
-            self.recorder.write(topic, data)
-
-    def _open_recorder(self, path: str) -> Recorder:
-        meta = {
-            "scenario_name": self.scenario.name,
-            "scenario": json.dumps(scenario_to_dict(self.scenario)),
-            "seed": str(self.config.seed),
-            "mode": self.config.mode,
-            "robots": str(len(self.world.robots)),
-        }
-        live = None
-        if self.config.foxglove_port >= 0:
-            from swarm_sim.nodes.live_view import LiveView
-
-            live = LiveView(self.config.foxglove_port, self.config.foxglove_host)
-        return Recorder(self, Path(path) if path else None, meta, lambda: self.world.t_ns, live)
-
-    def _publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
-        if send:
-            pub.publish(data)
-        self._record(topic, data)
+    # ------------------------------------------------------------------ intake
 
     @property
     def rejected_commands(self) -> int:
@@ -219,7 +172,7 @@ class WorldNode(Node):
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
         topic = topics.robot_topic(robot, topics.CMD_VEL)
-        self._record(topic, data)
+        self.recording.write(topic, data)
         try:
             stamp_ns, linear, angular = twist.decode_twist(data)
         except ValueError as exc:
@@ -242,7 +195,7 @@ class WorldNode(Node):
         self.barrier.answered(robot, stamp_ns)
 
     def _on_ack(self, data: bytes) -> None:
-        self._record(topics.LOCKSTEP_ACK, data)
+        self.recording.write(topics.LOCKSTEP_ACK, data)
         try:
             channel, stamp_ns = ack_codec.decode_ack(data)
         except ValueError as exc:
@@ -257,157 +210,12 @@ class WorldNode(Node):
         else:
             self.barrier.answered(channel, stamp_ns)
 
-    def _on_peer(self, topic: str, family, data: bytes) -> None:
-        """A robot's message to the others: recorded, checked (`swarm_sim.inbound`) and relayed
-        on ``heard(topic)`` just before the next tick's observations. Lockstep order makes this
-        exact: a robot publishes its messages of tick k before its command k, so they are here
-        before the barrier lets tick k+1 out, and they leave before its observations, from the
-        same sender, in order."""
-        self._record(topic, data)
-        try:
-            messages = family.decode(data)
-        except ValueError as exc:
-            self.inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
-            return
-        if all([self.inbound.admit(topic, m) for m in messages]):  # a list: every bad one is counted
-            self._relayed.append((topic, data))
+    def commands(self) -> dict[RobotId, Command]:
+        """The last command of every robot that has sent one, in robot order."""
+        return {r: self._commands[r] for r in self.robots if r in self._commands}
 
-    def _discover(self) -> None:
-        """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
-        if self.recorder is not None:
-            self.recorder.discover(self._warn_unknown_commands)
-
-    def _warn_unknown_commands(self, topic: str) -> None:
-        if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
-            self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
-
-    # ------------------------------------------------------------------ the loop
-
-    def _publish_tick(self, obs: dict[RobotId, Observation], *, send: bool = True) -> None:
-        """Tick k's clock and observations; `send=False` records them without asking the
-        controllers for another answer (the state at the end of the run)."""
-        t_ns = self.world.t_ns
-        self.inbound.now_ns = self.inbound.released_ns = t_ns
-        if send:  # what robots sent each other at the last tick, before this tick's observations
-            for topic, data in self._relayed:
-                self._relays[topic].publish(data)
-        self._relayed = []
-        self._publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK, send=send)
-        sc = self.scenario.sensors.scan
-        # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
-        # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
-        poses = self.world.odometry_poses()
-        for r, o in obs.items():
-            pubs = self._obs_pubs[r]
-            encoded = {
-                topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
-                topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
-                **self.sensing.encode_all(t_ns, o.sensed),
-            }
-            for name, data in encoded.items():
-                self._publish(pubs[name], data, topics.robot_topic(r, name), send=send)
-            self._sent[r] = encoded
-        if self.state_topics:
-            values = self.world.task.state()
-            for st, pub in zip(self.state_topics, self._state_pubs):
-                self._publish(pub, st.encode(t_ns, values[st.field]), st.topic, send=send)
-
-    def _publish_world_state(self, final: bool = False) -> None:
-        t_ns = self.world.t_ns
-        events = [*self._down_events, *self.world.drain_events()]
-        self._down_events = []
-        if events:
-            self._publish(self._events_pub, diagnostics.encode_events(t_ns, events), topics.WORLD_EVENTS)
-        stats_every = max(1, round(self.config.stats_period / self.scenario.sim.dt))
-        if final or self.world.tick % stats_every == 0:
-            self._publish(self._stats_pub, diagnostics.encode_robot_stats(t_ns, self.world.stats),
-                          topics.WORLD_ROBOT_STATS)
-        markers_every = max(1, round(self.config.markers_period / self.scenario.sim.dt))
-        if final or self.world.tick % markers_every == 0:
-            data = markers.encode_markers(
-                self.scenario, t_ns, self.world.task.placed(), self.world.true_poses()
-            )
-            self._publish(self._markers_pub, data, topics.WORLD_MARKERS)
-        counts = dict(sorted(self.rejections.counts.items()))
-        if counts != self._published_rejections:
-            self._published_rejections = counts
-            self._diagnostics_pub.publish(diagnostics.encode_rejections(t_ns, self.get_fully_qualified_name(), counts))
-
-    def _start_live_view(self) -> None:
-        """Serve Foxglove clients once the run's topics exist (`swarm_sim.nodes.live_view`)."""
-        live = self.recorder.live if self.recorder is not None else None
-        if live is not None:
-            self._discover()
-            live.start()
-            print(f"[world] live view: {live.url} (Foxglove: Open connection -> Foxglove WebSocket)", flush=True)
-
-    def wait_for_controllers(self, executor: Executor) -> None:
-        start = time.monotonic()
-        print(f"[world] up ({start - _IMPORTED:.1f} s after its imports to build the world and the topics of "
-              f"{len(self.robots)} robots); waiting for the controllers{' and servers' if self.servers else ''} to connect", flush=True)
-        deadline = start + self.config.startup_timeout
-        missing = list(self.robots)
-        said = start
-        while missing and time.monotonic() < deadline:
-            self._spin(executor, 0.1)
-            missing = [
-                r for r in self.robots
-                if self._cmd_subs[r].get_publisher_count() == 0
-                or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
-            ]
-            if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
-                missing.append("servers (" + ", ".join(self.servers) + ")")
-            if missing and time.monotonic() - said >= self.config.progress_period:
-                said = time.monotonic()
-                self.print_startup(missing, said - start)
-        print(f"[world] {len(self.robots) - len([m for m in missing if m in self._cmd_subs])}/{len(self.robots)} "
-              f"controllers connected after {time.monotonic() - start:.1f} s: starting", flush=True)
-        if missing:
-            self.get_logger().warning(
-                f"starting without {len(missing)} controller(s) that did not connect: {missing[:5]}"
-            )
-
-    stop_requested = False
-    """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
-
-    def _spin(self, executor: Executor, timeout: float) -> float:
-        """Spin once; returns the wall seconds the bag took (flush/split), which must not
-        count against the controllers' deadline. Raises Interrupted once a stop is requested."""
-        if self.stop_requested:
-            raise Interrupted
-        executor.spin_once(timeout_sec=timeout)
-        if self.recorder is None:
-            return 0.0
-        t0 = time.monotonic()
-        self.recorder.poll()
-        return time.monotonic() - t0
-
-    def _await_commands(self, executor: Executor) -> None:
-        """Lockstep barrier: spin until every live controller and server answered this tick."""
-        stamp = self.world.t_ns
-        waiting = self.barrier.live()
-        now = time.monotonic()
-        deadline, resend = now + self.config.tick_timeout, now + self.config.resend_period
-        while True:
-            waiting = self.barrier.waiting(stamp, waiting)
-            now = time.monotonic()
-            if not waiting:
-                break
-            if now >= deadline:  # take what has already arrived before calling anyone stale
-                for _ in range(4 * len(waiting)):
-                    executor.spin_once(timeout_sec=0.0)
-                break
-            if now >= resend:  # a sample lost (e.g. while discovery settles): ask again
-                resend = now + self.config.resend_period
-                for r in waiting:
-                    if r in self._sent:
-                        for name, data in self._sent[r].items():
-                            self._obs_pubs[r][name].publish(data)
-                    else:  # a server: it answers a repeated /clock with its ack
-                        self._clock_pub.publish(clock_codec.encode_clock(stamp))
-            bag_time = self._spin(executor, min(0.05, max(0.0, deadline - now)))
-            deadline += bag_time
-            resend += bag_time
+    def close_tick(self, stamp: int) -> None:
+        """Lockstep: tick `stamp` is over; count who was stale and declare who is dead."""
         stale, dead = self.barrier.close_tick(stamp)
         for r in stale:
             if r in self.world.stats:
@@ -428,75 +236,79 @@ class WorldNode(Node):
                                         "the run ends here")
                 self.ended = f"server {r} died"
 
-    def _await_wall(self, executor: Executor, until: float) -> None:
-        while (remaining := until - time.monotonic()) > 0:
-            self._spin(executor, min(0.05, remaining))
-        stamp = self.world.t_ns
-        for r in self.barrier.waiting(stamp, self.robots):
-            self.world.stats[r].stale_ticks += 1
+    # ------------------------------------------------------------------ discovery
 
-    def run(self, executor: Executor) -> None:
-        cfg, sim = self.config, self.scenario.sim
-        self._discover()
-        self.wait_for_controllers(executor)
-        self._start_live_view()
-        obs = self.world.reset()
-        wall0 = last_progress = time.monotonic()
-        self.wall_start = wall0
-        for k in range(self.scenario.ticks):
-            now = time.monotonic()
-            if now >= self._next_discovery:
-                self._discover()
-                self._next_discovery = now + 1.0
-            self._publish_tick(obs)
-            if cfg.mode == "lockstep":
-                self._await_commands(executor)
-            else:
-                self._await_wall(executor, wall0 + (k + 1) * sim.dt / cfg.real_time_factor)
-            obs = self.world.step({r: self._commands[r] for r in self.robots if r in self._commands})
-            self._publish_world_state()
-            if now - last_progress >= cfg.progress_period:
-                last_progress = now
-                self.print_progress(now - wall0)
-            if self.ended != "complete":
-                break
-        self._publish_tick(obs, send=False)
-        self._publish_world_state(final=True)
-        # Let the controllers' last status messages reach the recorder.
-        end = time.monotonic() + 0.5
-        while time.monotonic() < end:
-            self._spin(executor, 0.05)
+    def discover(self) -> None:
+        """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
+        self.recording.discover(self._warn_unknown_commands)
 
-    def print_startup(self, missing: list[str], waited: float) -> None:
-        """What the start-up is waiting for (nodes starting and discovering each other)."""
-        robots = [m for m in missing if m in self._cmd_subs]
-        others = [m for m in missing if m not in self._cmd_subs]
-        text = f"{len(self.robots) - len(robots)}/{len(self.robots)} controllers connected"
-        if robots:
-            text += f", waiting for {', '.join(robots[:3])}{' ...' if len(robots) > 3 else ''}"
-        if others:
-            text += f"; waiting for {', '.join(others)}"
-        print(f"[world] start-up {waited:5.1f} s: {text} (gives up after {self.config.startup_timeout:.0f} s)",
-              flush=True)
+    def _warn_unknown_commands(self, topic: str) -> None:
+        if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
+            self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
 
-    def print_progress(self, wall: float) -> None:
-        t = self.world.t_ns / NS_PER_S
-        stale = sum(s.stale_ticks for s in self.world.stats.values())
-        print(
-            f"[world] t={t:7.1f}/{self.scenario.sim.duration:.0f} s  rtf={t / max(wall, 1e-9):5.2f}x  "
-            f"{self.world.task.progress()}  stale={stale}",
-            flush=True,
-        )
+    def unconnected(self) -> list[str]:
+        """Robots whose controller is not matched on every topic yet, and the servers if any
+        has no ack publisher yet."""
+        missing = [
+            r for r in self.robots
+            if self._cmd_subs[r].get_publisher_count() == 0
+            or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
+        ]
+        if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
+            missing.append("servers (" + ", ".join(self.servers) + ")")
+        return missing
+
+    # ------------------------------------------------------------------ publishing
+
+    def publish_tick(self, obs: dict[RobotId, Observation], *, send: bool = True) -> None:
+        """Tick k's clock and observations; `send=False` records them without asking the
+        controllers for another answer (the state at the end of the run)."""
+        t_ns = self.world.t_ns
+        self.inbound.now_ns = self.inbound.released_ns = t_ns
+        self.relay.flush(send=send)  # what robots sent each other at the last tick, before this tick's observations
+        publish = self.recording.publish
+        publish(self._clock_pub, clock_codec.encode_clock(t_ns), topics.CLOCK, send=send)
+        sc = self.scenario.sensors.scan
+        # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
+        # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
+        poses = self.world.odometry_poses()
+        for r, o in obs.items():
+            pubs = self._obs_pubs[r]
+            encoded = {
+                topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
+                topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
+                **self.sensing.encode_all(t_ns, o.sensed),
+            }
+            for name, data in encoded.items():
+                publish(pubs[name], data, topics.robot_topic(r, name), send=send)
+            self._sent[r] = encoded
+        if self.state_topics:
+            values = self.world.task.state()
+            for st, pub in zip(self.state_topics, self._state_pubs):
+                publish(pub, st.encode(t_ns, values[st.field]), st.topic, send=send)
+
+    def resend(self, waiting: list[str], stamp: int) -> None:
+        """Tick `stamp` again to those of `waiting` (robots: their observations; servers: the clock)."""
+        for r in waiting:
+            if r in self._sent:
+                for name, data in self._sent[r].items():
+                    self._obs_pubs[r][name].publish(data)
+            else:  # a server: it answers a repeated /clock with its ack
+                self._clock_pub.publish(clock_codec.encode_clock(stamp))
+
+    def publish_world_state(self, final: bool = False) -> None:
+        """After a step: events, stats, markers, diagnostics (`swarm_sim.nodes.world_outputs`)."""
+        events, self._down_events = self._down_events, []
+        self.outputs.publish(self.world, events, final=final)
 
     def close(self) -> None:
-        if self.recorder is not None:
-            self.recorder.close(
-                wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
-                sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
-                server_stale_ticks=json.dumps(self.server_stale_ticks),
-                ended=self.ended,
-                dead_nodes=json.dumps([e.node for e in self.down]),
-            )
+        self.recording.close(
+            wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
+            sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
+            server_stale_ticks=json.dumps(self.server_stale_ticks),
+            ended=self.ended,
+            dead_nodes=json.dumps([e.node for e in self.down]),
+        )
         self.world.close()
 
 

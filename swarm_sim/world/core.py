@@ -57,7 +57,7 @@ from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
 from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.jit import inline, kernel
-from swarm_sim.world.observations import observations, with_messages
+from swarm_sim.world.observations import observations
 from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
@@ -297,8 +297,6 @@ class World:
         self._meas_v = np.zeros(n)
         self._meas_w = np.zeros(n)
         self._obs_cache: dict[RobotId, Observation] | None = None
-        self._obs_messages: tuple[object, ...] = ()
-        """The messages the cached observations carry."""
         self.task: WorldTask = self._task_factory(self, task_seeds)
         self._fresh = True
 
@@ -382,16 +380,13 @@ class World:
     # ------------------------------------------------------------------ API
 
     def reset(self) -> dict[RobotId, Observation]:
-        """Back to tick 0 (same seed, fresh pybullet simulation); observations with messages=()."""
+        """Back to tick 0 (same seed, fresh pybullet simulation); its observations."""
         if not self._fresh:
             self._build()
         return self.observe()
 
-    def step(
-        self, commands: Mapping[RobotId, Command], messages: tuple[object, ...] = ()
-    ) -> dict[RobotId, Observation]:
-        """Apply `commands`, advance one tick, return the new tick's observations, each carrying
-        `messages` (see `observe`)."""
+    def step(self, commands: Mapping[RobotId, Command]) -> dict[RobotId, Observation]:
+        """Apply `commands`, advance one tick, return the new tick's observations (see `observe`)."""
         try:
             idx = np.fromiter(map(self._index.__getitem__, commands), np.intp, len(commands))
         except KeyError as exc:
@@ -411,7 +406,7 @@ class World:
         self._odometry(pos0, yaw0)
         self.task.post_step((self.tick + 1) * self._dt_ns)
         self.tick += 1
-        return self.observe(messages)
+        return self.observe()
 
     def _apply_commands(self, idx: np.ndarray, commands: Collection[Command]) -> None:
         """Store the commanded (v, w) of robots `idx`, NaN/inf -> 0 and clamped to the limits."""
@@ -537,14 +532,12 @@ class World:
         self._meas_v = forward / self._dt
         self._meas_w = turn / self._dt
 
-    def observe(self, messages: tuple[object, ...] = ()) -> dict[RobotId, Observation]:
-        """Observations for the current tick (wire-rounded), each carrying `messages`: the batch
-        runner hands every robot the tick's inbox in them (a graph controller takes its messages
-        from its own mailbox); the world itself sends no messages."""
+    def observe(self) -> dict[RobotId, Observation]:
+        """Observations for the current tick (wire-rounded), with no messages: the world neither
+        sends nor carries any (the batch runner hands each behaviour its inbox, as a controller
+        node does)."""
         if self._obs_cache is not None:
-            if messages is self._obs_messages or messages == self._obs_messages:
-                return dict(self._obs_cache)
-            return {r: with_messages(o, messages) for r, o in self._obs_cache.items()}
+            return dict(self._obs_cache)
         sc = self.scenario.sensors.scan
         if sc.backend == "pybullet":
             ranges = cast_scan_pybullet(
@@ -558,8 +551,8 @@ class World:
         ranges.flags.writeable = False
         self._ring_ahead = self._ring.ahead(ranges)
         sensed = self.task.sense()
-        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed, messages)
-        self._obs_cache, self._obs_messages = obs, messages
+        obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed)
+        self._obs_cache = obs
         return dict(obs)
 
     def true_poses(self) -> dict[RobotId, Pose2D]:

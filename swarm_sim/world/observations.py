@@ -4,9 +4,9 @@
 each field through ``object.__setattr__``, which made constructing them most of the cost of
 `World.observe` (1000 robots: 1.1 ms a tick). Here the slots are filled through their
 descriptors directly (`swarm_sim.types.slot_setters`): field by field for the whole swarm
-(`observations`, 1000 robots: 0.7 ms; the batch runner's inbox is one more column), or one
-object at a time (`with_messages`). Both fall back to the ordinary constructor should the classes
-ever gain fields or a ``__post_init__`` (test_world checks both give equal objects).
+(`observations`, 1000 robots: 0.7 ms), or one object at a time (`with_messages`: the batch
+runner's copies carrying a tick's inbox). Both fall back to the ordinary constructor should the
+classes ever gain fields or a ``__post_init__`` (test_world checks both give equal objects).
 """
 
 from __future__ import annotations
@@ -88,16 +88,16 @@ def _build(cls: type, setters: tuple | None, columns: Sequence[Iterable[Any]], n
 
 def observations(
     robots: Sequence[RobotId], stamp_ns: int, odometry: np.ndarray, speeds: np.ndarray,
-    turn_rates: np.ndarray, ranges: np.ndarray, sensed: Sequence[Any], messages: tuple[object, ...] = (),
+    turn_rates: np.ndarray, ranges: np.ndarray, sensed: Sequence[Any],
 ) -> dict[RobotId, Observation]:
-    """Every robot's observation: `odometry` (n, 3) x, y, yaw [m, rad] (the yaw rounded as on the
-    wire here), measured forward `speeds` and `turn_rates` (n,), `ranges` (n, rays) (each robot
-    gets its row), `sensed` the task's readings, `messages` the same tuple for every robot."""
+    """Every robot's observation, without messages: `odometry` (n, 3) x, y, yaw [m, rad] (the
+    yaw rounded as on the wire here), measured forward `speeds` and `turn_rates` (n,), `ranges`
+    (n, rays) (each robot gets its row), `sensed` the task's readings."""
     n = len(robots)
     x, y = odometry[:, 0].tolist(), odometry[:, 1].tolist()
     poses = _build(Pose2D, _POSE_SETTERS, (x, y, _wire_yaws(odometry[:, 2])), n)
     columns = (robots, repeat(stamp_ns), poses, speeds.tolist(), turn_rates.tolist(), list(ranges), sensed,
-               repeat(messages))
+               repeat(()))
     return dict(zip(robots, _build(Observation, _OBSERVATION_SETTERS, columns, n)))
 
 

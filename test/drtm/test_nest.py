@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from swarm_controllers.drtm.nest import NestServer, replay_nest_state
+from swarm_controllers.drtm.nest import NestServer
 from swarm_controllers.drtm.metrics import (
     active_robots_series,
     energy_efficiency,
@@ -22,7 +22,9 @@ from swarm_controllers.drtm.metrics import (
 )
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_controllers.drtm.codec import NEST
+from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_msgs_py.topics import NEST_STATE
+from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.types import BehaviourStatus, DropEvent
@@ -175,15 +177,20 @@ def test_series_are_sampled_every_five_seconds():
     assert active_robots_series(trace) == [[0.0, 0], [5.0, 2], [10.0, 1]]
 
 
-def test_the_recorded_nest_state_replays_as_the_servers_series():
+def test_the_recorded_nest_state_replays_as_the_batch_runners_series():
+    """The nest's series are read off the states it sends: from the messages in a batch run,
+    from their recorded bytes in a bag replay (`swarm_msgs_py.server_outputs.SeriesLog`)."""
     nest = NestServer(_scenario())
+    (spec,) = registry.algorithm("drtm").servers
+    live, replayed = SeriesLog([spec], {}), SeriesLog([spec], {})
+    sent = []
     for k in range(3):
-        nest.step(k * DT_NS, [_report(k - 1, 0, NestEvent.LEFT)] if k == 1 else [])
-    replayed: dict[str, list] = {}
-    for state in nest.history:
+        sent += nest.step(k * DT_NS, [_report(k - 1, 0, NestEvent.LEFT)] if k == 1 else [])
+    live.sent(sent)
+    for state in sent:
         for data in NEST.encode(state.stamp_ns, [state]):
-            for name, t, v in replay_nest_state(NEST_STATE, data):
-                replayed.setdefault(name, []).append((t, v))
-    assert replayed == nest.series()
-    assert replay_nest_state("/nest/reports", NEST.encode(0, [_report(0, 0, NestEvent.LEFT)])[0]) == []
-    assert isinstance(nest.history[-1], NestState) and nest.history[-1].waiting == 2
+            replayed.replay(NEST_STATE, data)
+    assert replayed.series == live.series and set(live.series) == {"nest_food", "nest_waiting", "nest_oaes"}
+    assert live.series["nest_waiting"] == [(0.0, 3), (0.1, 2), (0.2, 2)]
+    assert NEST_STATE in live.topics and "/nest/reports" not in live.topics
+    assert isinstance(sent[-1], NestState) and sent[-1].waiting == 2

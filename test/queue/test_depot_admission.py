@@ -33,8 +33,10 @@ from depot_manager.geometry import (
     make_layout,
 )
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
+from depot_manager.codec import OUTPUTS
 from depot_manager.server import DepotServer
 from swarm_controllers.spiral.protocol import ProgressReport
+from swarm_msgs_py.server_outputs import StateWatch
 from swarm_sim.scenario import ControllerConfig, DepotConfig, Scenario
 
 P_MIN = 0.3
@@ -700,11 +702,33 @@ def _scenario(wrapping: str, **queue) -> Scenario:
     return Scenario(depot=DepotConfig(delivery="docks"), controller=controller)
 
 
+class _Recorded:
+    """A depot server stepped as the batch runner steps it: its ``queue_lengths`` series read off
+    the state it publishes (`depot_manager.codec.OUTPUTS`)."""
+
+    def __init__(self, srv: DepotServer) -> None:
+        self.srv, self.series = srv, {}
+        self._watch = StateWatch(OUTPUTS.state)
+
+    def step(self, stamp_ns, messages):
+        out = self.srv.step(stamp_ns, messages)
+        for st, value in self._watch.changed(self.srv.state()):
+            for series in OUTPUTS.series:
+                if series.topic == st.topic:
+                    series.record(self.series, stamp_ns, value)
+        return out
+
+    @property
+    def history(self):
+        return self.series.get("queue_lengths", [])
+
+
 def test_server_refusals_grants_history_errors():
     srv = DepotServer(_scenario("multi"))
+    rec = _Recorded(srv)
     n = len(srv.admission.cells("entry_line_0"))
     s = 1_000_000_000
-    out = srv.step(1 * s, [
+    out = rec.step(1 * s, [
         DepotReport(0, "robot_2", ReportKind.JOIN, "entry_line_0", 5),
         DepotReport(0, "robot_1", ReportKind.JOIN, "entry_line_0", 5),
         DepotReport(0, "robot_10", ReportKind.JOIN, "nowhere", 0),
@@ -719,17 +743,17 @@ def test_server_refusals_grants_history_errors():
     assert by["robot_3"].reason is Refusal.NOT_BEHIND_TAIL
     assert by["robot_2"] == DepotGrant(s, "robot_2", "entry_line_0", 5 + LOOKAHEAD, True)
     assert by["robot_4"] == DepotGrant(s, "robot_4", "entry_line_1", LOOKAHEAD, True)
-    assert srv.history == [(1.0, (1, 1, 0, 0))]
+    assert rec.history == [(1.0, (1, 1, 0, 0))]
     # already inside
-    out = srv.step(2 * s, [DepotReport(s, "robot_2", ReportKind.JOIN, "entry_line_2", 0)])
+    out = rec.step(2 * s, [DepotReport(s, "robot_2", ReportKind.JOIN, "entry_line_2", 0)])
     assert out == (DepotGrant(2 * s, "robot_2", "entry_line_2", -1, False, Refusal.ALREADY_INSIDE),)
     # a robot joining behind robot_2 takes `last` from it: both are told
-    out = srv.step(3 * s, [DepotReport(2 * s, "robot_5", ReportKind.JOIN, "entry_line_0", 0)])
+    out = rec.step(3 * s, [DepotReport(2 * s, "robot_5", ReportKind.JOIN, "entry_line_0", 0)])
     assert [(g.robot, g.last) for g in out] == [("robot_2", False), ("robot_5", True)]
     assert out[0].cell == 5 + LOOKAHEAD  # unchanged grant, re-sent for the flag
-    assert srv.history[-1] == (3.0, (2, 1, 0, 0))
+    assert rec.history[-1] == (3.0, (2, 1, 0, 0))
     # bad reports are recorded, not raised
-    out = srv.step(4 * s, [
+    out = rec.step(4 * s, [
         DepotReport(3 * s, "ghost", ReportKind.AT, "entry_line_0", 1),
         DepotReport(3 * s, "robot_2", ReportKind.AT, "entry_line_0", 99),
         DepotReport(3 * s, "robot_2", "teleport"),
@@ -738,7 +762,7 @@ def test_server_refusals_grants_history_errors():
     ])
     assert srv.rejections.counts == {("DepotReport", "unknown robot"): 1, ("DepotReport", "refused"): 3}
     assert [(g.robot, g.cell) for g in out] == [("robot_2", 6 + LOOKAHEAD), ("robot_5", 5)]
-    assert len(srv.history) == 2  # queue lengths unchanged
+    assert len(rec.history) == 2  # queue lengths unchanged
     # robot_2 all the way through: dock, unloading, exit, gone
     adm = srv.admission
     tick = 5
@@ -750,14 +774,14 @@ def test_server_refusals_grants_history_errors():
         else:
             assert route.index(adm.grant("robot_2")) > i
             msg = DepotReport(0, "robot_2", ReportKind.AT, *route[i + 1])
-        out = srv.step(tick * s, [msg])
+        out = rec.step(tick * s, [msg])
         tick += 1
         assert tick < 100
     assert "robot_2" not in [g.robot for g in out] and adm.snapshot().left == 1
     assert srv.rejections.total == 4
     # robot_2 left the queue when it drove off its dock onto the exit line
-    assert [h[1] for h in srv.history] == [(1, 1, 0, 0), (2, 1, 0, 0), (1, 1, 0, 0)]
-    times = [h[0] for h in srv.history]
+    assert [h[1] for h in rec.history] == [(1, 1, 0, 0), (2, 1, 0, 0), (1, 1, 0, 0)]
+    times = [h[0] for h in rec.history]
     assert times == sorted(times) and times[-1] < tick - 1
 
 

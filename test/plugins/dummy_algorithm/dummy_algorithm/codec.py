@@ -9,6 +9,7 @@ from dummy_algorithm.task import BeaconSense
 from swarm_msgs_py.cdr import ENCAPSULATION, align, codec, frames_fragment, skip_header, split_stamp
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.sensing import SenseTopic, Sensing
+from swarm_msgs_py.server_outputs import ServerOutputs, Series
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
 _FRAME = frames_fragment("base_link", then_align=8)
@@ -33,3 +34,11 @@ SENSING = Sensing(BeaconSense, (SenseTopic("beacon", TYPE_NAME, "beacon", encode
 
 PINGS = RecordFamily("pings", {Ping: "/dummy/pings"})
 """The dummy's message family: robots' pings to the counter server."""
+
+
+def _ping(ping: Ping) -> dict[str, int]:
+    return {"pings": 1}
+
+
+OUTPUTS = ServerOutputs(series=(Series(PINGS.topics[Ping], _ping),))
+"""The counter publishes nothing of its own; the trace's ``pings`` has a point per ping sent."""

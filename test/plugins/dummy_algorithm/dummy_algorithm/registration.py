@@ -12,7 +12,6 @@ register(Algorithm(
     behaviour="dummy_algorithm.behaviour:DummyBehaviour",
     task="beacon",
     servers=(ServerSpec(channel="counter", core="dummy_algorithm.server:CounterServer",
-                        node="dummy_algorithm.node", script="dummy-counter",
-                        family="dummy_algorithm.codec:PINGS", replay="dummy_algorithm.server:replay_pings"),),
+                        family="dummy_algorithm.codec:PINGS", outputs="dummy_algorithm.codec:OUTPUTS"),),
     metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard", None),),
 ))

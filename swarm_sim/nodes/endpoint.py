@@ -1,0 +1,125 @@
+"""A node's end of the message families: what robots and servers share on the graph.
+
+A robot's controller node and a server node both load the scenario from the same config
+(`EndpointConfig`), hear some message families' topics and send on others
+(`swarm_sim.registry.robot_topics` / `server_topics`). `Endpoint` is that plumbing, once:
+
+- one subscription per inbound topic, whose messages are decoded and checked
+  (`swarm_sim.inbound.Inbound`: decodable, naming robots of this run, stamped for a tick the node
+  can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
+  before tick k in the fixed delivery order, exactly what the batch runner hands the core;
+- one publisher per outbound topic and the topic map (message class -> topic): `send` publishes
+  a core's answers of a tick grouped by topic, one encoded batch per topic;
+- `RejectionReport`: the messages dropped, by the node or by its core, on ``/diagnostics``
+  whenever the count grew (the world node reports its own drops the same way).
+
+A node creates its `Endpoint` before its other subscriptions: in a wait set where both are
+ready, rclpy runs the earlier subscription first.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import defaultdict
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from rclpy.node import Node
+
+from swarm_msgs_py import diagnostics, topics
+from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
+from swarm_sim.inbound import Inbound, Rejections, merged, total
+from swarm_sim.messaging import Mailbox
+from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario
+
+
+@dataclass(frozen=True)
+class EndpointConfig:
+    """The parameters of a controller or server node (`swarm_msgs_py.params.declare_config`)."""
+
+    scenario: str = DEFAULT_SCENARIO
+    """Scenario name or YAML path (the same one the world loads)."""
+    overrides: tuple[str, ...] = ()
+    seed: int = 0
+    startup_timeout: float = 60.0
+    """Wall seconds to wait for the node's peers on its topics to be matched before going on."""
+
+
+def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--scenario``, ``--set KEY=VALUE`` (repeatable) and ``--seed`` (`endpoint_config`)."""
+    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def endpoint_config(args: argparse.Namespace) -> EndpointConfig:
+    return EndpointConfig(args.scenario, tuple(args.overrides), args.seed)
+
+
+class RejectionReport:
+    """A node's messages dropped so far (its own `rejections` and its core's, merged) on
+    ``/diagnostics``, latched, published only when the count grew (counts only grow)."""
+
+    def __init__(self, node: Node, rejections: Rejections) -> None:
+        self._node = node
+        self.rejections = rejections
+        self._published = 0
+        self._pub = node.create_publisher(topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, STATE_LATCHED)
+
+    def publish(self, stamp_ns: int, core: object = None) -> None:
+        """`core`: the node's core, whose own ``rejections`` (if any) are merged in."""
+        theirs = getattr(core, "rejections", None)
+        if (dropped := total(self.rejections, theirs)) != self._published:
+            self._published = dropped
+            self._pub.publish(diagnostics.encode_rejections(
+                stamp_ns, self._node.get_fully_qualified_name(), merged(self.rejections, theirs)))
+
+
+class Endpoint:
+    """A node's family topics (see the module docstring): `inbound` and `outbound` map each
+    topic to its message family."""
+
+    def __init__(self, node: Node, scenario: Scenario, inbound: Mapping[str, Any], outbound: Mapping[str, Any]) -> None:
+        self._name = node.get_fully_qualified_name()
+        self.mailbox = Mailbox()
+        self.rejections = Rejections()
+        self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning)
+        self.subscriptions = {
+            topic: node.create_subscription(
+                topics.import_type(family.type_name), topic,
+                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
+                EVENTS, raw=True,
+            )
+            for topic, family in inbound.items()
+        }
+        self.publishers = {t: (f, node.create_publisher(topics.import_type(f.type_name), t, family_qos(f, t)))
+                           for t, f in outbound.items()}
+        self.topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
+        """Message class -> the topic this node sends it on."""
+        self.report = RejectionReport(node, self.rejections)
+
+    def take(self, stamp_ns: int) -> tuple[object, ...]:
+        """Tick `stamp_ns` begins: the messages stamped before it, in delivery order."""
+        self.inbound.now_ns = self.inbound.released_ns = stamp_ns
+        return self.mailbox.take_before(stamp_ns)
+
+    def send(self, stamp_ns: int, messages: Iterable[object]) -> None:
+        """A core's messages of tick `stamp_ns`, on the topics of their families."""
+        by_topic: dict[str, list] = defaultdict(list)
+        for message in messages:
+            topic = self.topic_of.get(type(message))
+            if topic is None:
+                raise TypeError(f"{self._name}: this algorithm sends no {type(message).__name__}")
+            by_topic[topic].append(message)
+        for topic, group in by_topic.items():
+            family, pub = self.publishers[topic]
+            for data in family.encode(stamp_ns, group):
+                pub.publish(data)
+
+    def unmatched(self, peers: int) -> list[str]:
+        """Topics with fewer than `peers` nodes on their other end (publishers of what this node
+        hears, subscribers of what it sends)."""
+        missing = [t for t, sub in self.subscriptions.items() if sub.get_publisher_count() < peers]
+        return missing + [t for t, (_, pub) in self.publishers.items() if pub.get_subscription_count() < peers]
+

@@ -1,0 +1,55 @@
+"""The world's relay of what robots send each other, like a radio medium.
+
+Robots never match each other directly (N relays, not N x N matches): each robot publishes its
+peer families' messages (`swarm_sim.registry.peer_topics`) on their topics, and the world
+republishes them on ``heard(topic)``, which every robot hears. A message is recorded as sent,
+checked (`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick the
+world can take) and relayed just before the next tick's observations. Lockstep order makes this
+exact: a robot publishes its messages of tick k before its command k, so they are here before
+the barrier lets tick k+1 out, and they leave before its observations, from the same sender, in
+order.
+"""
+
+from __future__ import annotations
+
+from rclpy.node import Node
+
+from swarm_msgs_py import topics
+from swarm_msgs_py.qos import EVENTS
+from swarm_sim import registry
+from swarm_sim.inbound import Inbound, Reason
+from swarm_sim.nodes.world_recording import WorldRecording
+
+
+class PeerRelay:
+    def __init__(self, node: Node, algorithm: registry.Algorithm, inbound: Inbound, recording: WorldRecording) -> None:
+        self._inbound = inbound
+        self._recording = recording
+        self._relays = {}
+        """Peer topic -> publisher on ``heard(topic)``."""
+        self._relayed: list[tuple[str, bytes]] = []
+        """What arrived since the last tick went out, in order."""
+        for topic, family in registry.peer_topics(algorithm).items():
+            msg_type = topics.import_type(family.type_name)
+            recording.add(topic, family.type_name)
+            recording.skip(topics.heard(topic))  # the relay's copies: recorded once, as sent
+            self._relays[topic] = node.create_publisher(msg_type, topics.heard(topic), EVENTS)
+            node.create_subscription(msg_type, topic, lambda data, t=topic, f=family: self._on_peer(t, f, data),
+                                     EVENTS, raw=True)
+
+    def _on_peer(self, topic: str, family, data: bytes) -> None:
+        self._recording.write(topic, data)
+        try:
+            messages = family.decode(data)
+        except ValueError as exc:
+            self._inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
+            return
+        if all([self._inbound.admit(topic, m) for m in messages]):  # a list: every bad one is counted
+            self._relayed.append((topic, data))
+
+    def flush(self, *, send: bool = True) -> None:
+        """Relay what robots sent at the last tick (`send=False`: drop it, the run is over)."""
+        if send:
+            for topic, data in self._relayed:
+                self._relays[topic].publish(data)
+        self._relayed = []
