@@ -35,7 +35,8 @@ MARKER_PERIOD = 1.0
 _ENTRY = (0.1, 0.1, 0.1, 0.9)
 _EXIT = (0.1, 0.3, 0.9, 0.9)
 _INNER = (0.6, 0.2, 0.8, 0.9)
-_DOCK = (0.1, 0.7, 0.2, 1.0)
+DOCK_COLOUR = (0.1, 0.7, 0.2, 1.0)
+"""RGBA of the docks in the depot's markers."""
 _FREE = (0.7, 0.7, 0.7, 0.5)
 _OWNED = (0.9, 0.1, 0.1, 0.9)
 
@@ -118,7 +119,7 @@ def draw(server: DepotServer, stamp_ns: int) -> Drawing:
         Lines("entry_lines", [ln.points for ln in layout.entry_lines], _ENTRY, 0.01),
         Lines("exit_lines", [ln.points for ln in layout.exit_lines], _EXIT, 0.01),
         Lines("inner_queues", [ln.points for ln in layout.inner_queues], _INNER, 0.01),
-        Points("docks", 0, np.array([d.stop for d in layout.docks]), _DOCK, server.queue.lane_spacing, cubes=True),
+        Points("docks", 0, np.array([d.stop for d in layout.docks]), DOCK_COLOUR, server.queue.lane_spacing, cubes=True),
         Points("entry_points", 0, layout.entry_points, _ENTRY, 0.08),
         Points("exit_points", 0, layout.exit_points, _EXIT, 0.08),
         Points("slots_free", 0, free, _FREE, 0.04),

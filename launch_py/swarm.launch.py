@@ -4,14 +4,16 @@
 
 Starts the world node (which records the bag), one controller process hosting every robot's
 controller node and a server node (``swarm-server --channel ...``) for each server the scenario
-needs (center, depot manager; console scripts on PATH). `swarm-run` does the same without ros2launch; nothing in the tests needs this.
+needs (console scripts on PATH). `swarm-run` does the same without ros2launch; nothing in the
+tests needs this.
 """
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 
-from swarm_sim.scenario import DEFAULT_SCENARIO
+from swarm_sim import registry
+from swarm_sim.scenario import load_scenario
 
 
 def _nodes(context):
@@ -20,9 +22,6 @@ def _nodes(context):
     seed = LaunchConfiguration("seed").perform(context)
     bag = LaunchConfiguration("bag").perform(context)
     common = ["--scenario", scenario, "--seed", seed, "--set", f"robots.count={robots}"]
-    from swarm_sim import registry
-    from swarm_sim.scenario import load_scenario
-
     servers = registry.of(load_scenario(scenario, [f"robots.count={robots}"])).servers
     return [
         *[ExecuteProcess(cmd=["swarm-server", "--channel", spec.channel, *common], output="screen")
@@ -36,7 +35,7 @@ def _nodes(context):
 def generate_launch_description():
     return LaunchDescription([
         DeclareLaunchArgument("robots", default_value="16"),
-        DeclareLaunchArgument("scenario", default_value=DEFAULT_SCENARIO),
+        DeclareLaunchArgument("scenario", default_value=registry.default_scenario()),
         DeclareLaunchArgument("seed", default_value="0"),
         DeclareLaunchArgument("bag", default_value="bags/launch_run"),
         OpaqueFunction(function=_nodes),

@@ -10,8 +10,7 @@ from collections.abc import Callable
 
 import yaml
 
-from swarm_sim.registry import scenario_files
-from swarm_sim.scenario import DEFAULT_SCENARIO
+from swarm_sim.registry import default_scenario, scenario_files
 
 
 def number(kind: type, low: float, high: float = math.inf, *, open_low: bool = False) -> Callable[[str], float]:
@@ -71,8 +70,9 @@ class _ListScenarios(argparse.Action):
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--scenario", default=DEFAULT_SCENARIO,
-                        help=f"scenario name or YAML path (default: {DEFAULT_SCENARIO}; --list-scenarios "
+    default = default_scenario()
+    parser.add_argument("--scenario", default=default,
+                        help=f"scenario name or YAML path (default: {default}; --list-scenarios "
                              "shows the shipped ones)")
     parser.add_argument("--list-scenarios", action=_ListScenarios,
                         help="list the shipped scenarios (name, algorithm, robots, sim seconds, what it is) and exit")

@@ -183,6 +183,8 @@ class Algorithm:
 _ALGORITHMS: dict[str, Algorithm] = {}
 _TASKS: dict[str, TaskSpec] = {}
 _DELIVERIES: dict[str, DeliveryKind] = {}
+_DEFAULT_SCENARIO: list[str] = []
+"""The scenario that a registration declared the commands' default (`register_default_scenario`)."""
 _PACKAGES: dict[str, Path] = {}
 """Entry-point name -> the folder of the module it loaded (where its ``scenarios/`` are)."""
 _ORIGINS: dict[str, str] = {}
@@ -263,6 +265,22 @@ def register_delivery(kind: DeliveryKind) -> DeliveryKind:
         raise ValueError(f"delivery kind {kind.name!r} is already registered")
     _DELIVERIES[kind.name] = kind
     return kind
+
+
+def register_default_scenario(name: str) -> None:
+    """Make scenario `name` (one the registering package ships) what every command runs unless
+    told otherwise; refuses a second claim, naming both."""
+    if _DEFAULT_SCENARIO and _DEFAULT_SCENARIO[0] != name:
+        raise ValueError(f"default scenario: {name!r} claimed, but {_DEFAULT_SCENARIO[0]!r} already is")
+    _DEFAULT_SCENARIO[:] = [name]
+
+
+def default_scenario() -> str:
+    """The commands' default scenario; ValueError if no registered package declares one."""
+    _load_entries()
+    if not _DEFAULT_SCENARIO:
+        raise ValueError("no registered package declares a default scenario (register_default_scenario)")
+    return _DEFAULT_SCENARIO[0]
 
 
 def resolve(path: str) -> Any:

@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
+from swarm_sim import registry
 from swarm_sim.scenario import (
+    ControllerConfig,
     Scenario,
     ScenarioError,
     load_scenario,
@@ -13,7 +17,6 @@ from swarm_sim.scenario import (
     scenario_from_dict,
     scenario_to_dict,
 )
-from swarm_sim import registry
 from swarm_sim.sites import drop_zones
 
 
@@ -81,7 +84,9 @@ def test_parse_override():
 def test_defaults_are_valid():
     from swarm_sim.scenario import validate
 
-    validate(Scenario())
+    validate(dataclasses.replace(Scenario(), controller=ControllerConfig(behaviour=registry.default_scenario())))
+    with pytest.raises(ScenarioError, match="controller.behaviour: unknown behaviour '' \\(known: "):
+        validate(Scenario())  # a scenario names its algorithm
 
 
 @pytest.mark.parametrize("content, named", [

@@ -15,7 +15,7 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 
-from depot_manager.node import _DOCK as DOCK_COLOUR
+from depot_manager.server import DOCK_COLOUR
 from swarm_sim.analysis.cli import main as analyze
 from swarm_sim.analysis.video import SIZE_PX, render_video, save_frame
 

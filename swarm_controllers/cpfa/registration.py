@@ -1,7 +1,7 @@
 """The CPFA's registry record (Hecker & Moses 2015), loaded through the ``swarmforage.algorithms``
 entry point: the queue paper's baseline, and the search its queue strategies build on."""
 
-from swarm_sim.registry import Algorithm, Measure, register
+from swarm_sim.registry import Algorithm, Measure, register, register_default_scenario
 
 SECTION = ("cpfa", "swarm_controllers.cpfa.config:CpfaConfig")
 """``controller.cpfa``: also declared by the algorithms that search as the CPFA does."""
@@ -20,3 +20,5 @@ register(Algorithm(
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
     headline=HEADLINE,
 ))
+
+register_default_scenario("cpfa")  # what scripts/run and every command run unless told otherwise

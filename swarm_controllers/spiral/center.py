@@ -435,7 +435,7 @@ class CenterServer:
         self.rejections = Rejections()
         """Reports dropped: sent out of range, from an unknown or dead robot, about an unknown region."""
         self.lost: set[RobotId] = set()
-        self.regions, self.arena_size = scenario.regions.count, scenario.arena.size
+        self.regions, self.arena_size = RegionConfig.of(scenario).count, scenario.arena.size
 
     def snapshot(self) -> list[RegionState]:
         """Per-region state (walkers, covered arc lengths, remaining) for publishing."""

@@ -31,15 +31,15 @@ from swarm_msgs_py import diagnostics, topics
 from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
 from swarm_sim.inbound import Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario
+from swarm_sim.scenario import Scenario
 
 
 @dataclass(frozen=True)
 class EndpointConfig:
     """The parameters of a controller or server node (`swarm_msgs_py.params.declare_config`)."""
 
-    scenario: str = DEFAULT_SCENARIO
-    """Scenario name or YAML path (the same one the world loads)."""
+    scenario: str = ""
+    """Scenario name or YAML path (the same one the world loads; '': the default scenario)."""
     overrides: tuple[str, ...] = ()
     seed: int = 0
     startup_timeout: float = 60.0
@@ -48,7 +48,7 @@ class EndpointConfig:
 
 def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
     """``--scenario``, ``--set KEY=VALUE`` (repeatable) and ``--seed`` (`endpoint_config`)."""
-    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
+    parser.add_argument("--scenario", default="", help="scenario name or YAML path (default: the default scenario)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
 

@@ -47,15 +47,15 @@ from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
-from swarm_sim.scenario import DEFAULT_SCENARIO, Scenario, load_scenario
+from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 
 
 @dataclass(frozen=True)
 class WorldNodeConfig:
-    scenario: str = DEFAULT_SCENARIO
-    """Scenario name or YAML path."""
+    scenario: str = ""
+    """Scenario name or YAML path ('': the default scenario)."""
     overrides: tuple[str, ...] = ()
     """``a.b=VALUE`` scenario overrides."""
     seed: int = 0
@@ -314,7 +314,7 @@ class WorldNode(Node):
 
 def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser = argparse.ArgumentParser(prog="swarm-world", description=__doc__.splitlines()[0])
-    parser.add_argument("--scenario", default=DEFAULT_SCENARIO)
+    parser.add_argument("--scenario", default="", help="scenario name or YAML path (default: the default scenario)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=number(int, 0, 2**63 - 1), default=0)
     parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")

@@ -21,7 +21,6 @@ from swarm_sim.scenario.loading import (
     scenario_to_dict,
 )
 from swarm_sim.scenario.schema import (
-    DEFAULT_SCENARIO,
     ArenaConfig,
     AvoidanceConfig,
     ControllerConfig,
@@ -44,7 +43,6 @@ from swarm_sim.scenario.schema import (
 from swarm_sim.scenario.validation import validate
 
 __all__ = [
-    "DEFAULT_SCENARIO",
     "ArenaConfig",
     "AvoidanceConfig",
     "ControllerConfig",

@@ -26,7 +26,7 @@ from typing import Any, Literal, get_args, get_origin
 import yaml
 
 from swarm_sim import registry
-from swarm_sim.scenario.schema import DEFAULT_SCENARIO, ControllerConfig, Scenario, ScenarioError
+from swarm_sim.scenario.schema import ControllerConfig, Scenario, ScenarioError
 from swarm_sim.scenario.validation import validate
 
 MAX_FILE_BYTES = 1 << 20
@@ -182,16 +182,16 @@ def resolve_path(name_or_path: str) -> Path:
 
 
 def load_scenario(
-    name_or_path: str = DEFAULT_SCENARIO,
+    name_or_path: str | None = None,
     overrides: Iterable[str] = (),
     **fields: Any,
 ) -> Scenario:
-    """Load, override, build and validate a scenario.
+    """Load, override, build and validate a scenario (None or '': `registry.default_scenario`).
 
     `overrides` are ``a.b=VALUE`` strings (the CLI's ``--set``); `fields` are dotted keys
     with ``__`` for dots, e.g. ``robots__count=8`` (the CLI's ``--robots``).
     """
-    path = resolve_path(name_or_path)
+    path = resolve_path(name_or_path or registry.default_scenario())
     data = read_yaml(path)
     for text in overrides:
         _set_path(data, *parse_override(text))

@@ -24,8 +24,6 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 if TYPE_CHECKING:
     from typing import Self  # Python >= 3.11; annotations only
 
-DEFAULT_SCENARIO = "cpfa"
-"""The scenario every command runs unless told otherwise (the CPFA baseline)."""
 
 
 class ScenarioError(ValueError):
@@ -308,8 +306,8 @@ class ControllerConfig:
     `section` hands it out. Sections left out of the file take their defaults.
     """
 
-    behaviour: str = DEFAULT_SCENARIO
-    """The registered algorithm (`swarm_sim.registry.known`)."""
+    behaviour: str = ""
+    """The registered algorithm (`swarm_sim.registry.known`); every scenario names one."""
     avoidance: AvoidanceConfig = field(default_factory=AvoidanceConfig)
     arrival_tolerance: float = 0.1
     """A target counts as reached within this distance [m]."""
@@ -331,7 +329,7 @@ class Scenario:
     """A whole scenario: the generic world facts, the controller, and the world sections that
     tasks and algorithms declare (`sections`)."""
 
-    name: str = DEFAULT_SCENARIO
+    name: str = ""
     seed: int = 0
     sim: SimConfig = field(default_factory=SimConfig)
     arena: ArenaConfig = field(default_factory=ArenaConfig)
