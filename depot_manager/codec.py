@@ -17,14 +17,19 @@ line, a point whenever they change) is read from the state.
 
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply
 from depot_manager.server import MARKER_PERIOD, draw
-from swarm_msgs_py import topics
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState, Series
-from swarm_msgs_py.server_state import DepotView, decode_depot_state, encode_depot_state
+from depot_manager.state import DepotView, decode_depot_state, encode_depot_state
 
-DEPOT = RecordFamily("depot", {DepotReport: topics.DEPOT_REPORTS, DepotGrant: topics.DEPOT_GRANTS})
-RADIO = RecordFamily("radio", {RadioQuery: topics.RADIO, RadioReply: topics.RADIO})
+DEPOT_REPORTS = "/depot/reports"
+DEPOT_GRANTS = "/depot/grants"
+DEPOT_STATE = "/depot/state"
+DEPOT_MARKERS = "/depot/markers"
+RADIO_TOPIC = "/radio"
+
+DEPOT = RecordFamily("depot", {DepotReport: DEPOT_REPORTS, DepotGrant: DEPOT_GRANTS})
+RADIO = RecordFamily("radio", {RadioQuery: RADIO_TOPIC, RadioReply: RADIO_TOPIC})
 
 
 def _queue_lengths(depot: DepotView) -> dict[str, tuple[int, ...]]:
@@ -32,7 +37,7 @@ def _queue_lengths(depot: DepotView) -> dict[str, tuple[int, ...]]:
 
 
 OUTPUTS = ServerOutputs(
-    state=(ServerState(topics.DEPOT_STATE, TYPE_NAME, "depot", encode_depot_state, decode_depot_state),),
-    markers=ServerMarkers(topics.DEPOT_MARKERS, draw, MARKER_PERIOD),
-    series=(Series(topics.DEPOT_STATE, _queue_lengths, on_change=True),),
+    state=(ServerState(DEPOT_STATE, TYPE_NAME, "depot", encode_depot_state, decode_depot_state),),
+    markers=ServerMarkers(DEPOT_MARKERS, draw, MARKER_PERIOD),
+    series=(Series(DEPOT_STATE, _queue_lengths, on_change=True),),
 )

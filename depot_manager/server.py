@@ -24,7 +24,7 @@ from depot_manager.admission import DepotAdmission
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
-from swarm_msgs_py.server_state import DepotView
+from depot_manager.state import DepotView
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.protocol import Drawing, Lines, Points
 from swarm_sim.types import NS_PER_S

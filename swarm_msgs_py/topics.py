@@ -1,4 +1,4 @@
-"""Topic names and their ROS types: the one list the nodes, the recorder and analysis share.
+"""The shared topic names and their ROS types (each paper's protocol topics are in its codecs).
 
 Robot topics are relative names (``odom``) so that a controller node started in namespace
 ``/robot_3`` resolves them to ``/robot_3/odom`` and remapping works; nodes that serve every
@@ -29,23 +29,11 @@ CLOCK = "/clock"
 WORLD_EVENTS = "/world/events"
 WORLD_ROBOT_STATS = "/world/robot_stats"
 WORLD_MARKERS = "/world/markers"
-PHEROMONES = "/nest/pheromones"
-CENTER_REPORTS = "/center/reports"
-CENTER_ASSIGNMENTS = "/center/assignments"
-CENTER_STATE = "/center/state"
-CENTER_MARKERS = "/center/markers"
-DEPOT_REPORTS = "/depot/reports"
-DEPOT_GRANTS = "/depot/grants"
-DEPOT_STATE = "/depot/state"
-DEPOT_MARKERS = "/depot/markers"
-RADIO = "/radio"
-NEST_REPORTS = "/nest/reports"
-NEST_STATE = "/nest/state"
 DIAGNOSTICS = "/diagnostics"
 """Every node's rejected-message counts (`swarm_sim.inbound`), one status per node, on change."""
 LOCKSTEP_ACK = "/lockstep/ack"
-"""Servers (center, depot manager, nest) answer each lockstep tick here: header.stamp = the tick,
-header.frame_id = the server's channel (`center`, `depot`)."""
+"""Servers answer each lockstep tick here: header.stamp = the tick, header.frame_id = the
+server's channel (`swarm_sim.registry.ServerSpec.channel`)."""
 
 ROBOT_TOPIC_TYPES: dict[str, str] = {
     ODOM: "nav_msgs/msg/Odometry",
@@ -62,18 +50,6 @@ GLOBAL_TOPIC_TYPES: dict[str, str] = {
     WORLD_EVENTS: "diagnostic_msgs/msg/DiagnosticArray",
     WORLD_ROBOT_STATS: "diagnostic_msgs/msg/DiagnosticArray",
     WORLD_MARKERS: "visualization_msgs/msg/MarkerArray",
-    PHEROMONES: "geometry_msgs/msg/PointStamped",
-    CENTER_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
-    CENTER_ASSIGNMENTS: "diagnostic_msgs/msg/DiagnosticArray",
-    CENTER_STATE: "diagnostic_msgs/msg/DiagnosticArray",
-    CENTER_MARKERS: "visualization_msgs/msg/MarkerArray",
-    DEPOT_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
-    DEPOT_GRANTS: "diagnostic_msgs/msg/DiagnosticArray",
-    DEPOT_STATE: "diagnostic_msgs/msg/DiagnosticArray",
-    DEPOT_MARKERS: "visualization_msgs/msg/MarkerArray",
-    RADIO: "diagnostic_msgs/msg/DiagnosticArray",
-    NEST_REPORTS: "diagnostic_msgs/msg/DiagnosticArray",
-    NEST_STATE: "diagnostic_msgs/msg/DiagnosticArray",
     LOCKSTEP_ACK: "std_msgs/msg/Header",
     DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
 }

@@ -23,16 +23,13 @@ from typing import Protocol
 
 import numpy as np
 
-from swarm_sim.types import PheromoneMessage
 
 ROBOTS = "robots"
 """The channel every robot controller receives."""
 
 
 def channel_of(message: object) -> str:
-    """The channel `message` travels on; PheromoneMessage predates this module (robots)."""
-    if isinstance(message, PheromoneMessage):
-        return ROBOTS
+    """The channel `message` travels on (its class's ``CHANNEL``)."""
     channel = getattr(type(message), "CHANNEL", None)
     if not isinstance(channel, str) or not channel:
         raise TypeError(f"{type(message).__name__} is not a message type (no CHANNEL)")

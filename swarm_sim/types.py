@@ -182,19 +182,6 @@ class RobotStats:
 
 
 @dataclass(frozen=True, slots=True)
-class PheromoneMessage:
-    """CPFA: a pheromone waypoint laid at the nest (Hecker & Moses 2015, sec. 2.3).
-
-    x, y: the resource site the waypoint points to [m, world frame]; stamp_ns: when it was laid.
-    Receivers compute its decayed strength from the time since `stamp_ns`.
-    """
-
-    stamp_ns: int
-    x: float
-    y: float
-
-
-@dataclass(frozen=True, slots=True)
 class BehaviourStatus:
     """A behaviour's own counters and state, published when they change."""
 

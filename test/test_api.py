@@ -10,7 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from swarm_controllers.api import new_command, uniform_draws
-from swarm_sim.types import Command, PheromoneMessage
+from swarm_controllers.cpfa.messages import PheromoneMessage
+from swarm_sim.types import Command
 
 speeds = st.floats(allow_nan=True, allow_infinity=True)
 messages = st.lists(

@@ -30,6 +30,7 @@ from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from swarm_controllers.cpfa import codec as pheromone
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_msgs_py import clock, diagnostics, gripper, odometry, resources, scan, twist
 from swarm_msgs_py import topics as topic_names
 from swarm_msgs_py.cdr import CodecError, Reader, Writer
@@ -46,7 +47,6 @@ from swarm_sim.scenario import (
 from swarm_sim.types import (
     BehaviourStatus,
     DropEvent,
-    PheromoneMessage,
     PickupEvent,
     Pose2D,
     RobotStats,
@@ -641,4 +641,4 @@ def test_topic_types():
     for topic, name in topics.items():  # every type exists in stock Jazzy and imports
         assert name in TYPESTORE.types
         assert topic_names.type_name(type_of(topic)) == name
-    assert type_of("cmd_vel") is TwistStamped and type_of("/nest/pheromones") is PointStamped
+    assert type_of("cmd_vel") is TwistStamped and type_of("/world/events") is DiagnosticArray

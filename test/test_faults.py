@@ -17,13 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import rclpy
-from graph_helpers import overrides
-from launch_py.dds import discovery_port
 from rclpy.node import Node
 
+from depot_manager.codec import DEPOT, DEPOT_REPORTS, DEPOT_STATE, RADIO, RADIO_TOPIC
 from depot_manager.protocol import DepotReport, RadioReply, ReportKind
+from graph_helpers import overrides
+from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, server_state, topics, twist
-from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.recording import BagError, BagTruncatedWarning, bag_info, read_bag
@@ -142,8 +142,14 @@ def _last(bag: Path, topic: str):
 
 
 def _dock_occupant(bag: Path) -> str:
-    m = _last(bag, topics.DEPOT_STATE)
+    m = _last(bag, DEPOT_STATE)
     return next((r for r in server_state.decode_state(m.data)[1]["docks"].values() if r), "") if m else ""
+
+
+def _type_of(topic: str):
+    """The message class of a run topic, the depot's protocol topics included."""
+    families = {DEPOT_REPORTS: DEPOT, RADIO_TOPIC: RADIO}
+    return topics.import_type(families[topic].type_name) if topic in families else topics.type_of(topic)
 
 
 class Hostile(Node):
@@ -154,8 +160,8 @@ class Hostile(Node):
         self.stamp = 0
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK,
                                  lambda d: setattr(self, "stamp", clock.decode_clock(d)), SENSOR_LOCKSTEP, raw=True)
-        self.pubs = {t: self.create_publisher(topics.type_of(t), t, qos) for t, qos in (
-            (topics.RADIO, EVENTS), (topics.DEPOT_REPORTS, EVENTS), ("/robot_0/status", EVENTS),
+        self.pubs = {t: self.create_publisher(_type_of(t), t, qos) for t, qos in (
+            (RADIO_TOPIC, EVENTS), (DEPOT_REPORTS, EVENTS), ("/robot_0/status", EVENTS),
             ("/robot_1/cmd_vel", SENSOR_LOCKSTEP), (topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP))}
 
     def ready(self) -> bool:
@@ -163,8 +169,8 @@ class Hostile(Node):
 
     def attack(self) -> None:
         s = self.stamp
-        self.pubs[topics.RADIO].publish(RADIO.encode(s, [RadioReply(s, "robot_1", "robot_0", 0.0, 0.0, "entry_line_0", 10**9, False)])[0])
-        self.pubs[topics.DEPOT_REPORTS].publish(DEPOT.encode(s, [
+        self.pubs[RADIO_TOPIC].publish(RADIO.encode(s, [RadioReply(s, "robot_1", "robot_0", 0.0, 0.0, "entry_line_0", 10**9, False)])[0])
+        self.pubs[DEPOT_REPORTS].publish(DEPOT.encode(s, [
             DepotReport(s, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])[0])
         self.pubs["/robot_0/status"].publish(diagnostics.encode_diagnostics(s, [(0, "robot_0", "", "", (("garbage", "1"),))]))
         self.pubs["/robot_1/cmd_vel"].publish(twist.encode_twist("robot_1", s - 5 * 10**8, 0.15, 0.0))
@@ -241,7 +247,7 @@ def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(
     after = track[track[:, 0] > down.stamp_ns / NS_PER_S + 0.2]
     still = np.hypot(*np.diff(after[:, 1:3], axis=0).T) < 1e-9
     assert len(after) > 100 and still.mean() > 0.8, still.mean()
-    state = server_state.decode_state(_last(run.bag, topics.DEPOT_STATE).data)[1]
+    state = server_state.decode_state(_last(run.bag, DEPOT_STATE).data)[1]
     assert victim not in state["docks"].values() and victim not in state["slots"].values()
     # and the others keep delivering through the depot after it
     assert any(e.stamp_ns > down.stamp_ns and e.robot != victim for e in events if type(e).__name__ == "DropEvent")

@@ -7,16 +7,17 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
+from depot_manager.codec import DEPOT, RADIO
 from depot_manager.protocol import DepotGrant, DepotReport, RadioReply, ReportKind
 from depot_manager.server import DepotServer
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.spiral.center import CenterServer
 from swarm_controllers.spiral.protocol import ProgressReport
 from swarm_msgs_py import diagnostics
-from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_sim.inbound import Inbound, Reason, Rejections, merged, robot_fields
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NodeDownEvent, PheromoneMessage
+from swarm_sim.types import NodeDownEvent
 
 DT = 100_000_000
 ROBOTS = ("robot_0", "robot_1")

@@ -200,7 +200,6 @@ def _code_words(path: Path) -> tuple[set[str], set[str]]:
     return names, strings
 
 
-@PENDING
 def test_no_paper_name_outside_its_package():
     papers = _paper_names()
     assert {"cpfa", "queue", "spiral", "drtm", "caging"} <= set(papers)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_sim.messaging import per_inbox
-from swarm_sim.types import PheromoneMessage
 
 
 def test_per_inbox_summarises_each_tuple_once_and_never_confuses_two():

@@ -12,6 +12,8 @@ from rclpy.node import Node
 
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_controllers.cpfa import codec as pheromone
+from swarm_controllers.cpfa.codec import PHEROMONES, PHEROMONES_TOPIC
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_msgs_py import diagnostics, gripper, odometry, resources, scan, topics, twist
 from swarm_msgs_py.executor import share_sim_time
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
@@ -19,7 +21,7 @@ from swarm_sim.analysis.replay import load_run
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import PheromoneMessage, Pose2D
+from swarm_sim.types import Pose2D
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")
@@ -154,8 +156,8 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
             for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
     # the world's relay of what the other robots send, and its end that hears what robot_0 sends:
     # robot_0 answers only once both are matched
-    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.heard(topics.PHEROMONES), EVENTS)
-    peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
+    laid = peer.create_publisher(topics.import_type(PHEROMONES.type_name), topics.heard(PHEROMONES_TOPIC), EVENTS)
+    peer.create_subscription(topics.import_type(PHEROMONES.type_name), PHEROMONES_TOPIC, lambda d: None, EVENTS, raw=True)
     node.behaviour = _InboxLog(node.behaviour, inbox)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)

@@ -10,13 +10,15 @@ from hypothesis import strategies as st
 from rclpy.serialization import deserialize_message
 from std_msgs.msg import Header
 
+from depot_manager import state as depot_state
+from depot_manager.codec import DEPOT, RADIO
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind
+from swarm_controllers.spiral import state as center_state
 from swarm_controllers.spiral.center import RegionState
+from swarm_controllers.spiral.codec import CENTER
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_msgs_py import ack, server_state
 from swarm_msgs_py.cdr import CodecError
-from swarm_controllers.spiral.codec import CENTER
-from depot_manager.codec import DEPOT, RADIO
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_msgs_py.records import topic_of
 
@@ -111,38 +113,38 @@ def test_server_state_round_trip():
         RegionState(0, 12.5, (("robot_1", 1), ("robot_4", -1)), ((0.0, 3.25), (10.5, 12.5)), 7.25, False, 1.0),
         RegionState(1, 9.0, (), (), 9.0, True, float("-inf")),
     ]
-    stamp, state = server_state.decode_state(server_state.encode_center_state(7, regions))
+    stamp, state = server_state.decode_state(center_state.encode_center_state(7, regions))
     assert stamp == 7
     assert state["region_0"] == {"length": "12.5", "remaining": "7.25", "finished": "false",
                                  "walkers": "robot_1:+1 robot_4:-1", "covered": "0.0-3.25 10.5-12.5"}
     assert state["region_1"]["finished"] == "true"
 
-    depot = server_state.DepotView(
+    depot = depot_state.DepotView(
         (("entry_line_0", 3), ("entry_line_1", 0)), ("robot_2", ""), (), (("entry_line_0", 4, "robot_2"),)
     )
-    data = server_state.encode_depot_state(9, depot)
+    data = depot_state.encode_depot_state(9, depot)
     deserialize_message(data, DiagnosticArray)
     stamp, state = server_state.decode_state(data)
-    assert stamp == 9 and server_state.queue_lengths(state) == (3, 0)
+    assert stamp == 9 and depot_state.queue_lengths(state) == (3, 0)
     assert state["docks"] == {"dock_0": "robot_2", "dock_1": ""}
     assert state["slots"] == {"entry_line_0/4": "robot_2"}
-    assert server_state.decode_depot_state(data) == (9, depot)
+    assert depot_state.decode_depot_state(data) == (9, depot)
 
 
 def test_server_state_values_come_back_exactly():
     """What a server's state topic carries decodes to the very value its core gave (the series
     read from a bag equal the batch runner's), exponents and robot names with colons included."""
     regions = (
-        server_state.RegionView(0, 12.5, 7.25, False, (("robot_1", 1), ("robot_4", -1)), ((0.0, 1e-05), (1e-07, 12.5))),
-        server_state.RegionView(1, 1 / 3, 0.0, True, (), ((0.0, 1 / 3),)),
-        server_state.RegionView(2, 2e20, 2e20, False, (("a:b", 1),), ()),
+        center_state.RegionView(0, 12.5, 7.25, False, (("robot_1", 1), ("robot_4", -1)), ((0.0, 1e-05), (1e-07, 12.5))),
+        center_state.RegionView(1, 1 / 3, 0.0, True, (), ((0.0, 1 / 3),)),
+        center_state.RegionView(2, 2e20, 2e20, False, (("a:b", 1),), ()),
     )
-    assert server_state.decode_center_state(server_state.encode_center_state(5, regions)) == (5, regions)
-    depot = server_state.DepotView((("entry/line", 2),), ("", "robot_9"), (1, 0), (("entry/line", 12, "robot_9"),))
-    assert server_state.decode_depot_state(server_state.encode_depot_state(6, depot)) == (6, depot)
+    assert center_state.decode_center_state(center_state.encode_center_state(5, regions)) == (5, regions)
+    depot = depot_state.DepotView((("entry/line", 2),), ("", "robot_9"), (1, 0), (("entry/line", 12, "robot_9"),))
+    assert depot_state.decode_depot_state(depot_state.encode_depot_state(6, depot)) == (6, depot)
     for bad in (encode_diagnostics(0, [(OK, "region_0", "", "center", (("length", "1.0"),))]),
                 encode_diagnostics(0, [(OK, "queues", "", "depot_manager", (("entry_line_0", "x"),))])):
         with pytest.raises(CodecError):
-            server_state.decode_center_state(bad)
+            center_state.decode_center_state(bad)
         with pytest.raises(CodecError):
-            server_state.decode_depot_state(bad)
+            depot_state.decode_depot_state(bad)

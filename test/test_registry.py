@@ -13,8 +13,10 @@ from pathlib import Path
 
 import pytest
 
+from depot_manager.codec import DEPOT_GRANTS, DEPOT_REPORTS, RADIO_TOPIC
+from swarm_controllers.cpfa.codec import PHEROMONES_TOPIC
 from swarm_msgs_py import topics
-from swarm_msgs_py.server_outputs import SeriesLog, ServerOutputs, Series
+from swarm_msgs_py.server_outputs import Series, SeriesLog, ServerOutputs
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
 
@@ -25,12 +27,12 @@ def test_shipped_records_and_their_wiring():
     assert {"cpfa", "ddsa", "mdbsa_c", "mdbsa_d", "queue", "caging"} <= set(registry.known())
     queue = registry.algorithm("queue")
     inbound, outbound = registry.robot_topics(queue)
-    assert set(inbound) == {topics.DEPOT_GRANTS, topics.heard(topics.RADIO), topics.heard(topics.PHEROMONES)}
-    assert set(outbound) == {topics.DEPOT_REPORTS, topics.RADIO, topics.PHEROMONES}
+    assert set(inbound) == {DEPOT_GRANTS, topics.heard(RADIO_TOPIC), topics.heard(PHEROMONES_TOPIC)}
+    assert set(outbound) == {DEPOT_REPORTS, RADIO_TOPIC, PHEROMONES_TOPIC}
     server_in, server_out = registry.server_topics(queue.servers[0])
-    assert set(server_in) == {topics.DEPOT_REPORTS} and set(server_out) == {topics.DEPOT_GRANTS}
+    assert set(server_in) == {DEPOT_REPORTS} and set(server_out) == {DEPOT_GRANTS}
     assert registry.robot_topics(registry.algorithm("ddsa")) == ({}, {})
-    assert set(registry.peer_topics(queue)) == {topics.RADIO, topics.PHEROMONES}  # the world relays these
+    assert set(registry.peer_topics(queue)) == {RADIO_TOPIC, PHEROMONES_TOPIC}  # the world relays these
     caging_in, caging_out = registry.robot_topics(registry.algorithm("caging"))
     caging = {f"/caging/type{k}_{name}" for k, name in enumerate(
         ("recruitment", "summon", "positioned", "oriented", "reached"))}

@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from swarm_sim.types import Command, Observation, PheromoneMessage, Pose2D, slot_constructor, slot_setters
+from swarm_controllers.cpfa.messages import PheromoneMessage
+from swarm_sim.types import Command, Observation, Pose2D, slot_constructor, slot_setters
 
 
 def _same(fast: object, slow: object) -> None:

@@ -6,11 +6,11 @@ import dataclasses
 import math
 
 import numpy as np
-from swarm_sim.world.bullet import pybullet as p
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_sim.geometry import wire_yaw, wrap_angle
 from swarm_sim.scenario import (
     DropZoneConfig,
@@ -20,8 +20,9 @@ from swarm_sim.scenario import (
     ScenarioError,
     load_scenario,
 )
-from swarm_sim.types import Command, DropEvent, Observation, PheromoneMessage, PickupEvent, Pose2D
+from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
 from swarm_sim.world import World
+from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.observations import with_messages
 
 

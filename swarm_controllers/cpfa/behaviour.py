@@ -86,6 +86,7 @@ from math import inf, remainder
 
 import numpy as np
 
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.cpfa.config import CpfaConfig
@@ -98,7 +99,6 @@ from swarm_sim.types import (
     BehaviourStatus,
     Command,
     Observation,
-    PheromoneMessage,
     RobotId,
 )
 

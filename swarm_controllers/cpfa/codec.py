@@ -16,10 +16,10 @@ from swarm_msgs_py.cdr import (
     skip_header,
     split_stamp,
 )
-from swarm_msgs_py.topics import PHEROMONES as PHEROMONES_TOPIC
-from swarm_sim.types import PheromoneMessage
+from swarm_controllers.cpfa.messages import PheromoneMessage
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
+PHEROMONES_TOPIC = "/nest/pheromones"
 WORLD_FRAME = "world"
 
 _POINT = struct.Struct("<3d")

@@ -14,16 +14,17 @@ tick: ``nest_food`` F(t) [tokens], ``nest_waiting`` N_W and ``nest_oaes`` the OA
 """
 
 from swarm_controllers.drtm.protocol import NestReport, NestState
-from swarm_msgs_py import topics
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.server_outputs import ServerOutputs, Series
 
-NEST = RecordFamily("nest", {NestReport: topics.NEST_REPORTS, NestState: topics.NEST_STATE},
-                    latched=(topics.NEST_STATE,))
+NEST_REPORTS = "/nest/reports"
+NEST_STATE = "/nest/state"
+
+NEST = RecordFamily("nest", {NestReport: NEST_REPORTS, NestState: NEST_STATE}, latched=(NEST_STATE,))
 
 
 def _nest_series(state: NestState) -> dict[str, float]:
     return {"nest_food": state.food, "nest_waiting": state.waiting, "nest_oaes": state.total_oaes}
 
 
-OUTPUTS = ServerOutputs(series=(Series(topics.NEST_STATE, _nest_series),))
+OUTPUTS = ServerOutputs(series=(Series(NEST_STATE, _nest_series),))

@@ -59,7 +59,7 @@ import numpy as np
 
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
-from swarm_msgs_py.server_state import RegionView
+from swarm_controllers.spiral.state import RegionView
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.protocol import Drawing, Lines
 from swarm_controllers.spiral.geometry import (

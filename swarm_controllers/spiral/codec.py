@@ -14,15 +14,19 @@ Besides its messages the center publishes (`OUTPUTS`) the regions' walkers and p
 
 from swarm_controllers.spiral.center import draw
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
-from swarm_msgs_py import topics
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState
-from swarm_msgs_py.server_state import decode_center_state, encode_center_state
+from swarm_controllers.spiral.state import decode_center_state, encode_center_state
 
-CENTER = RecordFamily("center", {ProgressReport: topics.CENTER_REPORTS, RegionAssignment: topics.CENTER_ASSIGNMENTS})
+CENTER_REPORTS = "/center/reports"
+CENTER_ASSIGNMENTS = "/center/assignments"
+CENTER_STATE = "/center/state"
+CENTER_MARKERS = "/center/markers"
+
+CENTER = RecordFamily("center", {ProgressReport: CENTER_REPORTS, RegionAssignment: CENTER_ASSIGNMENTS})
 
 OUTPUTS = ServerOutputs(
-    state=(ServerState(topics.CENTER_STATE, TYPE_NAME, "regions", encode_center_state, decode_center_state),),
-    markers=ServerMarkers(topics.CENTER_MARKERS, draw),
+    state=(ServerState(CENTER_STATE, TYPE_NAME, "regions", encode_center_state, decode_center_state),),
+    markers=ServerMarkers(CENTER_MARKERS, draw),
 )

@@ -15,7 +15,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from swarm_controllers.api import Behaviour, behaviour_rng
-from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.behaviour import (
     CpfaBehaviour,
     CpfaState,
@@ -24,10 +23,12 @@ from swarm_controllers.cpfa.behaviour import (
     per_tick_probability,
     poisson_cdf,
 )
+from swarm_controllers.cpfa.config import CpfaConfig
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, PheromoneMessage, Pose2D
+from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = load_scenario("cpfa")

@@ -7,9 +7,9 @@ from __future__ import annotations
 import yaml
 
 from graph_helpers import overrides, run_graph
+from swarm_controllers.drtm.codec import NEST, NEST_REPORTS, NEST_STATE
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_msgs_py import topics
-from swarm_controllers.drtm.codec import NEST
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.recording import bag_info, read_bag
@@ -33,15 +33,15 @@ def test_drtm_graph_run_publishes_the_nest_state_every_tick(tmp_path):
     meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     qos = {t["topic_metadata"]["name"]: t["topic_metadata"]["offered_qos_profiles"]
            for t in meta["topics_with_message_count"]}
-    assert "transient_local" in str(qos[topics.NEST_STATE])  # latched: a late echo gets it at once
-    assert bag_info(bag).message_counts.get(topics.NEST_REPORTS, 0) > 0
+    assert "transient_local" in str(qos[NEST_STATE])  # latched: a late echo gets it at once
+    assert bag_info(bag).message_counts.get(NEST_REPORTS, 0) > 0
 
     states: list[NestState] = []
     reports: list[NestReport] = []
     for m in read_bag(bag):
-        if m.topic == topics.NEST_STATE:
+        if m.topic == NEST_STATE:
             states.extend(NEST.decode(m.data))
-        elif m.topic == topics.NEST_REPORTS:
+        elif m.topic == NEST_REPORTS:
             reports.extend(NEST.decode(m.data))
     ticks = round(DURATION / 0.1)
     assert [s.stamp_ns for s in states] == [k * 100_000_000 for k in range(ticks)]  # one per tick

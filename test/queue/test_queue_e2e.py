@@ -4,10 +4,11 @@ bag gives the same metrics as the in-process batch run of the same seed."""
 
 from __future__ import annotations
 
+from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_MARKERS, DEPOT_REPORTS, DEPOT_STATE, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
+from depot_manager.state import queue_lengths
 from graph_helpers import run_graph
 from swarm_msgs_py import server_state, topics
-from depot_manager.codec import DEPOT
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.batch import run_batch
@@ -28,19 +29,19 @@ def test_qmt_graph_run_delivers_at_docks_only(tmp_path):
     trace = load_run(bag)
     assert trace.drops and all(d.zone.startswith("dock_") for d in trace.drops)
     counts = bag_info(bag).message_counts
-    for topic in (topics.DEPOT_REPORTS, topics.DEPOT_GRANTS, topics.DEPOT_STATE, topics.DEPOT_MARKERS,
-                  topics.RADIO, topics.LOCKSTEP_ACK):
+    for topic in (DEPOT_REPORTS, DEPOT_GRANTS, DEPOT_STATE, DEPOT_MARKERS,
+                  RADIO_TOPIC, topics.LOCKSTEP_ACK):
         assert counts.get(topic, 0) > 0, topic
     assert counts[topics.LOCKSTEP_ACK] >= DURATION / 0.1
 
     grants, reports, lengths = [], [], []
     for m in read_bag(bag):
-        if m.topic == topics.DEPOT_GRANTS:
+        if m.topic == DEPOT_GRANTS:
             grants += DEPOT.decode(m.data)
-        elif m.topic == topics.DEPOT_REPORTS:
+        elif m.topic == DEPOT_REPORTS:
             reports += DEPOT.decode(m.data)
-        elif m.topic == topics.DEPOT_STATE:
-            lengths.append(server_state.queue_lengths(server_state.decode_state(m.data)[1]))
+        elif m.topic == DEPOT_STATE:
+            lengths.append(queue_lengths(server_state.decode_state(m.data)[1]))
     assert all(isinstance(g, DepotGrant) for g in grants) and all(isinstance(r, DepotReport) for r in reports)
     unloaded = {r.robot for r in reports if r.kind is ReportKind.UNLOADED}
     assert unloaded == {d.robot for d in trace.drops}

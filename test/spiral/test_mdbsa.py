@@ -14,6 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from depot_manager.protocol import DepotReport, ReportKind
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.spiral.center import (
     FORWARD,
     REVERSE,
@@ -22,22 +23,22 @@ from swarm_controllers.spiral.center import (
     region_paths,
     region_spiral,
 )
-from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
-from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, MdbsaBehaviour, MdbsaState
-from swarm_controllers.spiral.regions import RegionConfig
 from swarm_controllers.spiral.geometry import (
     mdbsa_path,
     region_centers,
     region_side,
     segments_overlap_collinear,
 )
+from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, MdbsaBehaviour, MdbsaState
+from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment
+from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import DropEvent, Observation, PheromoneMessage, Pose2D, robot_name
+from swarm_sim.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 C = load_scenario("mdbsa_c")

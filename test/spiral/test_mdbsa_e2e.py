@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 
 from graph_helpers import run_graph
-from swarm_controllers.spiral.protocol import RegionAssignment
+from swarm_controllers.spiral.codec import CENTER, CENTER_ASSIGNMENTS, CENTER_MARKERS, CENTER_REPORTS, CENTER_STATE
 from swarm_controllers.spiral.geometry import region_centers, region_side
+from swarm_controllers.spiral.protocol import RegionAssignment
 from swarm_msgs_py import topics
-from swarm_controllers.spiral.codec import CENTER
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry, load_run
 from swarm_sim.batch import run_batch
@@ -35,13 +35,13 @@ def test_mdbsa_d_graph_run_stays_in_assigned_regions(tmp_path):
 
     scenario = load_scenario("mdbsa_d", [f"robots.count={ROBOTS}"])
     counts = bag_info(bag).message_counts
-    for topic in (topics.CENTER_REPORTS, topics.CENTER_ASSIGNMENTS, topics.CENTER_STATE,
-                  topics.CENTER_MARKERS, topics.LOCKSTEP_ACK):
+    for topic in (CENTER_REPORTS, CENTER_ASSIGNMENTS, CENTER_STATE,
+                  CENTER_MARKERS, topics.LOCKSTEP_ACK):
         assert counts.get(topic, 0) > 0, topic
 
     assignments: dict[str, list[tuple[float, int]]] = {}
     for m in read_bag(bag):
-        if m.topic == topics.CENTER_ASSIGNMENTS:
+        if m.topic == CENTER_ASSIGNMENTS:
             for a in CENTER.decode(m.data):
                 assert isinstance(a, RegionAssignment)
                 assignments.setdefault(a.robot, []).append((a.stamp_ns / NS_PER_S, a.region))
