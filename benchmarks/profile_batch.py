@@ -8,7 +8,7 @@ Each (scenario, robots) pair is run with the same seed plain (only the tick wind
 the real-time factor) and instrumented, alternated ``--repeat`` times; the table is the
 instrumented run of median length, the real-time factor the plain runs' median. The instrumented run is `run_batch`
 itself, untouched: the benchmark swaps the names `swarm_sim.batch` looks up (`World`,
-`make_servers`, `Router`, `PerimeterLog`, ...), the world's scan functions and the behaviour
+`make_servers`, `Router`, `make_probes`, ...), the world's scan functions and the behaviour
 class's ``step`` for versions wrapped in a `time.perf_counter` timer, and restores them
 afterwards. A timer stack gives each phase its exclusive time (a behaviour's obstacle avoidance
 is taken out of the behaviour, the scan out of ``World.observe``), and Python's garbage
@@ -17,8 +17,9 @@ phases plus "other" add up to the measured tick exactly. "other" is what no wrap
 `run_batch`'s own loop (the commands dict, the message loop) and the timers' own cost.
 
 The measured ticks run from the start of the first tick after ``--warmup`` sim seconds to the
-end of the last: tick boundaries are the calls of ``PerimeterLog.update`` (the statement that
-opens every tick of `run_batch` and follows its last one). Set-up, the final status and the
+end of the last: tick boundaries are the calls of the probes' ``update`` (`make_probes`: the
+statement that opens every tick of `run_batch` and follows its last one; a marker probe is added
+first). Set-up, the final status and the
 trace's wrap-up are not per-tick work and are left out. The robots start on a grid around the
 depot, so the first minute's ticks are the crowded ones (more robot pairs within scan range).
 
@@ -181,6 +182,19 @@ def _patched(targets: list[tuple[Any, str, Any]]) -> Iterator[None]:
             setattr(obj, name, value)
 
 
+class TickMarker:
+    """A probe that observes nothing: its ``update`` opens each measured tick (`TickWindow`)."""
+
+    def __init__(self, window: Any, timers: Any) -> None:
+        self._window, self._timers = window, timers
+
+    def update(self, _t: float, _xy: Any) -> None:
+        self._window.mark(self._timers)
+
+    def result(self) -> None:
+        return None
+
+
 def profile_run(
     scenario: Scenario, *, instrument: bool = True, warmup_ticks: int = 0, record_poses: bool = False
 ) -> Profile:
@@ -188,7 +202,7 @@ def profile_run(
     after the first `warmup_ticks`."""
     timers = Timers() if instrument else None
     window = TickWindow(warmup_ticks)
-    world_cls, perimeter_cls, router_cls = batch.World, batch.PerimeterLog, batch.Router
+    world_cls, probes_of, router_cls = batch.World, batch.make_probes, batch.Router
     wrap = timers.wrap if timers else (lambda _name, fn: fn)
 
     def make_world(s: Scenario) -> Any:
@@ -221,19 +235,14 @@ def profile_run(
         })
         return router
 
-    def make_perimeter(*args: Any) -> Any:
-        log = perimeter_cls(*args)
-        update = wrap("bookkeeping: perimeter log", log.update)
-
-        def update_marked(t: float, xy: Any) -> None:
-            window.mark(timers)
-            update(t, xy)
-
-        log.update = update_marked
-        return log
+    def make_probes(*args: Any) -> dict[str, Any]:
+        probes = probes_of(*args)
+        for probe in probes.values():
+            probe.update = wrap("bookkeeping: probes (perimeter log)", probe.update)
+        return {"tick marker": TickMarker(window, timers), **probes}
 
     batch_make_servers = batch.make_servers
-    targets: list[tuple[Any, str, Any]] = [(batch, "World", make_world), (batch, "PerimeterLog", make_perimeter)]
+    targets: list[tuple[Any, str, Any]] = [(batch, "World", make_world), (batch, "make_probes", make_probes)]
     if timers is not None:
         # The behaviours have slots (no instance attribute can shadow a method): their class's
         # step is timed, for the run only. A throwaway behaviour names the class.

@@ -22,18 +22,20 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import chain
+from typing import Any
 from operator import attrgetter, call
 
 import numpy as np
 
 from swarm_controllers.api import behaviour_rng
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
-from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
+from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
+from swarm_sim.registry import probes as registered_probes
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
@@ -69,6 +71,12 @@ def _few_collections() -> Iterator[None]:
         gc.unfreeze()
 
 
+def make_probes(scenario: Scenario, robots: tuple[str, ...]) -> dict[str, Any]:
+    """The observers of the probes that measure the run's task (`swarm_sim.registry.Probe`), by
+    name; each is fed the odometry positions at the start of every tick and after the last."""
+    return {p.name: resolve(p.observer)(scenario, robots) for p in registered_probes(of(scenario).task)}
+
+
 def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
     with _few_collections():
         return _run_batch(scenario, record_poses)
@@ -87,7 +95,8 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
         scenario=scenario.name, seed=scenario.seed, robots=robots, sim_seconds=0.0,
         wall_seconds=0.0, total_resources=scenario.resources.count, mode="batch", config=scenario,
     )
-    perimeter = PerimeterLog(robots, scenario.depot.center, scenario.depot.perimeter_radius)
+    probes = make_probes(scenario, robots)
+    observers = tuple(probes.values())
     poses = np.zeros((scenario.ticks + 1, len(robots), 3)) if record_poses else None
     algorithm = of(scenario)
     spec = task(algorithm.task).state
@@ -100,7 +109,8 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
         obs = world.reset()
         _record_state(world, state_topics, trace)
         for k in range(scenario.ticks):
-            perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
+            for observer in observers:
+                observer.update(world.t_ns / NS_PER_S, world.odometry_positions)
             if poses is not None:
                 poses[k] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
             # Each behaviour's inbox: every message stamped before this tick has been posted (the
@@ -129,14 +139,15 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
                 if poses is not None:
                     poses = poses[:k + 2]
                 break
-        perimeter.update(world.t_ns / NS_PER_S, world.odometry_positions)
+        for observer in observers:
+            observer.update(world.t_ns / NS_PER_S, world.odometry_positions)
         if poses is not None:
             poses[-1] = [(o.pose.x, o.pose.y, o.pose.yaw) for o in obs.values()]
         status = {r: b.status(last_step_ns) for r, b in behaviours.items()}
         trace.sim_seconds = world.t_ns / NS_PER_S
         trace.stats = {r: dataclasses.replace(s) for r, s in world.stats.items()}
         trace.status = status
-        trace.perimeter_entries, trace.perimeter_exits = perimeter.entries, perimeter.exits
+        trace.probes = {name: observer.result() for name, observer in probes.items()}
         trace.messages.sort(key=delivery_order)
     finally:
         world.close()

@@ -53,7 +53,8 @@ ROS_BLOCKER = textwrap.dedent(
 
 WALL_FIELDS = ("wall_seconds", "real_time_factor", "mode")
 GRAPH_COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
-                  "trips_by_robot", "clamped_commands", "stale_ticks", "dropoff_times_s")
+                  "trips_by_robot", "clamped_commands", "stale_ticks")
+"""Compared between the graph and the batch run, with every probe's per-event lists."""
 
 
 class ConformanceError(AssertionError):
@@ -205,9 +206,9 @@ def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch
     if result.returncode != 0:
         _fail("graph_equals_batch", f"swarm-run failed: {(result.stderr.strip().splitlines() or ['?'])[-1]}")
     graph = json.loads(result.stdout.strip().splitlines()[-1])
-    for key in GRAPH_COMPARED:
+    for key in (*GRAPH_COMPARED, *(field for p in registry.probes() for field, _ in p.details)):
         if key not in graph and key not in batch_summary:
-            continue  # a field of another world task (dropoff_times_s: foraging)
+            continue  # a probe of another world task
         if graph.get(key) != batch_summary.get(key):
             _fail("graph_equals_batch", f"{key}: graph {graph.get(key)!r} != batch {batch_summary.get(key)!r}")
     odometry = load_odometry(bag)

@@ -106,9 +106,32 @@ class TaskSpec:
     bag replay keep each as the time series ``RunTrace.series[field]`` (None: none)."""
     headline: tuple[Measure, ...] = ()
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
+    extends: str | None = None
+    """The task it builds on (the DRTM nest is the foraging task with food and a light): the
+    probes of that task measure its runs too."""
     world: tuple[tuple[str, str], ...] = ()
     """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
     section (a `swarm_sim.scenario.WorldSection`)."""
+
+
+@dataclass(frozen=True)
+class Probe:
+    """A measurement a package makes in every run of the world tasks it names, beyond the tasks'
+    own metrics (the queue paper's perimeter crossings, which it reports for every foraging run):
+    an observer of the robots' odometry positions, fed every tick by the batch runner as they
+    are stepped and by the bag replay as they were recorded, and the result fields it yields."""
+
+    name: str
+    tasks: tuple[str, ...]
+    """The world tasks whose runs it measures."""
+    observer: str
+    """``module:Class`` built as ``Class(scenario, robots)``; ``update(t [s], xy)`` with the
+    (robots, 2) odometry positions [m, world frame] every tick; ``result()`` -> what its metrics
+    read as ``RunTrace.probes[name]``."""
+    metrics: str
+    """``module:function`` ``(trace) -> dict`` of its JSON result fields."""
+    details: tuple[tuple[str, str], ...] = ()
+    """(list field, count field): per-event lists that sweeps store as their length only."""
 
 
 @dataclass(frozen=True)
@@ -183,6 +206,7 @@ class Algorithm:
 _ALGORITHMS: dict[str, Algorithm] = {}
 _TASKS: dict[str, TaskSpec] = {}
 _DELIVERIES: dict[str, DeliveryKind] = {}
+_PROBES: dict[str, Probe] = {}
 _DEFAULT_SCENARIO: list[str] = []
 """The scenario that a registration declared the commands' default (`register_default_scenario`)."""
 _PACKAGES: dict[str, Path] = {}
@@ -265,6 +289,25 @@ def register_delivery(kind: DeliveryKind) -> DeliveryKind:
         raise ValueError(f"delivery kind {kind.name!r} is already registered")
     _DELIVERIES[kind.name] = kind
     return kind
+
+
+def register_probe(probe: Probe) -> Probe:
+    """Make `probe` known; refuses a second record of the same name."""
+    if probe.name in _PROBES:
+        raise ValueError(f"probe {probe.name!r} is already registered")
+    _PROBES[probe.name] = probe
+    return probe
+
+
+def probes(task_name: str | None = None) -> tuple[Probe, ...]:
+    """The probes that measure runs of world task `task_name` or of a task it extends (None:
+    every probe)."""
+    _load_entries()
+    lineage = set()
+    while task_name is not None and task_name not in lineage:
+        lineage.add(task_name)
+        task_name = _TASKS[task_name].extends if task_name in _TASKS else None
+    return tuple(p for p in _PROBES.values() if not lineage or lineage & set(p.tasks))
 
 
 def register_default_scenario(name: str) -> None:

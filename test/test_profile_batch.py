@@ -35,7 +35,7 @@ def test_phases_add_up_and_the_run_is_unchanged():
     assert abs(sum(prof.phases.values()) - prof.window_s) <= 0.05 * prof.window_s
     assert prof.window_s <= prof.run_s
     for phase in ("world: physics: pybullet stepSimulation", "world: ray casting", "behaviours: QueueBehaviour.step",
-                  "behaviours: obstacle avoidance", "servers: DepotServer.step", "bookkeeping: perimeter log"):
+                  "behaviours: obstacle avoidance", "servers: DepotServer.step", "bookkeeping: probes (perimeter log)"):
         assert any(name.startswith(phase) for name in prof.phases), (phase, sorted(prof.phases))
     assert prof.calls["behaviours: QueueBehaviour.step"] == 4 * scenario.ticks
     plain = run_batch(scenario, record_poses=True)

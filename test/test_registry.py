@@ -122,3 +122,19 @@ def test_a_server_is_found_by_its_channel_and_built_from_its_record():
 
 
 _BAD_OUTPUTS = ServerOutputs(series=(Series("/nowhere", lambda value: {}),))
+
+
+def test_a_probe_measures_its_tasks_and_the_tasks_that_extend_them():
+    """The queue paper's perimeter crossings are measured in every foraging run (the DRTM nest
+    extends the foraging task), not in the transport task's; a second record is refused."""
+    (perimeter,) = registry.probes("foraging")
+    assert perimeter.name == "perimeter" and registry.probes("nest") == (perimeter,)
+    assert registry.probes("transport") == () and registry.probes("beacon") == ()
+    with pytest.raises(ValueError, match="probe 'perimeter' is already registered"):
+        registry.register_probe(perimeter)
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.batch import run_batch
+
+    caging = summarize(run_batch(load_scenario("caging", ["sim.duration=1.0"])).trace)
+    drtm = summarize(run_batch(load_scenario("drtm", ["sim.duration=1.0"])).trace)
+    assert "dropoff_times_s" not in caging and drtm["dropoff_times_s"] == []

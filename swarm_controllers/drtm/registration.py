@@ -8,6 +8,7 @@ register_task(TaskSpec(
     core="swarm_controllers.drtm.task:NestTask",
     sensing="swarm_controllers.drtm.sensing:SENSING",
     metrics="swarm_sim.analysis.metrics:foraging_metrics",
+    extends="foraging",
 ))
 
 _SECTIONS = (("nest", "swarm_controllers.drtm.config:NestConfig"),

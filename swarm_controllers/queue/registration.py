@@ -4,12 +4,30 @@ manager's server in the top-level `depot_manager` package."""
 
 from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES
 from swarm_controllers.cpfa.registration import SECTION as CPFA_SECTION
-from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, ServerSpec, register, register_delivery
+from swarm_sim.registry import (
+    Algorithm,
+    DeliveryKind,
+    Measure,
+    Metric,
+    Probe,
+    ServerSpec,
+    register,
+    register_delivery,
+    register_probe,
+)
 
 register_delivery(DeliveryKind(
     name="docks",
     zones="depot_manager.docks:dock_zones",
     checks=("depot_manager.docks:check_docks",),
+))
+
+register_probe(Probe(
+    name="perimeter",
+    tasks=("foraging",),
+    observer="swarm_controllers.queue.perimeter:PerimeterLog",
+    metrics="swarm_controllers.queue.perimeter:perimeter_metrics",
+    details=(("dropoff_times_s", "dropoff_count"),),
 ))
 
 register(Algorithm(

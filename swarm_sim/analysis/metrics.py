@@ -7,44 +7,14 @@ trace, so a metric is defined once and means the same thing for both kinds of ru
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from swarm_sim.registry import delivery_zones
+from swarm_sim import registry
 from swarm_sim.scenario import Scenario
-from swarm_sim.sites import drop_zones
 from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
-
-
-class PerimeterLog:
-    """When each robot crossed into the depot perimeter (queue paper sec. III: the drop-off
-    time runs from entering the perimeter to the drop). Fed the odometry poses every tick, by
-    the batch runner as they are stepped and by `swarm-analyze` as they were recorded."""
-
-    def __init__(self, robots: tuple[RobotId, ...], center: tuple[float, float], radius: float) -> None:
-        self.robots = robots
-        self._center = np.asarray(center, dtype=float)
-        self._r2 = radius * radius
-        self._inside = np.zeros(len(robots), dtype=bool)
-        self.entries: dict[RobotId, list[float]] = {r: [] for r in robots}
-        """Per robot, the sim times [s] it entered the perimeter disc."""
-        self.exits: dict[RobotId, list[float]] = {r: [] for r in robots}
-        """Per robot, the sim times [s] it left the perimeter disc."""
-
-    def update(self, t: float, xy: np.ndarray) -> None:
-        """`xy`: (robots, 2) positions at time `t` [m, world frame], in `robots` order."""
-        d = np.asarray(xy, dtype=float) - self._center
-        inside = np.einsum("ij,ij->i", d, d) < self._r2
-        if np.array_equal(inside, self._inside):  # nobody crossed (almost every tick)
-            return
-        for i in np.flatnonzero(inside & ~self._inside):
-            self.entries[self.robots[i]].append(t)
-        for i in np.flatnonzero(~inside & self._inside):
-            self.exits[self.robots[i]].append(t)
-        self._inside = inside
 
 
 @dataclass
@@ -66,10 +36,8 @@ class RunTrace:
     """Each behaviour's last published status."""
     config: Scenario | None = None
     """The scenario the run used (world facts the metrics need: docks, perimeter, regions)."""
-    perimeter_entries: dict[RobotId, list[float]] = field(default_factory=dict)
-    """`PerimeterLog.entries`."""
-    perimeter_exits: dict[RobotId, list[float]] = field(default_factory=dict)
-    """`PerimeterLog.exits`."""
+    probes: dict[str, Any] = field(default_factory=dict)
+    """What each probe of the run's task observed (`swarm_sim.registry.Probe`), by name."""
     server_stale: dict[str, int] = field(default_factory=dict)
     """Lockstep ticks each server (by channel) did not acknowledge in time (graph runs)."""
     malformed: dict[str, int] = field(default_factory=dict)
@@ -129,58 +97,6 @@ def trips_by_robot(trace: RunTrace) -> dict[RobotId, int]:
     return trips
 
 
-def dock_arrival_s(trace: RunTrace, drop: DropEvent) -> float:
-    """When the carrier reached the zone it dropped in [s]: the drop's time less the zone's
-    dwell (T_unload at a dock) rounded up to whole ticks, as the foraging task drops on the
-    first tick the carrier has been inside for the dwell (`swarm_sim.world.tasks.foraging`)."""
-    t = drop.stamp_ns / NS_PER_S
-    if trace.config is None:
-        return t
-    dwell = {z.name: z.dwell for z in drop_zones(trace.config)}.get(drop.zone, 0.0)
-    dt = trace.config.sim.dt
-    return t - math.ceil(dwell / dt - 1e-9) * dt if dwell > 0 else t
-
-
-def dropoff_times(trace: RunTrace) -> list[float]:
-    """Per delivery, the time from the carrier's last entry into the perimeter to its arrival at
-    the dock, before T_unload (queue paper sec. VII, metric 3: "entering the red circular region"
-    to "dropping off a resource at a designated dock"; the authors' controllers stop this clock
-    on reaching the nest, before their ``Wait(5)``: ``CPFA_controller::FollowingEntryPath`` in
-    Tameem786/Collision_Free_CPFA); deliveries without a recorded entry are skipped [s]."""
-    out = []
-    for d in trace.drops:
-        t = d.stamp_ns / NS_PER_S
-        entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
-        if entered:
-            out.append(dock_arrival_s(trace, d) - entered[-1])
-    return out
-
-
-def perimeter_delays(trace: RunTrace) -> list[float]:
-    """Per delivery, the queue paper's *time delay* (sec. III): from the carrier's last entry
-    into the perimeter before the drop to its first exit after it [s]; deliveries whose robot
-    had not left again by the end of the run are skipped."""
-    out = []
-    for d in trace.drops:
-        t = d.stamp_ns / NS_PER_S
-        entered = [e for e in trace.perimeter_entries.get(d.robot, ()) if e <= t]
-        left = [e for e in trace.perimeter_exits.get(d.robot, ()) if e >= t]
-        if entered and left:
-            out.append(left[0] - entered[-1])
-    return out
-
-
-def deliveries_outside_docks(trace: RunTrace) -> int | None:
-    """Drops farther than the dock radius from every dock stop (None without a scenario)."""
-    if trace.config is None:
-        return None
-    stops = np.array([z.center for z in delivery_zones(trace.config, "docks")])
-    radius = trace.config.depot.dock_radius + 1e-6
-    return sum(
-        1 for d in trace.drops if np.min(np.hypot(stops[:, 0] - d.x, stops[:, 1] - d.y)) > radius
-    )
-
-
 def rejected_messages(trace: RunTrace) -> dict[str, dict[str, int]]:
     """Messages dropped by every node, summed: {topic or message class: {reason: count}}."""
     out: dict[str, dict[str, int]] = {}
@@ -232,33 +148,26 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
 
 
 def foraging_metrics(trace: RunTrace) -> dict[str, Any]:
-    """The foraging task's per-run metrics: the queue paper's (resources collected, drop-off
-    time, time delay, deliveries outside docks) and the MDBSA paper's (resources per robot,
-    foraging rate)."""
+    """The foraging task's per-run metrics: the share of the resources collected, resources per
+    robot and the foraging rate."""
     delivered = resources_delivered(trace)
-    dropoff = dropoff_times(trace)
-    delay = perimeter_delays(trace)
     minutes = trace.sim_seconds / 60.0
     return {
         "resources_collected_pct": round(100.0 * delivered / trace.total_resources, 6)
         if trace.total_resources else 0.0,
-        "dropoff_time_mean_s": round(float(np.mean(dropoff)), 6) if dropoff else None,
-        "dropoff_times_s": [round(v, 3) for v in dropoff],
-        "perimeter_delay_mean_s": round(float(np.mean(delay)), 6) if delay else None,
-        "deliveries_outside_docks": deliveries_outside_docks(trace),
         "resources_per_robot": round(delivered / len(trace.robots), 6) if trace.robots else 0.0,
         "foraging_rate_per_min": round(delivered / minutes, 6) if minutes > 0 else 0.0,
     }
 
 
 def _registered_metrics(trace: RunTrace) -> dict[str, Any]:
-    """The world task's metrics, then every metric an algorithm registers (runs of algorithms
-    that do not declare one report its default, so every run has the same fields)."""
-    from swarm_sim import registry
-
+    """The world task's metrics and its probes', then every metric an algorithm registers (runs
+    of algorithms that do not declare one report its default, so every run has the same fields)."""
     ours = registry.of(trace.config) if trace.config is not None else None
     task = registry.task(ours.task if ours is not None else "foraging")
     out = registry.resolve(task.metrics)(trace) if task.metrics else {}
+    for probe in registry.probes(task.name):
+        out.update(registry.resolve(probe.metrics)(trace))
     mine = {m.name for m in ours.metrics} if ours is not None else set()
     for a in registry.algorithms():
         for m in a.metrics:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, topics
 from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_sim import registry
-from swarm_sim.analysis.metrics import PerimeterLog, RunTrace
+from swarm_sim.analysis.metrics import RunTrace
 from swarm_sim.messaging import delivery_order
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
@@ -100,7 +101,7 @@ def load_run(path: Path | str) -> RunTrace:
     elif "sim_seconds" not in meta:  # the world died before it wrote its totals: the data ends where it ends
         trace.ended = "cut off"
         trace.sim_seconds = last_clock / NS_PER_S
-    trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
+    trace.probes = _probes(trace, positions)
     return trace
 
 
@@ -118,19 +119,20 @@ def _server_stale(path: Path, text: str) -> dict[str, int]:
     return {}
 
 
-def _perimeter_log(trace: RunTrace, positions: dict[int, np.ndarray]) -> tuple[dict, dict]:
-    """Replay the recorded odometry through the `PerimeterLog` the batch runner feeds live (a
-    robot missing from a tick keeps its previous position)."""
-    depot = trace.config.depot
-    log = PerimeterLog(trace.robots, depot.center, depot.perimeter_radius)
+def _probes(trace: RunTrace, positions: dict[int, np.ndarray]) -> dict[str, Any]:
+    """Replay the recorded odometry through the probes the batch runner feeds live
+    (`swarm_sim.registry.Probe`; a robot missing from a tick keeps its previous position)."""
+    observers = {p.name: registry.resolve(p.observer)(trace.config, trace.robots)
+                 for p in registry.probes(registry.of(trace.config).task)}
     previous = np.full((len(trace.robots), 2), np.inf)
     for stamp in sorted(positions):
         xy = positions[stamp]
         missing = np.isnan(xy[:, 0])
         xy[missing] = previous[missing]
-        log.update(stamp / NS_PER_S, xy)
+        for observer in observers.values():
+            observer.update(stamp / NS_PER_S, xy)
         previous = xy
-    return log.entries, log.exits
+    return {name: observer.result() for name, observer in observers.items()}
 
 
 def load_odometry(path: Path | str) -> dict[str, np.ndarray]:

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from swarm_sim import registry
 from swarm_sim.compare.report import fmt
 from swarm_sim.executors import Executor, LocalExecutor, Progress
 
@@ -57,10 +58,11 @@ class RunPlan:
 
 
 def slim(summary: dict[str, Any]) -> dict[str, Any]:
-    """A summary without the per-robot dicts and the per-delivery drop-off list (their means stay)."""
-    row = {k: v for k, v in summary.items() if not k.endswith("_by_robot") and k != "dropoff_times_s"}
-    if "dropoff_times_s" in summary:
-        row["dropoff_count"] = len(summary["dropoff_times_s"])
+    """A summary without the per-robot dicts and the probes' per-event lists, each of which
+    is kept as its length (`swarm_sim.registry.Probe.details`); their means stay."""
+    details = dict(d for p in registry.probes() for d in p.details)
+    row = {k: v for k, v in summary.items() if not k.endswith("_by_robot") and k not in details}
+    row.update({count: len(summary[field]) for field, count in details.items() if field in summary})
     return row
 
 

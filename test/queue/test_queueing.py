@@ -156,13 +156,14 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
 
 
 def test_dropoff_time_stops_at_the_dock_before_t_unload():
-    from swarm_sim.analysis.metrics import RunTrace, dock_arrival_s, dropoff_times
+    from swarm_controllers.queue.perimeter import PROBE, Crossings, dock_arrival_s, dropoff_times
+    from swarm_sim.analysis.metrics import RunTrace
     from swarm_sim.types import DropEvent
 
     s = load_scenario("queue_qmt")
     drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)
     trace = RunTrace("queue_qmt", 0, ("robot_0",), 120.0, 1.0, 320, "batch", drops=[drop], config=s,
-                     perimeter_entries={"robot_0": [10.0, 40.0]})
+                     probes={PROBE: Crossings(entries={"robot_0": [10.0, 40.0]})})
     # the foraging task drops on the first tick the carrier has been inside for T_unload
     assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - s.depot.unload_time)
     assert dropoff_times(trace) == [pytest.approx(100.0 - s.depot.unload_time - 40.0)]
