@@ -33,6 +33,7 @@ from swarm_sim.scenario import load_scenario  # noqa: E402
 from swarm_sim.types import Command  # noqa: E402
 from swarm_sim.world import World  # noqa: E402
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet  # noqa: E402
+from swarm_sim.registry import task_factory
 
 BLOCK = 20
 """Ticks per timing block."""
@@ -131,7 +132,7 @@ def bench_world(robots: int, backend: str, ticks: int, spread_after: int, jammed
     """Phases: "start" (wandering off the start grid), "spread" (wandering after `spread_after`
     ticks), "jammed" (everyone pushing towards the depot centre after 400 ticks of homing)."""
     s = load_scenario("cpfa", robots__count=robots, sensors__scan__backend=backend)
-    world = World(s)
+    world = World(s, task_factory(s))
     wander, homing = Wander(world.robots, s.sensors.scan.rays), Homing(world.robots)
     obs = world.reset()
     phases, parts = {}, {}
@@ -168,7 +169,7 @@ def bench_raycast(repeats: int = 200) -> None:
     layouts = {"crowded (start grid)": grid, "spread (uniform)": rng.uniform(-5.8, 5.8, (112, 2))}
     yaw = rng.uniform(-math.pi, math.pi, 112)
     scene = StaticScene.from_scenario(s)
-    world = World(s)
+    world = World(s, task_factory(s))
     try:
         for name, pos in layouts.items():
             world.teleport({r: _pose(pos[k], yaw[k]) for k, r in enumerate(world.robots)})

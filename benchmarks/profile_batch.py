@@ -205,8 +205,8 @@ def profile_run(
     world_cls, probes_of, router_cls = batch.World, batch.make_probes, batch.Router
     wrap = timers.wrap if timers else (lambda _name, fn: fn)
 
-    def make_world(s: Scenario) -> Any:
-        world = world_cls(s)
+    def make_world(s: Scenario, *args: Any) -> Any:
+        world = world_cls(s, *args)
         task = world.task
         _instrument_instance(world, timers, {
             "_physics": "world: physics: per-body velocities + contact loop (Python)",

@@ -41,9 +41,12 @@ from launch_py.dds import (
     server_profile,
 )
 from swarm_sim import registry
+from swarm_sim.analysis.metrics import summarize
+from swarm_sim.analysis.replay import load_run
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.recording import repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
@@ -229,10 +232,6 @@ def main(argv: list[str] | None = None) -> int:
     if world_died:
         print(f"[swarm-run] the world node (pid {world.pid}) {_how(world.returncode)}: the run stopped early; "
               f"repairing the bag's cut-off last file", file=sys.stderr, flush=True)
-
-    from swarm_sim.analysis.metrics import summarize
-    from swarm_sim.analysis.replay import load_run
-    from swarm_sim.recording import repair_bag
 
     try:
         if world_died:

@@ -34,7 +34,7 @@ from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
+from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task, task_factory
 from swarm_sim.registry import probes as registered_probes
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
@@ -84,7 +84,7 @@ def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:
 
 def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
     wall0 = time.monotonic()
-    world = World(scenario)
+    world = World(scenario, task_factory(scenario))
     robots = world.robots
     behaviours = {r: make_behaviour(scenario, r, behaviour_rng(scenario.seed, r)) for r in robots}
     steps = [b.step for b in behaviours.values()]  # robot order, bound once: stepped every tick

@@ -33,7 +33,12 @@ import numpy as np
 
 from swarm_msgs_py.server_outputs import outputs_of
 from swarm_sim import registry
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.analysis.metrics import summarize
+from swarm_sim.analysis.replay import load_odometry
+from swarm_sim.batch import run_batch
+from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
+from swarm_sim.types import Command
+from swarm_sim.world import World
 
 ROS_BLOCKER = textwrap.dedent(
     """
@@ -96,17 +101,12 @@ def check_ros_free(algorithm: registry.Algorithm, scenario: Scenario) -> None:
 
 
 def _short(scenario: Scenario, duration: float) -> dict[str, Any]:
-    from swarm_sim.scenario import scenario_to_dict
-
     data = scenario_to_dict(scenario)
     data["sim"]["duration"] = duration
     return data
 
 
 def _batch(scenario: Scenario) -> tuple[dict[str, Any], np.ndarray]:
-    from swarm_sim.analysis.metrics import summarize
-    from swarm_sim.batch import run_batch
-
     run = run_batch(scenario, record_poses=True)
     summary = {k: v for k, v in summarize(run.trace).items() if k not in WALL_FIELDS}
     return summary, run.poses
@@ -159,14 +159,12 @@ def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
                 _fail("codecs", f"{cls.__name__}: {exc}")
             if decoded != (message,):
                 _fail("codecs", f"{cls.__name__} came back as {decoded!r}")
-    from swarm_sim.world import World
 
     sensing = registry.resolve(registry.task(algorithm.task).sensing)
-    from swarm_sim.types import Command
 
     state = registry.task(algorithm.task).state
     state_topics = registry.resolve(state) if state else ()
-    with World(scenario) as world:  # robots drive in circles so that what they sense changes
+    with World(scenario, registry.task_factory(scenario)) as world:  # robots drive in circles so that what they sense changes
         observations = [world.reset()]
         states = [(world.t_ns, world.task.state())] if state_topics else []
         turn = Command(scenario.robots.max_linear_speed, 0.5)
@@ -198,8 +196,6 @@ def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
 def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch_summary: dict[str, Any],
                              batch_poses: np.ndarray, bag: Path, domain_id: int) -> None:
     """`scenario_args`: swarm-run arguments that load exactly `scenario`."""
-    from swarm_sim.analysis.replay import load_odometry
-
     cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json", "--tick-timeout", "20",
            "--domain-id", str(domain_id), *scenario_args]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=dict(os.environ))

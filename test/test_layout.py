@@ -13,8 +13,7 @@ from collections.abc import Iterator
 from importlib.metadata import entry_points
 from pathlib import Path
 
-import pytest
-
+from swarm_msgs_py.server_outputs import outputs_of
 from swarm_sim import registry
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -27,11 +26,11 @@ COMMON_WORDS = {
     "center": "the spiral paper's server channel, and a plain word (a disc's centre, matplotlib's loc)",
 }
 """Names a paper uses that are also the shared core's own words, and why."""
+UNTIL_REBUILT = {"swarm_sim.nodes.foxglove_layout": "the shipped live layout, rebuilt from the records with the viewers (issue 28)"}
+"""Shared modules still naming a paper, each with the work that removes the names; the test fails
+once a module here names none (take it off the list then)."""
 LAZY = "lazy:"
 """What the comment on (or just above) a function-local import of a project module starts with."""
-
-
-PENDING = pytest.mark.xfail(strict=True, reason="issue 23: the scenario split and the graph endpoint are on their way")
 
 
 def _modules() -> dict[str, Path]:
@@ -141,7 +140,6 @@ def test_no_import_circles():
     assert "swarm_sim.scenario" not in graph["swarm_sim.registry"]
 
 
-@PENDING
 def test_function_local_imports_of_project_modules_say_why():
     unexplained = []
     for module, path in MODULES.items():
@@ -167,6 +165,8 @@ def _paper_names() -> dict[str, tuple[set[str], set[str]]]:
         fields |= {m.name for m in a.metrics}
         families = [registry.resolve(f) for f in (*a.peers, *(s.family for s in a.servers))]
         strings |= {t for f in families for t in f.topics.values()}
+        for out in map(outputs_of, a.servers):
+            strings |= {st.topic for st in out.state} | ({out.markers.topic} if out.markers else set())
         if registry.origin("task", a.task) == paper:
             task = registry.task(a.task)
             strings.add(task.name)
@@ -209,10 +209,15 @@ def test_no_paper_name_outside_its_package():
         if not shared:
             continue
         identifiers, strings = _code_words(path)
+        hits_here = []
         for paper, (spelt, fields) in papers.items():
             hits = sorted(((spelt | fields) & strings | fields & identifiers) - set(COMMON_WORDS))
             if hits:
-                found.append(f"{module}: {paper}'s {', '.join(hits)}")
+                hits_here.append(f"{module}: {paper}'s {', '.join(hits)}")
+        if module in UNTIL_REBUILT:
+            assert hits_here, f"{module} names no paper now: take it off UNTIL_REBUILT"
+        else:
+            found += hits_here
     assert found == []
 
 

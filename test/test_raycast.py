@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from swarm_sim.registry import task_factory
 from swarm_sim.scenario import ObstacleConfig, ScanConfig, load_scenario
 from swarm_sim.types import Pose2D
 from swarm_sim.world import World
@@ -343,7 +344,8 @@ def _world_with(scene: StaticScene, n: int, rays: int, backend: str = "analytic"
     boxes = [ObstacleConfig("box", (x, y), (2 * hx, 2 * hy), yaw) for x, y, hx, hy, yaw in scene.boxes]
     obstacles = (*cylinders, *boxes)
     s = load_scenario("cpfa", robots__count=n, sensors__scan__rays=rays, sensors__scan__backend=backend)
-    return World(dataclasses.replace(s, obstacles=obstacles))
+    s = dataclasses.replace(s, obstacles=obstacles)
+    return World(s, task_factory(s))
 
 
 BULLET_TOLERANCE = 2e-3
@@ -386,7 +388,7 @@ def test_world_observations_use_the_configured_backend():
     out, poses = {}, None
     for backend in ("analytic", "pybullet"):
         s = load_scenario("cpfa", robots__count=9, sensors__scan__backend=backend)
-        with World(s) as w:
+        with World(s, task_factory(s)) as w:
             out[backend] = np.stack([o.ranges for o in w.reset().values()])
             poses = list(w.true_poses().values())
     pos = np.array([[q.x, q.y] for q in poses])
@@ -403,7 +405,7 @@ def test_world_observations_use_the_configured_backend():
 
 def test_pybullet_threads_do_not_change_the_scan():
     s = load_scenario("cpfa", robots__count=16, sensors__scan__backend="pybullet")
-    one, two = World(s, scan_threads=1), World(s, scan_threads=2)
+    one, two = World(s, task_factory(s), scan_threads=1), World(s, task_factory(s), scan_threads=2)
     try:
         a, b = one.reset(), two.reset()
         assert all(np.array_equal(a[r].ranges, b[r].ranges) for r in one.robots)

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_sim.geometry import wire_yaw, wrap_angle
+from swarm_sim.registry import task_factory
 from swarm_sim.scenario import (
     DropZoneConfig,
     NoiseConfig,
@@ -35,7 +36,7 @@ def make_world():
     worlds: list[World] = []
 
     def make(s: Scenario, seed: int | None = None) -> World:
-        worlds.append(World(s, seed))
+        worlds.append(World(s, task_factory(s), seed))
         return worlds[-1]
 
     yield make
@@ -301,7 +302,7 @@ def test_resources_in_reach_by_cells_are_those_of_testing_every_pair(seed, robot
     rng = np.random.default_rng(seed)
     s = load_scenario("cpfa", robots__count=robots, arena__size=6.0, depot__radius=0.3,
                       resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
-    with World(s) as w:
+    with World(s, task_factory(s)) as w:
         w.teleport({r: Pose2D(*rng.uniform(-3.5, 3.5, 2), 0.0) for r in w.robots})  # the arena: +-3 m
         task = w.task
         pos, r = w.positions, task._near_r
@@ -501,7 +502,7 @@ def test_a_missing_robot_keeps_its_previous_command(make_world):
 def test_an_impossible_layout_raises_naming_the_key():
     s = load_scenario("cpfa", robots__count=1, arena__size=3.0)  # five 8 x 8 clusters do not fit
     with pytest.raises(ScenarioError, match="resources.clusters"):
-        World(s)
+        World(s, task_factory(s))
 
 
 def test_unknown_robot_id_raises_naming_it(make_world):
@@ -577,7 +578,7 @@ def test_robots_stay_in_the_arena_and_apart(seed, robots):
         resources__distribution="uniform", resources__count=10, resources__min_depot_clearance=0.1,
     )
     overlap = 2 * 0.16 * 0.05 + 1e-3
-    with World(s, seed) as w:
+    with World(s, task_factory(s), seed) as w:
         rng = np.random.default_rng(seed)
         for _ in range(100):
             w.step(random_commands(w.robots, rng))
@@ -621,7 +622,7 @@ def trajectory(s: Scenario, seed: int, ticks: int, always_set: bool) -> list:
     """True poses, observations and stats of a run of sticky commands (a teleport half-way)."""
     rng = np.random.default_rng(seed)
     out, last = [], {}
-    with World(s) as w, pytest.MonkeyPatch.context() as m:
+    with World(s, task_factory(s)) as w, pytest.MonkeyPatch.context() as m:
         if always_set:  # the reference: every velocity set on every substep
             m.setattr(w, "_velocities_kept", lambda turning, touching: np.zeros(len(touching), dtype=bool))
         obs = w.reset()

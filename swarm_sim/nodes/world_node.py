@@ -95,7 +95,7 @@ class WorldNode(Node):
         if cfg.mode not in ("lockstep", "realtime"):
             raise ValueError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
-        self.world = World(self.scenario, cfg.seed)
+        self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
         self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns)
         self.recorder = self.recording.recorder

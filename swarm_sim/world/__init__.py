@@ -11,6 +11,7 @@ __all__ = ["World"]
 
 def __getattr__(name: str) -> Any:
     if name == "World":
+        # lazy: a task's sense types live in this package; importing them must not load pybullet
         from swarm_sim.world.core import World
 
         return World

@@ -41,20 +41,18 @@ stamp of the observations `step` returns.
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
 import math
-import os
-import sys
 from collections import deque
 from collections.abc import Collection, Mapping
 from itertools import repeat
 from operator import attrgetter
 
 import numpy as np
+
 from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
+from swarm_sim.world import bullet
 from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.observations import observations
@@ -115,22 +113,6 @@ def tune_malloc() -> None:
         pass
 
 
-@contextlib.contextmanager
-def _quiet_stdout():
-    """pybullet's C code prints its build time on stdout when it connects; keep stdout for
-    results (``--json`` output must be JSON only)."""
-    sys.stdout.flush()
-    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
-    try:
-        yield
-    finally:
-        ctypes.CDLL(None).fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
-
-
 @kernel
 def _stale_rows(
     v: np.ndarray, cos_yaw: np.ndarray, sin_yaw: np.ndarray, vz: np.ndarray, w: np.ndarray,
@@ -173,8 +155,7 @@ class World:
     """
 
     def __init__(
-        self, scenario: Scenario, seed: int | None = None, *, task: TaskFactory | None = None,
-        scan_threads: int = 1,
+        self, scenario: Scenario, task: TaskFactory, seed: int | None = None, *, scan_threads: int = 1,
     ) -> None:
         tune_malloc()
         self.scenario = scenario
@@ -196,13 +177,8 @@ class World:
         self._scene = StaticScene.from_scenario(scenario)
         self._ring = ProximityRing(scenario)
         self._scan_threads = scan_threads
-        if task is None:
-            from swarm_sim.registry import task_factory
-
-            task = task_factory(scenario)
         self._task_factory = task
-        with _quiet_stdout():
-            self._client: int | None = p.connect(p.DIRECT)
+        self._client: int | None = bullet.connect(p.DIRECT)
         try:
             self._build()
         except BaseException:

@@ -8,26 +8,27 @@ import dataclasses
 import math
 
 import numpy as np
-from swarm_sim.world.bullet import pybullet as p
 import pytest
 
 from swarm_controllers.api import behaviour_rng
 from swarm_controllers.caging.behaviour import Phase
 from swarm_controllers.caging.metrics import inside_polygon, polyline_length
 from swarm_controllers.caging.sensing import SENSING, STATE
+from swarm_controllers.caging.task import OBJECT, WALL
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.registry import make_behaviour
+from swarm_sim.registry import make_behaviour, task_factory
 from swarm_sim.scenario import load_scenario
 from swarm_sim.types import Command, Pose2D
 from swarm_sim.world import World
-from swarm_controllers.caging.task import OBJECT, WALL
+from swarm_sim.world.bullet import pybullet as p
 
 OBJECT_AT = (-1.5, -1.0)
 
 
 def _world(*overrides: str, seed: int = 1) -> World:
-    world = World(load_scenario("caging", ["sim.duration=120", *overrides], seed=seed))
+    scenario = load_scenario("caging", ["sim.duration=120", *overrides], seed=seed)
+    world = World(scenario, task_factory(scenario))
     p.resetBasePositionAndOrientation(world.task.body, [*OBJECT_AT, world.scenario.robots.height / 2],
                                       [0, 0, 0, 1], physicsClientId=world.client)
     world.task.post_step(0)
@@ -112,7 +113,8 @@ def test_sensors_report_detect_and_id():
 
 def test_robots_and_object_start_in_the_landmark_rectangle_apart_and_out_of_sight():
     for seed in range(5):
-        with World(load_scenario("caging", seed=seed)) as world:
+        scenario = load_scenario("caging", seed=seed)
+        with World(scenario, task_factory(scenario)) as world:
             obj = np.array([world.task.object_pose.x, world.task.object_pose.y])
             pos = world.positions
             assert (np.abs(obj) <= (4.0, 3.5)).all() and (np.abs(pos) <= (4.0, 3.5)).all()

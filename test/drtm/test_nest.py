@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from swarm_controllers.drtm.nest import NestServer
+from swarm_controllers.drtm.codec import NEST, NEST_STATE
 from swarm_controllers.drtm.metrics import (
     active_robots_series,
     energy_efficiency,
@@ -20,12 +20,12 @@ from swarm_controllers.drtm.metrics import (
     nest_food_series,
     oae_total,
 )
+from swarm_controllers.drtm.nest import NestServer
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
-from swarm_controllers.drtm.codec import NEST
 from swarm_msgs_py.server_outputs import SeriesLog
-from swarm_msgs_py.topics import NEST_STATE
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
+from swarm_sim.registry import task_factory
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.types import BehaviourStatus, DropEvent
 from swarm_sim.world import World
@@ -120,7 +120,7 @@ def test_food_changes_only_by_deliveries_consumption_and_the_nest_rate(events, p
 
 def test_the_light_points_at_the_nest_centre_within_its_range():
     s = _scenario("sensors.light_range=1.0")
-    with World(s) as world:
+    with World(s, task_factory(s)) as world:
         from swarm_sim.types import Pose2D
 
         world.teleport({"robot_0": Pose2D(0.5, 0.0, math.pi), "robot_1": Pose2D(0.0, -0.9, 0.0),
@@ -134,7 +134,7 @@ def test_the_light_points_at_the_nest_centre_within_its_range():
 @pytest.mark.parametrize("layout", ["depot_random", "depot_ring"])
 def test_start_layouts_put_every_robot_inside_the_nest(layout):
     s = load_scenario("drtm", [f"robots.start_layout={layout}", "robots.count=30"])
-    with World(s) as world:
+    with World(s, task_factory(s)) as world:
         xy = world.positions.copy()
     room = s.depot.radius - s.robots.diameter / 2
     assert np.all(np.hypot(xy[:, 0], xy[:, 1]) <= room + 1e-9)
