@@ -23,10 +23,10 @@ import time
 from pathlib import Path
 
 import numpy as np
+from profile_batch import scaled_fields
 
 import swarm_sim.batch as batch
-from profile_batch import scaled_fields
-from swarm_controllers.api import behaviour_rng
+from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import Observation, Pose2D

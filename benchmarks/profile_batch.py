@@ -44,9 +44,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import swarm_sim.batch as batch
-from swarm_controllers.api import behaviour_rng
-from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance
 import swarm_sim.world.core as world_core
+from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance
+from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.scenario import Scenario, load_scenario
 
 GROUPS = ("world", "behaviours", "routing", "servers", "bookkeeping", "gc")

@@ -39,12 +39,12 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim import registry
+from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
 from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
 from swarm_sim.scenario import Scenario, load_scenario

@@ -22,14 +22,14 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from itertools import chain
-from typing import Any
 from operator import attrgetter, call
+from typing import Any
 
 import numpy as np
 
-from swarm_controllers.api import behaviour_rng
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import RunTrace, summarize
+from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order

@@ -171,7 +171,7 @@ class Algorithm:
     paper: str
     """Where it is specified (a file of ../shared/papers and the section)."""
     behaviour: str
-    """``module:Class``, built as ``Class(scenario, robot, rng)`` (`swarm_controllers.api.Behaviour`)."""
+    """``module:Class``, built as ``Class(scenario, robot, rng)`` (`swarm_sim.behaviour.Behaviour`)."""
     task: str = "foraging"
     """The world task it runs in."""
     config: tuple[tuple[str, str], ...] = ()

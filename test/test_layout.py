@@ -268,3 +268,12 @@ def test_the_checks_can_fail(tmp_path):
     bad = tmp_path / "bad.py"
     bad.write_text('"""doc queue"""\nx = "queue"  # depot\n')
     assert _code_words(bad) == ({"x"}, {"queue"})
+
+
+def test_the_shared_core_imports_no_controller_code():
+    """swarm_sim and swarm_msgs_py sit below the controllers and the papers (the launcher may
+    start the controller node); a record names paper code only as a string the registry resolves."""
+    graph = _graph()
+    upward = [f"{m} -> {t}" for m, targets in graph.items() if m.split(".")[0] in ("swarm_sim", "swarm_msgs_py")
+              for t in targets if t.split(".")[0] in ("swarm_controllers", "depot_manager", "launch_py")]
+    assert upward == []

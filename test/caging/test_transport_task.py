@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from swarm_controllers.api import behaviour_rng
 from swarm_controllers.caging.behaviour import Phase
 from swarm_controllers.caging.metrics import inside_polygon, polyline_length
 from swarm_controllers.caging.sensing import SENSING, STATE
 from swarm_controllers.caging.task import OBJECT, WALL
+from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, task_factory

@@ -14,7 +14,6 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from swarm_controllers.api import Behaviour, behaviour_rng
 from swarm_controllers.cpfa.behaviour import (
     CpfaBehaviour,
     CpfaState,
@@ -25,6 +24,7 @@ from swarm_controllers.cpfa.behaviour import (
 )
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.messages import PheromoneMessage
+from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario

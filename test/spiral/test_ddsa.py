@@ -11,12 +11,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_controllers.api import behaviour_rng
 from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral.geometry import ddsa_path
 from swarm_sim.analysis.metrics import resources_delivered
+from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
