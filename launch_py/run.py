@@ -237,22 +237,27 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if world_died:
             repair_bag(bag)
-        summary = summarize(load_run(bag))
+        trace = load_run(bag)
+        summary = summarize(trace)
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
         return 1
     if args.json:
         print(json.dumps(summary))
     else:
-        print(
-            f"[swarm-run] done: {summary['resources_delivered']}/{summary['total_resources']} resources "
-            f"delivered in {summary['sim_seconds']:.1f} s sim ({summary['wall_seconds']:.1f} s wall, "
-            f"{summary['real_time_factor']}x); collision {summary['collision_time_per_robot_s']:.2f} s/robot; "
-            f"OAE {summary['oae_per_robot']:.1f}/robot; stale ticks {summary['stale_ticks']}\n"
-            f"[swarm-run] bag: {bag}  (swarm-analyze {bag})",
-            flush=True,
-        )
+        print("\n".join(_done_lines(summary, trace.config, bag)), flush=True)
     return _verdict(summary, world_died=world_died, interrupted=interrupted)
+
+
+def _done_lines(summary: dict, scenario: Scenario | None, bag: Path) -> list[str]:
+    """The run's end: the same per-paper text as ``swarm-analyze`` (`swarm_sim.analysis.text`)."""
+    from swarm_sim.analysis.text import summary_lines  # lazy: analysis loads after the run, as above
+
+    rtf = summary.get("real_time_factor")
+    return [f"[swarm-run] done: {summary['sim_seconds']:.1f} s sim in {summary['wall_seconds']:.1f} s wall"
+            + (f" ({rtf}x)" if rtf else ""),
+            *summary_lines(summary, scenario),
+            f"[swarm-run] bag: {bag}  (swarm-analyze {bag} --trajectories for its figures)"]
 
 
 def _how(returncode: int) -> str:

@@ -143,7 +143,7 @@ class ControllerNode(Node):
         if command.messages:
             self.endpoint.send(stamp_ns, command.messages)
         status = self.behaviour.status(stamp_ns)
-        key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
+        key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra, status.finished)
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))

@@ -35,7 +35,7 @@ from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
+from swarm_sim.types import FINISHED, NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
 from swarm_sim.world.observations import with_messages
 
@@ -126,6 +126,7 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
             if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):
+                trace.ended = FINISHED
                 if poses is not None:
                     poses = poses[:k + 2]
                 break

@@ -60,7 +60,13 @@ class Measure:
 
     field: str
     unit: str = ""
-    """Printed after the value (``s``, ``%``, ``min``); empty for counts and ratios."""
+    """Printed after the value (``s``, ``%``, ``min``, ``tokens``); empty for plain ratios."""
+    symbol: str = ""
+    """The paper's name for it (``V_f``, ``E_e``), printed beside the field."""
+    scale: float = 1.0
+    """The text shows the value times this (a fraction as ``%``: 100); the JSON keeps the value."""
+    missing: str = "n/a"
+    """What the text says when the value is null (a stage the run did not reach: ``not reached``)."""
 
 
 @dataclass(frozen=True)
@@ -178,6 +184,10 @@ class Algorithm:
     by ``swarm-analyze --trajectories`` (None: none)."""
     headline: tuple[Measure, ...] = ()
     """The paper's own measures, as a run's text summary shows them (after its task's)."""
+    progress: str | None = None
+    """``module:function`` ``(statuses) -> str``: what the world node's progress line says of the
+    run, from every robot's last reported status (`swarm_sim.types.BehaviourStatus`, by robot;
+    e.g. the caging stage); None: its world task's ``progress()`` (deliveries)."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

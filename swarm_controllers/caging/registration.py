@@ -11,6 +11,22 @@ register_task(TaskSpec(
     world=(("transport", "swarm_controllers.caging.world_config:TransportConfig"),),
 ))
 
+_NOT_REACHED = "not reached"
+_HEADLINE = (
+    Measure("search_time_s", "s", "search", missing=_NOT_REACHED),
+    Measure("recruitment_time_s", "s", "recruitment", missing=_NOT_REACHED),
+    Measure("transport_time_s", "s", "transport", missing=_NOT_REACHED),
+    Measure("total_time_s", "s", "execution time", missing=_NOT_REACHED),
+    Measure("object_delivered"),
+    Measure("cage_held", missing=_NOT_REACHED),
+    Measure("planned_path_m", "m", "path minimum length", missing=_NOT_REACHED),
+    Measure("trajectory_error_m", "m", "error", missing=_NOT_REACHED),
+    Measure("trajectory_error_pct", "%", "normalised error", missing=_NOT_REACHED),
+    Measure("landmarks", symbol="Lambda"),
+    Measure("cage_size", "robots", missing=_NOT_REACHED),
+)
+"""Sec. 5: the stage times, whether the object was delivered, the path error (Table 2)."""
+
 register(Algorithm(
     name="caging",
     paper="caging_transport.md (Cardoso, Nedjah & Mourelle): Algs. 1-6, eqs. (1), (2), (5)",
@@ -26,11 +42,10 @@ register(Algorithm(
         ("planned_path_m", "planned_path_m"), ("object_path_m", "object_path_m"),
         ("trajectory_error_m", "trajectory_error_m"), ("trajectory_error_pct", "trajectory_error_pct"),
         ("cage_held", "cage_held"), ("max_path_deviation_m", "max_path_deviation_m"),
-        ("landmarks", "landmark_count"), ("cage_size", "cage_size"),
+        ("landmarks", "landmark_count"), ("cage_size", "cage_size"), ("object_delivered", "object_delivered"),
     )),
     figures="swarm_controllers.caging.figures:transport_figure",
     comparison="swarm_controllers.caging.comparison:CAGING_COMPARISON",
-    headline=(Measure("search_time_s", "s"), Measure("recruitment_time_s", "s"), Measure("transport_time_s", "s"),
-              Measure("total_time_s", "s"), Measure("cage_held"), Measure("trajectory_error_pct", "%"),
-              Measure("landmarks"), Measure("cage_size")),
+    headline=_HEADLINE,
+    progress="swarm_controllers.caging.stages:progress",
 ))

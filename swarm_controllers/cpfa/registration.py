@@ -6,9 +6,12 @@ from swarm_sim.registry import Algorithm, Measure, register, register_default_sc
 SECTION = ("cpfa", "swarm_controllers.cpfa.config:CpfaConfig")
 """``controller.cpfa``: also declared by the algorithms that search as the CPFA does."""
 PHEROMONES = "swarm_controllers.cpfa.codec:PHEROMONES"
-HEADLINE = (Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"),
-            Measure("dropoff_time_mean_s", "s"))
-"""The queue paper's three metrics (sec. VII), which it reports for the CPFA too."""
+HEADLINE = (Measure("resources_collected_pct", "%", "resource collection"),
+            Measure("collision_time_total_min", "min", "collision time, all robots"),
+            Measure("collision_time_per_robot_s", "s", "collision time per robot"),
+            Measure("dropoff_time_mean_s", "s", "resource drop-off time"))
+"""The queue paper's three metrics (sec. VII: resources collected; the cumulative collision time
+in minutes, and per robot as its Fig. 9; the drop-off time), which it reports for the CPFA too."""
 
 register(Algorithm(
     name="cpfa",

@@ -22,8 +22,9 @@ _METRICS = tuple(
                  "nest_food_series", "active_robots_series", "oae_series")
 )
 
-_HEADLINE = (Measure("food_deviation"), Measure("energy_efficiency"), Measure("oae_total"),
-             Measure("oae_per_robot"), Measure("food_collected"), Measure("nest_food_final"))
+_HEADLINE = (Measure("food_deviation", "tokens", "V_f"), Measure("energy_efficiency", "%", "E_e", scale=100.0),
+             Measure("oae_total", "events", "M_T"), Measure("oae_per_robot", "events/robot", "M_v"),
+             Measure("food_collected", "tokens", "F_t"), Measure("nest_food_final", "tokens", "F(T)"))
 """The paper's V_f [tokens], E_e, M_T, M_v, F_t [tokens] and F(T) [tokens] (Sec. 3, eqs. (8)-(9))."""
 
 for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),

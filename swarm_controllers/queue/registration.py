@@ -29,6 +29,6 @@ register(Algorithm(
         Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
     ),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
-    headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s"), Measure("deliveries_outside_docks"),
-              Measure("queue_length_mean"), Measure("queue_length_max")),
+    headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s", "time delay"),
+              Measure("queue_length_mean", "robots"), Measure("queue_length_max", "robots")),
 ))

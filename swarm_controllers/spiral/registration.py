@@ -6,11 +6,14 @@ from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, ServerS
 
 _SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
 _CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
-_METRICS = (Metric("resources_per_robot_per_min",
-                   "swarm_controllers.spiral.metrics:resources_per_robot_per_min", None),)
-_HEADLINE = (Measure("resources_per_robot"), Measure("resources_per_robot_per_min", "/min"),
-             Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"))
-"""The spiral paper's measures (Figs. 6-10): resources per robot, their rate, collision time."""
+_METRICS = tuple(Metric(name, f"swarm_controllers.spiral.metrics:{name}", None)
+                 for name in ("resources_per_robot_per_min", "resources_per_robot_per_min_mean"))
+_HEADLINE = (Measure("resources_per_robot", "resources", "collected per robot"),
+             Measure("resources_per_robot_per_min_mean", "resources/min", "foraging rate per robot"),
+             Measure("resources_collected_pct", "%"),
+             Measure("collision_time_per_robot_s", "s", "collision time per robot"))
+"""The spiral paper's measures (Figs. 6-10): resources per robot, their rate per minute (the
+per-minute series itself is in the JSON), collision time per robot."""
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
 _REGIONS = ("regions", "swarm_controllers.spiral.regions:RegionConfig")
 _CENTER = ServerSpec(
@@ -49,5 +52,5 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
         paths="swarm_controllers.spiral.center:planned_paths",
         comparison=_COMPARISON,
-        headline=(*_HEADLINE, Measure("regions")),
+        headline=(*_HEADLINE, Measure("regions", symbol="N_regions")),
     ))

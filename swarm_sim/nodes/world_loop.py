@@ -66,6 +66,7 @@ class WorldLoop:
                 self.await_wall(executor, wall0 + (k + 1) * sim.dt / cfg.real_time_factor)
             obs = world.step(node.commands())
             node.publish_world_state()
+            node.check_finished(executor)
             if now - last_progress >= cfg.progress_period:
                 last_progress = now
                 self.print_progress(now - wall0)
@@ -153,6 +154,6 @@ class WorldLoop:
         stale = sum(s.stale_ticks for s in node.world.stats.values())
         print(
             f"[world] t={t:7.1f}/{node.scenario.sim.duration:.0f} s  rtf={t / max(wall, 1e-9):5.2f}x  "
-            f"{node.world.task.progress()}  stale={stale}",
+            f"{node.progress_text()}  stale={stale}",
             flush=True,
         )

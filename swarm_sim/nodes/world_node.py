@@ -44,11 +44,12 @@ from swarm_sim.cli import number
 from swarm_sim.inbound import Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.status_watch import StatusWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
+from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 
 
@@ -137,7 +138,8 @@ class WorldNode(Node):
         """Nodes declared dead, in order."""
         self._down_events: list[NodeDownEvent] = []
         self.ended = "complete"
-        """How the run ended: ``complete``, ``interrupted`` or ``server <channel> died``."""
+        """How the run ended: ``complete``, ``finished`` (``sim.stop_when_finished``), ``interrupted``
+        or ``server <channel> died``."""
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
@@ -154,6 +156,8 @@ class WorldNode(Node):
             )
         self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
+        self.statuses = StatusWatch(self, self.robots, self.inbound, self.recording, self.scenario.dt_ns)
+        self._progress = registry.resolve(algorithm.progress) if algorithm.progress else None
         self.loop = WorldLoop(self)
 
     stop_requested = False
@@ -235,6 +239,23 @@ class WorldNode(Node):
                 self.get_logger().error(f"server {r}: no ack for {self.barrier.dead_after} ticks: declared dead; "
                                         "the run ends here")
                 self.ended = f"server {r} died"
+
+    # ------------------------------------------------------------------ the run's course
+
+    def progress_text(self) -> str:
+        """What the progress line says of the run: the algorithm's reading of the robots'
+        statuses if its record declares one (the caging stage), else the task's (deliveries)."""
+        if self._progress is not None:
+            return self._progress(self.statuses.by_robot())
+        return self.world.task.progress()
+
+    def check_finished(self, executor: Executor) -> None:
+        """``sim.stop_when_finished``: end the run once every live robot reports its task over
+        (`swarm_sim.nodes.status_watch`); the bag's ``ended`` says ``finished``."""
+        if self.scenario.sim.stop_when_finished and self.ended == "complete":
+            self.statuses.settle(executor)
+            if self.statuses.all_finished(self.barrier.dead):
+                self.ended = FINISHED
 
     # ------------------------------------------------------------------ discovery
 
