@@ -29,7 +29,7 @@ import numpy as np
 from swarm_controllers.api import behaviour_rng
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
-from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
@@ -170,7 +170,7 @@ def run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="swarm-batch", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-batch", description=first_paragraph(__doc__))
     add_scenario_arguments(parser)
     parser.add_argument("--runs", type=number(int, 1, 10**6), default=1, help="runs with seeds seed, seed+1, ...")
     add_executor_arguments(parser)

@@ -62,6 +62,8 @@ class WorldLoop:
             node.publish_tick(obs)
             if cfg.mode == "lockstep":
                 self.await_commands(executor)
+                if cfg.pace > 0:
+                    self.pace(executor, wall0 + (k + 1) * sim.dt / cfg.pace)
             else:
                 self.await_wall(executor, wall0 + (k + 1) * sim.dt / cfg.real_time_factor)
             obs = world.step(node.commands())
@@ -134,6 +136,12 @@ class WorldLoop:
         stamp = node.world.t_ns
         for r in node.barrier.waiting(stamp, node.robots):
             node.world.stats[r].stale_ticks += 1
+
+    def pace(self, executor: Executor, until: float) -> None:
+        """Lockstep at a watchable pace: spin (the next tick's answers may not come before it is
+        sent, so nothing is missed) until `until` (wall)."""
+        while (remaining := until - time.monotonic()) > 0:
+            self.spin(executor, min(0.05, remaining))
 
     def print_startup(self, missing: list[str], waited: float) -> None:
         """What the start-up is waiting for (nodes starting and discovering each other)."""
