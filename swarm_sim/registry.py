@@ -70,6 +70,32 @@ class Measure:
 
 
 @dataclass(frozen=True)
+class Panel:
+    """One panel of a run's summary figure (``summary.png``, `swarm_sim.analysis.plots.plot_run`),
+    as the paper would print it: what it shows, with units, named legend entries and reference lines."""
+
+    title: str
+    ylabel: str
+    """The quantity and its unit (``robots queued [robots]``)."""
+    source: str
+    """What is drawn: a run-trace series (``RunTrace.series``, e.g. a server's ``queue_lengths``),
+    a JSON result field (a ``[[t, value], ...]`` series, or a ``{robot: value}`` table drawn as
+    bars per robot), or ``module:function`` ``(trace) -> either of those``."""
+    legend: tuple[str, ...] = ()
+    """Names of a series' components (``x``, ``y``); one with ``{i}`` is a pattern for every
+    component (``entry line {i}``). Empty: one unnamed line."""
+    integer: bool = False
+    """Counts: integer ticks on the value axis."""
+    references: str | None = None
+    """``module:function`` ``(trace) -> [(value, label)]``: horizontal lines the paper draws (F_d)."""
+    marks: str | None = None
+    """``module:function`` ``(trace) -> [(t [s], label)]``: moments marked by vertical lines
+    (the caging stages' ends)."""
+    empty: str = "nothing recorded in this run"
+    """What the panel says when the run gives it nothing to draw."""
+
+
+@dataclass(frozen=True)
 class ServerSpec:
     """A node core other than the world and the robots (`swarm_sim.protocol.Server`); on the
     graph it runs in the generic server node (``swarm-server --channel <channel>``,
@@ -112,6 +138,8 @@ class TaskSpec:
     bag replay keep each as the time series ``RunTrace.series[field]`` (None: none)."""
     headline: tuple[Measure, ...] = ()
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
+    panels: tuple[Panel, ...] = ()
+    """Its panels of a run's summary figure (before its algorithm's)."""
     world: tuple[tuple[str, str], ...] = ()
     """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
     section (a `swarm_sim.scenario.WorldSection`)."""
@@ -188,6 +216,15 @@ class Algorithm:
     """``module:function`` ``(statuses) -> str``: what the world node's progress line says of the
     run, from every robot's last reported status (`swarm_sim.types.BehaviourStatus`, by robot;
     e.g. the caging stage); None: its world task's ``progress()`` (deliveries)."""
+    panels: tuple[Panel, ...] = ()
+    """Its own panels of a run's summary figure (after its task's): e.g. its servers' series."""
+    backdrop: str | None = None
+    """``module:function`` ``(ax, scenario) -> None``: what it lays out in the world (a depot's
+    queues and docks, regions, landmarks), drawn under the recorded trajectories on a matplotlib
+    axis in metres, each part with a legend label."""
+    states: tuple[str, ...] = ()
+    """Every state its robots' statuses can report (``BehaviourStatus.state``), in the order a
+    replay video's legend lists them, each with its own colour from the first frame."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

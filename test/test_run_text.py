@@ -1,7 +1,9 @@
-"""What a researcher reads at the end of a run: for one algorithm of each registered paper, a short
-graph run (``swarm-run``, no ``--json``) ends with the paper's own measures, each with its unit,
-and ``swarm-analyze`` of the bag prints the very same lines; no other paper's measure and no time
-series appear in the text. The papers are found through the registry, not listed here."""
+"""What a researcher reads and sees after a run: for one algorithm of each registered paper, a
+short graph run (``swarm-run``, no ``--json``) ends with the paper's own measures, each with its
+unit, and ``swarm-analyze`` of the bag prints the very same lines; no other paper's measure and no
+time series appear in the text. The bag's summary figure is the paper's (`test_figures`), its
+trajectories are drawn over what the algorithm lays out, one colour per robot, titled with planned
+paths only where there are some. The papers are found through the registry, not listed here."""
 
 from __future__ import annotations
 
@@ -11,10 +13,16 @@ import subprocess
 import sys
 from pathlib import Path
 
+import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 import yaml
+from test_figures import check_summary_figure
 
 from swarm_sim import registry
+from swarm_sim.analysis.plots import summary_figure, trajectories_figure
+from swarm_sim.analysis.replay import load_run
 from swarm_sim.analysis.text import RUN
 
 REPO = Path(__file__).resolve().parents[1]
@@ -68,3 +76,16 @@ def test_a_run_ends_with_its_papers_measures_and_analysis_reads_the_same(name, s
     others = {m.field for a in registry.algorithms() for m in a.headline} - {m.field for m in (*own, *RUN)}
     assert not others & set(shown), sorted(others & set(shown))
     assert "[[" not in run.stdout  # series only in --json
+
+    trace = load_run(bag)
+    check_summary_figure(summary_figure(trace), trace.config)
+    fig = trajectories_figure(bag)
+    ax = fig.axes[0]
+    assert ("over the planned paths" in ax.get_title()) == bool(record.paths), ax.get_title()
+    robots = [ln for ln in ax.lines if ln.get_label().startswith("robot_")]
+    assert len(robots) == len(trace.robots)
+    assert len({tuple(np.round(matplotlib.colors.to_rgba(ln.get_color()), 4)) for ln in robots}) == len(robots)
+    world = [t.get_text() for t in ax.get_legend().get_texts() if not t.get_text().startswith("robot_")]
+    if record.backdrop:  # its layout is drawn, and named in the legend
+        assert len(set(world) - {"drop zone", "planned paths", "obstacle"}) >= 1, world
+    plt.close("all")

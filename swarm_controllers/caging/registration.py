@@ -1,7 +1,7 @@
 """The caging paper's registry records (caging_transport.md, Cardoso, Nedjah & Mourelle): the
 transport task (landmarks, the object: its ``transport`` world section) and the caging algorithm."""
 
-from swarm_sim.registry import Algorithm, Measure, Metric, TaskSpec, register, register_task
+from swarm_sim.registry import Algorithm, Measure, Metric, Panel, TaskSpec, register, register_task
 
 register_task(TaskSpec(
     name="transport",
@@ -26,6 +26,16 @@ _HEADLINE = (
     Measure("cage_size", "robots", missing=_NOT_REACHED),
 )
 """Sec. 5: the stage times, whether the object was delivered, the path error (Table 2)."""
+_FIGURES = "swarm_controllers.caging.figures"
+_STAGES = f"{_FIGURES}:stage_ends"
+_PANELS = (
+    Panel("the object's position", "position [m]", "object", legend=("x", "y"), marks=_STAGES),
+    Panel("the object's path so far", "path length [m]", f"{_FIGURES}:object_path",
+          references=f"{_FIGURES}:planned_length", marks=_STAGES),
+    Panel("the object's distance from the planned path", "distance [m]", f"{_FIGURES}:path_deviation",
+          marks=_STAGES, empty="the transport did not start in this run"),
+)
+"""The transport over time, the stages' ends marked (search, recruitment, transport)."""
 
 register(Algorithm(
     name="caging",
@@ -48,4 +58,8 @@ register(Algorithm(
     comparison="swarm_controllers.caging.comparison:CAGING_COMPARISON",
     headline=_HEADLINE,
     progress="swarm_controllers.caging.stages:progress",
+    panels=_PANELS,
+    backdrop=f"{_FIGURES}:landmark_grid",
+    states=("search", "approach", "wait_summon", "to_cage", "summoning", "placed", "spin", "wait_oriented", "move",
+            "wait_reached", "done"),  # `Phase` values, in the order of the protocol
 ))

@@ -12,6 +12,8 @@ HEADLINE = (Measure("resources_collected_pct", "%", "resource collection"),
             Measure("dropoff_time_mean_s", "s", "resource drop-off time"))
 """The queue paper's three metrics (sec. VII: resources collected; the cumulative collision time
 in minutes, and per robot as its Fig. 9; the drop-off time), which it reports for the CPFA too."""
+STATES = ("DEPARTING", "SEARCHING", "RETURNING")
+"""What a CPFA robot's status says (`CpfaState` names)."""
 
 register(Algorithm(
     name="cpfa",
@@ -22,6 +24,7 @@ register(Algorithm(
     deliveries=("depot", "docks"),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
     headline=HEADLINE,
+    states=STATES,
 ))
 
 register_default_scenario("cpfa")  # what scripts/run and every command run unless told otherwise

@@ -70,8 +70,8 @@ def main(argv: list[str] | None = None) -> int:
             status = 1
             continue
         summary = summarize(trace)
-        if not args.no_plot:
-            summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
+        if not args.no_plot and (plot := plot_run(trace, args.plot or bag / "summary.png")) is not None:
+            summary["plot"] = str(plot)
         if args.trajectories:
             summary["trajectories"] = str(plot_trajectories(bag, bag / "trajectories.png"))
             figures = registry.of(trace.config).figures
