@@ -140,6 +140,9 @@ class TaskSpec:
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
     panels: tuple[Panel, ...] = ()
     """Its panels of a run's summary figure (before its algorithm's)."""
+    bodies: str | None = None
+    """``module:function`` ``(scenario) -> {state field: diameter [m]}``: the bodies a replay
+    video draws to scale where its state topics put them (the caging object)."""
     world: tuple[tuple[str, str], ...] = ()
     """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
     section (a `swarm_sim.scenario.WorldSection`)."""

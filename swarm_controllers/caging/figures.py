@@ -163,3 +163,8 @@ def landmark_grid(ax, scenario) -> None:
     """The landmarks (`Algorithm.backdrop`)."""
     marks = landmarks(scenario).points
     ax.plot(marks[:, 0], marks[:, 1], ".", color="0.7", ms=2, zorder=1, label=f"landmarks ({len(marks)})")
+
+
+def bodies(scenario) -> dict[str, float]:
+    """The object, drawn to scale in replay videos: ``object`` -> its diameter 2r [m]."""
+    return {"object": 2.0 * TransportConfig.of(scenario).object.radius}

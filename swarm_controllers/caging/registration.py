@@ -8,6 +8,7 @@ register_task(TaskSpec(
     core="swarm_controllers.caging.task:TransportTask",
     sensing="swarm_controllers.caging.sensing:SENSING",
     state="swarm_controllers.caging.sensing:STATE",
+    bodies="swarm_controllers.caging.figures:bodies",
     world=(("transport", "swarm_controllers.caging.world_config:TransportConfig"),),
 ))
 
