@@ -181,7 +181,9 @@ def main(argv: list[str] | None = None) -> int:
     if port is not None:
         print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
               f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
-              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list", flush=True)
+              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list --spin-time 2  (discovery takes "
+              "~1.5 s: --spin-time 2 without a daemon, or `ros2 daemon start` once with the same variables)",
+              flush=True)
     python = [sys.executable, "-m"]
     me = os.getpid()
 

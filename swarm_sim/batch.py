@@ -29,6 +29,7 @@ import numpy as np
 from swarm_controllers.api import behaviour_rng
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import PerimeterLog, RunTrace, summarize
+from swarm_sim.analysis.text import summary_line
 from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
@@ -188,7 +189,8 @@ def main(argv: list[str] | None = None) -> int:
         with executor_from_args(args) as executor, Progress(len(jobs), f"swarm-batch ({executor.name})") as bar:
             for outcome in executor.map(run_one, jobs):
                 if outcome.ok:
-                    bar.write(_result_line(outcome.value, args.json), numbered=False)
+                    bar.write(json.dumps(outcome.value) if args.json else summary_line(outcome.value, base),
+                              numbered=False)
                 else:
                     failed += 1
                     bar.write(f"swarm-batch: seed {seeds[outcome.index]} failed: {outcome.error}",
@@ -203,18 +205,6 @@ def main(argv: list[str] | None = None) -> int:
     if failed:
         print(f"swarm-batch: {failed} of {len(jobs)} runs failed", file=sys.stderr)
     return 1 if failed else 0
-
-
-def _result_line(result: dict, as_json: bool) -> str:
-    if as_json:
-        return json.dumps(result)
-    return (
-        f"{result['scenario']} seed={result['seed']} robots={result['robots']}: "
-        f"delivered {result['resources_delivered']}/{result['total_resources']} in "
-        f"{result['sim_seconds']:.0f} s sim, {result['wall_seconds']:.1f} s wall "
-        f"({result['real_time_factor']}x), collision {result['collision_time_per_robot_s']:.2f} "
-        f"s/robot, OAE {result['oae_per_robot']:.1f}/robot"
-    )
 
 
 if __name__ == "__main__":

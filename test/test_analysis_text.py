@@ -68,3 +68,15 @@ def test_a_measure_reads_in_the_papers_units():
     assert text._value(0.1199, Measure("energy_efficiency", "%", "E_e", scale=100.0)) == "11.99 %"
     assert text._value(None, Measure("search_time_s", "s", missing="not reached")) == "not reached"
     assert text._value(True, Measure("cage_held")) == "yes"
+
+
+def test_the_batch_line_shows_the_algorithms_measures():
+    """``swarm-batch`` prints one line per run: what ran, then its own measures (not the
+    foraging fields for a caging run); null measures are left out."""
+    from swarm_sim.analysis.text import summary_line
+
+    scenario = load_scenario(_first_scenario("caging"), ["sim.duration=2.0"])
+    line = summary_line(summarize(run_batch(scenario).trace), scenario)
+    assert line.startswith("caging seed=0 robots=8: 2 s sim, ")
+    assert "landmarks 255" in line and "object_delivered no" in line
+    assert "resources" not in line and "not reached" not in line

@@ -90,3 +90,11 @@ def test_robot_colours_never_repeat_and_are_not_grey():
         colours = [tuple(np.round(matplotlib.colors.to_rgba(c), 4)) for c in robot_colours(count)]
         assert len(set(colours)) == count
         assert not any(r == g == b for r, g, b, _ in colours), count
+
+
+@pytest.mark.parametrize("name", [a.name for a in registry.algorithms() if a.states])
+def test_the_states_a_record_lists_are_the_ones_its_robots_report(name):
+    """The replay legend lists `Algorithm.states` up front: they must be what statuses say."""
+    trace = run_batch(load_scenario(_first_scenario(name), ["sim.duration=30.0"])).trace
+    reported = {s.state for s in trace.status.values()}
+    assert reported and reported <= set(registry.algorithm(name).states), reported

@@ -20,7 +20,8 @@ import numpy as np
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.analysis.replay import load_odometry
-from swarm_sim.recording import bag_info
+from swarm_msgs_py import topics
+from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.registry import Panel
 from swarm_sim.scenario import Scenario, scenario_from_dict
 from swarm_sim.sites import drop_zones
@@ -193,6 +194,10 @@ def trajectories_figure(path: Path | str, *, start: float = 0.0, end: float | No
                 label="planned paths" if k == 0 else None)
     if algorithm.backdrop:
         registry.resolve(algorithm.backdrop)(ax, scenario)
+    resources = _resources_at_start(path)
+    if len(resources):
+        ax.scatter(resources[:, 0], resources[:, 1], s=2, color="goldenrod", zorder=2, lw=0,
+                   label="resources at the start")
     robots = sorted(odometry_rows, key=robot_number)
     for colour, robot in zip(robot_colours(len(robots)), robots):
         rows = odometry_rows[robot]
@@ -217,6 +222,16 @@ def trajectories_figure(path: Path | str, *, start: float = 0.0, end: float | No
         bar.minorticks_off()
     fig.tight_layout()
     return fig
+
+
+def _resources_at_start(path: Path | str) -> np.ndarray:
+    """(n, 2) the resources of the first ``/world/markers`` in the bag [m] (none: empty)."""
+    from swarm_sim.analysis.video import resource_points  # lazy: matplotlib/rosbags only for figures
+
+    for m in read_bag(path):
+        if m.topic == topics.WORLD_MARKERS:
+            return resource_points(m.data)
+    return np.zeros((0, 2))
 
 
 def _end(rows: Mapping[str, np.ndarray]) -> float:

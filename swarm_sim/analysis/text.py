@@ -73,3 +73,13 @@ def summary_lines(summary: Mapping[str, Any], scenario: Scenario | None) -> list
             value = summary[key]
             lines.append(f"  {key:{NAME_WIDTH}s} {', '.join(value) if isinstance(value, list) else value}")
     return lines
+
+
+def summary_line(summary: Mapping[str, Any], scenario: Scenario | None) -> str:
+    """One line per run (``swarm-batch``): what ran, then its task's and algorithm's measures."""
+    own = measures(scenario)[len(RUN):] if scenario is not None else ()
+    shown = [f"{m.field} {_value(summary[m.field], m)}" for m in own
+             if summary.get(m.field) is not None and not _is_series(summary[m.field])]
+    head = (f"{summary.get('scenario')} seed={summary.get('seed')} robots={summary.get('robots')}: "
+            f"{summary.get('sim_seconds', 0):.0f} s sim, {summary.get('wall_seconds', 0):.1f} s wall")
+    return "; ".join([head, *shown])

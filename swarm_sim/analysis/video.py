@@ -117,6 +117,11 @@ def _markers(data: bytes) -> list:
 _STORE = None
 
 
+def resource_points(data: bytes) -> np.ndarray:
+    """(n, 2) the resources lying on the ground in a ``/world/markers`` message [m]."""
+    return next((_xy(m) for m in _markers(data) if m.ns == "resources"), np.zeros((0, 2)))
+
+
 def _xy(marker) -> np.ndarray:
     return np.array([(p.x, p.y) for p in marker.points], dtype=float).reshape(-1, 2)
 
