@@ -50,9 +50,11 @@ def transport_figure(trace, directory: Path) -> list[Path]:
                 label="planned path (landmarks of T_r* reversed)")
         moving = (obj_t >= stage.start_s) & (obj_t <= stage.end_s)
         ax.plot(obj[moving, 0], obj[moving, 1], color="tab:red", lw=1.5, label="object's centre, transported")
+    outcome = (f"path error {_fmt(report.trajectory_error_m, 2)} m ({_fmt(report.trajectory_error_pct)} %), "
+               f"cage held: {_yes(report.cage_held)}" if report.trajectory_error_m is not None
+               else "the object was not delivered in this run")
     ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]", xlim=(-half, half), ylim=(-half, half),
-           title=f"{trace.scenario} seed {trace.seed}: path error {_fmt(report.trajectory_error_m, 2)} m "
-                 f"({_fmt(report.trajectory_error_pct)} %), cage held: {_yes(report.cage_held)}")
+           title=f"{trace.scenario} seed {trace.seed}: {outcome}")
     ax.legend(fontsize=8, loc="upper right")
     if stage is not None:
         _snapshots(fig, grid, scenario, stage, obj_t, obj, rob_t, robots)

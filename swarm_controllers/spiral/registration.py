@@ -15,7 +15,7 @@ _HEADLINE = (Measure("resources_per_robot", "resources", "collected per robot"),
 """The spiral paper's measures (Figs. 6-10): resources per robot, their rate per minute (the
 per-minute series itself is in the JSON), collision time per robot."""
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
-_PANELS = (Panel("foraging rate per minute", "resources per robot [resources]",
+_PANELS = (Panel("foraging rate per minute", "collected per robot [resources/min]",
                  "swarm_controllers.spiral.figures:rate_per_minute"),)
 """Figs. 7 and 9: resources collected per robot in each minute."""
 _REGIONS = ("regions", "swarm_controllers.spiral.regions:RegionConfig")

@@ -14,6 +14,7 @@ the sim clock passes the next frame time, so memory stays flat however long the 
   its pick-up and drop events);
 - the sim clock and the deliveries so far (or what the algorithm's record makes of the robots'
   statuses, `swarm_sim.registry.Algorithm.progress`: the caging stage);
+- the algorithm's planned paths when no server draws what it plans (DDSA's spirals);
 - a scale bar, and beside the arena a legend fixed from the first frame: every state the
   algorithm's record lists (`Algorithm.states`), each in its own colour, and every server overlay
   by namespace, in the server's colours (its core drawn once from the scenario).
@@ -250,6 +251,10 @@ class _Canvas:
         self.states: list[str] = list(algorithm.states)
         """Every state in the legend, in colour order: the record's, then any other a robot reports."""
         self._overlays = overlays(scenario)
+        self._paths = [] if self._overlays or not algorithm.paths else registry.resolve(algorithm.paths)(scenario)
+        """The algorithm's planned paths, drawn when no server draws what it plans (DDSA's spirals)."""
+        if self._paths:
+            ax.add_collection(LineCollection(self._paths, colors="0.8", linewidths=0.6, zorder=0))
         self._legend()
         self._pt_per_m = ax.transData.get_matrix()[0, 0] * 72.0 / _DPI
         """Points per metre at this figure's scale (a scatter's size is in points squared)."""
@@ -284,6 +289,8 @@ class _Canvas:
                       Patch(color="tab:green", alpha=0.25, label="drop zone")]
         if self.scenario.obstacles:
             world.append(Patch(color="tab:brown", alpha=0.7, label="obstacle"))
+        if self._paths:
+            world.append(Line2D([], [], color="0.8", lw=1.5, label="planned paths"))
         world += [dot(BODY_COLOUR, name.replace("_", " "), size=9) for name in self.bodies]
         world += [dot(artist.get_facecolor()[0], name.replace("_", " "), size=3) for name, artist in self.placed.items()]
         for server, item in self._overlays:
