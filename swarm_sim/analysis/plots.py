@@ -111,7 +111,7 @@ def plot_run(trace: RunTrace, out: Path) -> Path | None:
 def _save(fig, out: Path, dpi: int) -> Path:
     import matplotlib.pyplot as plt
 
-    fig.savefig(out, dpi=dpi)
+    fig.savefig(out, dpi=dpi, bbox_inches="tight")  # the legend beside the arena included
     plt.close(fig)
     return Path(out)
 
