@@ -379,7 +379,7 @@ def test_diagnostics_wire(statuses):
 STATUS_ST = st.builds(
     Status,
     st.integers(0, 255), TEXT, TEXT, TEXT,
-    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple), st.booleans(),
+    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple),
 )  # fmt: skip
 
 
@@ -478,7 +478,7 @@ def test_robot_stats_of_a_bag_recorded_before_avoidance_time_decode():
 BEHAVIOUR_ST = st.builds(
     BehaviourStatus,
     st.sampled_from(ROBOTS), STAMPS, TEXT, st.integers(0, 10**9), st.integers(0, 10**9),
-    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple),
+    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple), st.booleans(),
 )  # fmt: skip
 
 
