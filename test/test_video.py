@@ -18,7 +18,7 @@ import pytest
 
 from depot_manager.server import DOCK_COLOUR
 from swarm_sim.analysis.cli import main as analyze
-from swarm_sim.analysis import video
+from swarm_sim.analysis import video_canvas
 from swarm_sim.analysis.video import SIZE_PX, WIDTH_PX, render_video, save_frame
 from swarm_sim.scenario import load_scenario
 
@@ -82,7 +82,7 @@ def test_a_dir_with_two_bags_or_none_is_refused_naming_them(out_dir, tmp_path, c
 def test_the_legend_names_every_state_and_overlay_from_the_first_frame():
     from matplotlib.legend import Legend
 
-    canvas = video._Canvas(load_scenario("queue_qmt", ["robots.count=6"]), 6, {})
+    canvas = video_canvas.Canvas(load_scenario("queue_qmt", ["robots.count=6"]), 6, {})
     try:
         texts = {t.get_text() for artist in canvas.key.get_children() if isinstance(artist, Legend)
                  for t in artist.get_texts()}
@@ -90,9 +90,9 @@ def test_the_legend_names_every_state_and_overlay_from_the_first_frame():
         canvas.close()
     assert {"departing", "searching", "returning", "to entry", "queued", "no status yet"} <= texts
     assert {"depot: entry lines", "depot: docks", "depot: slots owned", "resource", "carried resource"} <= texts
-    colours = [video._PALETTE[canvas.states.index(s)] for s in ("QUEUED", "SEARCHING")]
+    colours = [video_canvas.PALETTE[canvas.states.index(s)] for s in ("QUEUED", "SEARCHING")]
     assert colours[0] != colours[1]
 
 
 def test_the_scale_bar_is_a_round_length_of_about_a_fifth_of_the_arena():
-    assert [video.scale_bar_m(size) for size in (4.0, 5.0, 8.0, 10.0, 12.0, 100.0)] == [0.5, 1, 2, 2, 2, 20]
+    assert [video_canvas.scale_bar_m(size) for size in (4.0, 5.0, 8.0, 10.0, 12.0, 100.0)] == [0.5, 1, 2, 2, 2, 20]
