@@ -20,6 +20,7 @@ import numpy as np
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.analysis.replay import load_odometry
+from swarm_sim.analysis.video import resource_points
 from swarm_msgs_py import topics
 from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.registry import Panel
@@ -226,8 +227,6 @@ def trajectories_figure(path: Path | str, *, start: float = 0.0, end: float | No
 
 def _resources_at_start(path: Path | str) -> np.ndarray:
     """(n, 2) the resources of the first ``/world/markers`` in the bag [m] (none: empty)."""
-    from swarm_sim.analysis.video import resource_points  # lazy: matplotlib/rosbags only for figures
-
     for m in read_bag(path):
         if m.topic == topics.WORLD_MARKERS:
             return resource_points(m.data)
