@@ -43,9 +43,11 @@ from launch_py.dds import (
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
-from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.analysis.text import summary_lines
+from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.nodes.ws_proxy import check_port
 from swarm_sim.recording import repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
@@ -108,15 +110,21 @@ def _raise_interrupt(*_: object) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="swarm-run", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="swarm-run", description=first_paragraph(__doc__), formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="exit codes:\n" + "\n".join(f"  {code:3d}  {what}" for code, what in EXIT_CODES.items()))
     add_scenario_arguments(parser)
     parser.add_argument("--out", type=Path, default=Path("bags"), help="directory for bags (default: bags)")
     parser.add_argument("--bag", type=Path, help="exact bag directory (default: OUT/<scenario>_<N>r_s<seed>_<time>)")
-    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
+    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep",
+                        help="lockstep (default): the world waits for every controller's answer to each tick, "
+                             "so a run equals the batch run of its seed; realtime: the world steps at "
+                             "--real-time-factor with whatever commands have arrived, as Gazebo does")
     parser.add_argument("--controller-processes", type=number(int, 0), default=1, metavar="K",
                         help="processes for the controllers (default 1; 0 = one per robot)")
-    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0,
-                        help="realtime mode's target")
+    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), metavar="X",
+                        help="sim seconds per wall second: realtime mode's target (default 1); in lockstep "
+                             "the fastest it may go (default: as fast as the nodes answer; 1 with --foxglove)")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
     parser.add_argument("--domain-id", type=number(int, 0, MAX_DOMAIN_ID),
@@ -141,6 +149,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"swarm-run: {exc}", file=sys.stderr)
         return 2
 
+    if (problem := _foxglove_problem(args)) is not None:
+        print(f"swarm-run: {problem}", file=sys.stderr)
+        return 2
+    pace = _pace(args)
     bag = args.bag or default_bag_dir(args.out, scenario)
     if bag.exists() and (not bag.is_dir() or any(bag.iterdir())):
         print(f"swarm-run: --bag {bag}: already exists and is not an empty directory (a run never "
@@ -173,7 +185,9 @@ def main(argv: list[str] | None = None) -> int:
     if port is not None:
         print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
               f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
-              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list", flush=True)
+              f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list --spin-time 2  (discovery takes "
+              "~1.5 s: --spin-time 2 without a daemon, or `ros2 daemon start` once with the same variables)",
+              flush=True)
     python = [sys.executable, "-m"]
     me = os.getpid()
 
@@ -182,7 +196,9 @@ def main(argv: list[str] | None = None) -> int:
         return label, proc
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
-                 "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor)]
+                 "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor or 1.0)]
+    if pace:
+        world_cmd += ["--pace", str(pace)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
@@ -236,22 +252,49 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if world_died:
             repair_bag(bag)
-        summary = summarize(load_run(bag))
+        trace = load_run(bag)
+        summary = summarize(trace)
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
         return 1
     if args.json:
         print(json.dumps(summary))
     else:
-        print(
-            f"[swarm-run] done: {summary['resources_delivered']}/{summary['total_resources']} resources "
-            f"delivered in {summary['sim_seconds']:.1f} s sim ({summary['wall_seconds']:.1f} s wall, "
-            f"{summary['real_time_factor']}x); collision {summary['collision_time_per_robot_s']:.2f} s/robot; "
-            f"OAE {summary['oae_per_robot']:.1f}/robot; stale ticks {summary['stale_ticks']}\n"
-            f"[swarm-run] bag: {bag}  (swarm-analyze {bag})",
-            flush=True,
-        )
+        print("\n".join(_done_lines(summary, trace.config, bag)), flush=True)
     return _verdict(summary, world_died=world_died, interrupted=interrupted)
+
+
+def _done_lines(summary: dict, scenario: Scenario | None, bag: Path) -> list[str]:
+    """The run's end: the same per-paper text as ``swarm-analyze`` (`swarm_sim.analysis.text`)."""
+    rtf = summary.get("real_time_factor")
+    return [f"[swarm-run] done: {summary['sim_seconds']:.1f} s sim in {summary['wall_seconds']:.1f} s wall"
+            + (f" ({rtf}x)" if rtf else ""),
+            *summary_lines(summary, scenario),
+            f"[swarm-run] bag: {bag}  (swarm-analyze {bag} --trajectories for its figures)"]
+
+
+def _foxglove_problem(args: argparse.Namespace) -> str | None:
+    """Why the live view could not listen where ``--foxglove`` asks (checked before any node
+    starts; the world binds the port again a second later), or None."""
+    if args.foxglove is None:
+        return None
+    reason = check_port(args.foxglove_host, args.foxglove)
+    if reason is None:
+        return None
+    return (f"--foxglove {args.foxglove}: cannot listen on {args.foxglove_host}:{args.foxglove} ({reason}); "
+            "name a free port, or --foxglove 0 for any free one")
+
+
+def _pace(args: argparse.Namespace) -> float | None:
+    """Lockstep's cap on sim seconds per wall second: ``--real-time-factor`` if given; 1 with
+    ``--foxglove`` (a 300 s run would be over in ~20 s otherwise, too fast to watch)."""
+    if args.mode != "lockstep":
+        return None
+    if args.real_time_factor is None and args.foxglove is not None:
+        print("[swarm-run] --foxglove in lockstep: paced at 1x real time so it can be watched "
+              "(--real-time-factor X to go faster, e.g. 20)", flush=True)
+        return 1.0
+    return args.real_time_factor
 
 
 def _how(returncode: int) -> str:

@@ -45,6 +45,7 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim import registry
 from swarm_sim.behaviour import Behaviour, behaviour_rng
+from swarm_sim.cli import first_paragraph
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
 from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
 from swarm_sim.scenario import Scenario, load_scenario
@@ -143,7 +144,7 @@ class ControllerNode(Node):
         if command.messages:
             self.endpoint.send(stamp_ns, command.messages)
         status = self.behaviour.status(stamp_ns)
-        key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
+        key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra, status.finished)
         if key != self._last_status:
             self._last_status = key
             self._status_pub.publish(diagnostics.encode_status(status))
@@ -154,7 +155,7 @@ class ControllerNode(Node):
 
 
 def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool]:
-    parser = argparse.ArgumentParser(prog="swarm-controllers", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-controllers", description=first_paragraph(__doc__))
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
     add_endpoint_arguments(parser)
     parser.add_argument("--fork", action="store_true", help="one process per robot, forked from this one")

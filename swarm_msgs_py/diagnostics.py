@@ -15,8 +15,9 @@ Typed payloads (one status per record, level OK):
   ``collision_time_s`` (body contact), ``pickups``, ``deliveries``, ``clamped_commands``,
   ``stale_ticks``, ``avoidance_time_s`` (proximity ring saw something ahead).
 - `/<robot>/status` (`encode_status`): one status, name = hardware_id = robot,
-  message = state, values ``state``, ``obstacle_avoidance_events``, ``trips``, then the
-  behaviour's extra pairs in order.
+  message = state, values ``state``, ``obstacle_avoidance_events``, ``trips``, ``finished`` =
+  ``true`` once the behaviour's task is over (left out before), then the behaviour's extra pairs
+  in order.
 """
 
 from __future__ import annotations
@@ -215,6 +216,9 @@ def decode_robot_stats(data: bytes) -> tuple[int, dict[RobotId, RobotStats]]:
 # --------------------------------------------------------------------------- /<robot>/status
 
 _BEHAVIOUR_KEYS = ("state", "obstacle_avoidance_events", "trips")
+_FINISHED = ("finished", "true")
+"""The fourth pair of a finished behaviour's status (absent otherwise, so the bytes of every
+other status are what they were before the flag existed)."""
 
 
 @codec(f"{TYPE_NAME} (behaviour status)")
@@ -223,6 +227,7 @@ def encode_status(status: BehaviourStatus) -> bytes:
         ("state", status.state),
         ("obstacle_avoidance_events", str(int(status.obstacle_avoidance_events))),
         ("trips", str(int(status.trips))),
+        *((_FINISHED,) if status.finished else ()),
         *((str(k), str(v)) for k, v in status.extra),
     )
     return encode_diagnostics(
@@ -240,7 +245,8 @@ def decode_status(data: bytes) -> BehaviourStatus:
     if keys != _BEHAVIOUR_KEYS:
         raise ValueError(f"status {s.name!r}: leading keys {keys}, expected {_BEHAVIOUR_KEYS}")
     (_, state), (_, avoid), (_, trips) = s.values[:3]
-    return BehaviourStatus(s.name, stamp_ns, state, int(avoid), int(trips), s.values[3:])
+    finished = s.values[3:4] == (_FINISHED,)
+    return BehaviourStatus(s.name, stamp_ns, state, int(avoid), int(trips), s.values[3 + finished:], finished)
 
 
 # --------------------------------------------------------------------------- /diagnostics

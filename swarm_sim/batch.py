@@ -29,15 +29,16 @@ import numpy as np
 
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import RunTrace, summarize
+from swarm_sim.analysis.text import summary_line
 from swarm_sim.behaviour import behaviour_rng
-from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task, task_factory
 from swarm_sim.registry import probes as registered_probes
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
+from swarm_sim.types import FINISHED, NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
 from swarm_sim.world.observations import with_messages
 
@@ -136,6 +137,7 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             _collect_events(world, trace)
             _record_state(world, state_topics, trace)
             if scenario.sim.stop_when_finished and all(getattr(b, "finished", False) for b in behaviours.values()):
+                trace.ended = FINISHED
                 if poses is not None:
                     poses = poses[:k + 2]
                 break
@@ -180,7 +182,7 @@ def run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="swarm-batch", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-batch", description=first_paragraph(__doc__))
     add_scenario_arguments(parser)
     parser.add_argument("--runs", type=number(int, 1, 10**6), default=1, help="runs with seeds seed, seed+1, ...")
     add_executor_arguments(parser)
@@ -198,7 +200,8 @@ def main(argv: list[str] | None = None) -> int:
         with executor_from_args(args) as executor, Progress(len(jobs), f"swarm-batch ({executor.name})") as bar:
             for outcome in executor.map(run_one, jobs):
                 if outcome.ok:
-                    bar.write(_result_line(outcome.value, args.json), numbered=False)
+                    bar.write(json.dumps(outcome.value) if args.json else summary_line(outcome.value, base),
+                              numbered=False)
                 else:
                     failed += 1
                     bar.write(f"swarm-batch: seed {seeds[outcome.index]} failed: {outcome.error}",
@@ -213,18 +216,6 @@ def main(argv: list[str] | None = None) -> int:
     if failed:
         print(f"swarm-batch: {failed} of {len(jobs)} runs failed", file=sys.stderr)
     return 1 if failed else 0
-
-
-def _result_line(result: dict, as_json: bool) -> str:
-    if as_json:
-        return json.dumps(result)
-    return (
-        f"{result['scenario']} seed={result['seed']} robots={result['robots']}: "
-        f"delivered {result['resources_delivered']}/{result['total_resources']} in "
-        f"{result['sim_seconds']:.0f} s sim, {result['wall_seconds']:.1f} s wall "
-        f"({result['real_time_factor']}x), collision {result['collision_time_per_robot_s']:.2f} "
-        f"s/robot, OAE {result['oae_per_robot']:.1f}/robot"
-    )
 
 
 if __name__ == "__main__":

@@ -19,7 +19,8 @@ from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId, robo
 @runtime_checkable
 class Behaviour(Protocol):
     """One robot's controller. It may also have a ``finished`` attribute (True once its task is
-    over; `swarm_sim.scenario.SimConfig.stop_when_finished`)."""
+    over; `swarm_sim.scenario.SimConfig.stop_when_finished`), which its status then reports too
+    (``BehaviourStatus.finished``: how the world node learns it on the graph)."""
 
     def step(self, obs: Observation) -> Command:
         """The command answering the tick `obs` describes; messages go out with it."""

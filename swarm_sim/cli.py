@@ -30,6 +30,12 @@ def number(kind: type, low: float, high: float = math.inf, *, open_low: bool = F
     return parse
 
 
+def first_paragraph(doc: str | None) -> str:
+    """A module docstring's first paragraph as one line: a command's ``--help`` description,
+    whole (never its first line cut mid-sentence)."""
+    return " ".join((doc or "").strip().split("\n\n")[0].split())
+
+
 _SENTENCE_END = re.compile(r"(?<=[a-z0-9)]{4})\. (?=[A-Z])")
 """A full stop that ends a sentence: not after an abbreviation (Sec., et al.), not before a number."""
 

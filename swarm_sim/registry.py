@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from swarm_msgs_py.topics import heard
+from swarm_sim.presentation import Measure, Panel
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.types import robot_index
 
@@ -51,16 +52,6 @@ if TYPE_CHECKING:
     from swarm_sim.scenario.schema import DropZoneConfig, Scenario
 
 ENTRY_POINT_GROUP = "swarmforage.algorithms"
-
-
-@dataclass(frozen=True)
-class Measure:
-    """A result field (`swarm_sim.analysis.metrics.summarize`) that a run's text summary shows
-    (``swarm-analyze``), in the paper's words and unit."""
-
-    field: str
-    unit: str = ""
-    """Printed after the value (``s``, ``%``, ``min``); empty for counts and ratios."""
 
 
 @dataclass(frozen=True)
@@ -109,6 +100,11 @@ class TaskSpec:
     extends: str | None = None
     """The task it builds on (the DRTM nest is the foraging task with food and a light): the
     probes of that task measure its runs too."""
+    panels: tuple[Panel, ...] = ()
+    """Its panels of a run's summary figure (before its algorithm's)."""
+    bodies: str | None = None
+    """``module:function`` ``(scenario) -> {state field: diameter [m]}``: the bodies a replay
+    video draws to scale where its state topics put them (the caging object)."""
     world: tuple[tuple[str, str], ...] = ()
     """(section, ``module:Dataclass``): the world facts it adds, each a top-level scenario
     section (a `swarm_sim.scenario.WorldSection`)."""
@@ -201,6 +197,19 @@ class Algorithm:
     by ``swarm-analyze --trajectories`` (None: none)."""
     headline: tuple[Measure, ...] = ()
     """The paper's own measures, as a run's text summary shows them (after its task's)."""
+    progress: str | None = None
+    """``module:function`` ``(statuses) -> str``: what the world node's progress line says of the
+    run, from every robot's last reported status (`swarm_sim.types.BehaviourStatus`, by robot;
+    e.g. the caging stage); None: its world task's ``progress()`` (deliveries)."""
+    panels: tuple[Panel, ...] = ()
+    """Its own panels of a run's summary figure (after its task's): e.g. its servers' series."""
+    backdrop: str | None = None
+    """``module:function`` ``(ax, scenario) -> None``: what it lays out in the world (a depot's
+    queues and docks, regions, landmarks), drawn under the recorded trajectories on a matplotlib
+    axis in metres, each part with a legend label."""
+    states: tuple[str, ...] = ()
+    """Every state its robots' statuses can report (``BehaviourStatus.state``), in the order a
+    replay video's legend lists them, each with its own colour from the first frame."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

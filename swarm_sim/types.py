@@ -161,6 +161,9 @@ class NodeDownEvent:
 
 
 NODE_KINDS = ("robot", "server")
+FINISHED = "finished"
+"""A run's ``run_ended`` when it stopped because every behaviour's task was over
+(``sim.stop_when_finished``)."""
 
 
 @dataclass(slots=True)
@@ -191,6 +194,9 @@ class BehaviourStatus:
     obstacle_avoidance_events: int
     trips: int
     extra: tuple[tuple[str, str], ...] = field(default=())
+    finished: bool = False
+    """The behaviour's task is over (its ``finished``): what ``sim.stop_when_finished`` waits for,
+    in batch runs and on the graph alike."""
 
 
 # ---------------------------------------------------------------------- fast constructors

@@ -478,7 +478,7 @@ def test_robot_stats_of_a_bag_recorded_before_avoidance_time_decode():
 BEHAVIOUR_ST = st.builds(
     BehaviourStatus,
     st.sampled_from(ROBOTS), STAMPS, TEXT, st.integers(0, 10**9), st.integers(0, 10**9),
-    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple),
+    st.lists(st.tuples(TEXT, TEXT), max_size=3).map(tuple), st.booleans(),
 )  # fmt: skip
 
 
@@ -495,6 +495,10 @@ def test_behaviour_status_mapping():
     assert (s.name, s.message, s.hardware_id) == ("robot_9", "returning", "robot_9")
     assert [kv.key for kv in s.values] == ["state", "obstacle_avoidance_events", "trips", "site"]
     assert diagnostics.decode_status(serialize_message(msg)) == status
+    done = BehaviourStatus("robot_9", 10, "done", 4, 2, (("site", "1.0,2.0"),), finished=True)
+    (s,) = deserialize_message(diagnostics.encode_status(done), DiagnosticArray).status
+    assert [(kv.key, kv.value) for kv in s.values][3] == ("finished", "true")  # what `ros2 topic echo` shows
+    assert diagnostics.decode_status(diagnostics.encode_status(done)) == done
 
 
 # --------------------------------------------------------------------------- malformed input

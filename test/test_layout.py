@@ -26,9 +26,6 @@ COMMON_WORDS = {
     "center": "the spiral paper's server channel, and a plain word (a disc's centre, matplotlib's loc)",
 }
 """Names a paper uses that are also the shared core's own words, and why."""
-UNTIL_REBUILT = {"swarm_sim.nodes.foxglove_layout": "the shipped live layout, rebuilt from the records with the viewers (issue 28)"}
-"""Shared modules still naming a paper, each with the work that removes the names; the test fails
-once a module here names none (take it off the list then)."""
 LAZY = "lazy:"
 """What the comment on (or just above) a function-local import of a project module starts with."""
 
@@ -209,15 +206,10 @@ def test_no_paper_name_outside_its_package():
         if not shared:
             continue
         identifiers, strings = _code_words(path)
-        hits_here = []
         for paper, (spelt, fields) in papers.items():
             hits = sorted(((spelt | fields) & strings | fields & identifiers) - set(COMMON_WORDS))
             if hits:
-                hits_here.append(f"{module}: {paper}'s {', '.join(hits)}")
-        if module in UNTIL_REBUILT:
-            assert hits_here, f"{module} names no paper now: take it off UNTIL_REBUILT"
-        else:
-            found += hits_here
+                found.append(f"{module}: {paper}'s {', '.join(hits)}")
     assert found == []
 
 

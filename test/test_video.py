@@ -1,6 +1,7 @@
 """Replay video from a real bag (a short Q_MT graph run, written with ``--out DIR``): ``swarm-analyze
 DIR --video`` finds the one bag in DIR and writes an .mp4 that decodes to the expected frames; a .gif
-too; a DIR with two bags or none is refused in one line."""
+too; a DIR with two bags or none is refused in one line. The legend beside the arena lists every
+state and server overlay from the first frame; a scale bar of a round length."""
 
 from __future__ import annotations
 
@@ -17,7 +18,9 @@ import pytest
 
 from depot_manager.server import DOCK_COLOUR
 from swarm_sim.analysis.cli import main as analyze
-from swarm_sim.analysis.video import SIZE_PX, render_video, save_frame
+from swarm_sim.analysis import video_canvas
+from swarm_sim.analysis.video import SIZE_PX, WIDTH_PX, render_video, save_frame
+from swarm_sim.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -39,21 +42,23 @@ def test_analyze_dir_with_one_bag_renders_an_mp4(out_dir, tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert summary["video"] == str(video) and summary["video_frames"] == 13  # t = 0, 0.8, ..., 9.6
     frames = imageio.mimread(video, memtest=False)
-    assert len(frames) == 13 and frames[0].shape == (SIZE_PX, SIZE_PX, 3)
+    assert len(frames) == 13 and frames[0].shape == (SIZE_PX, WIDTH_PX, 3)
     assert np.abs(frames[-1].astype(int) - frames[0].astype(int)).sum() > 0  # the robots moved
 
 
-def test_gif_frames_show_the_robots_and_the_depot(out_dir, tmp_path):
+def test_gif_frames_show_the_robots_and_the_depot(out_dir, tmp_path, capsys):
     (bag,) = out_dir.iterdir()
-    info = render_video(bag, tmp_path / "run.gif", speedup=10, fps=2, start=5, max_frames=3)
+    info = render_video(bag, tmp_path / "run.gif", speedup=10, fps=2, start=5, max_frames=3, progress=True)
+    err = capsys.readouterr().err
+    assert "rendering run.gif" in err and "0/3" in err and "frame/s" in err  # the progress bar
     assert (info.frames, info.start_s, info.end_s) == (3, 5.0, 15.0)
     frames = imageio.mimread(tmp_path / "run.gif")
     assert len(frames) == 3
     png = save_frame(bag, 12.0, tmp_path / "frame.png")
     image = imageio.imread(png)[..., :3].reshape(-1, 3).astype(int)
-    tab_blue = np.array([31, 119, 180])  # a robot state
+    states = np.array([[31, 119, 180], [255, 127, 14], [44, 160, 44]])  # departing, searching, returning
     docks = np.round(255 * np.array(DOCK_COLOUR[:3]))  # drawn in the colour the depot manager gives them
-    assert (np.abs(image - tab_blue).sum(axis=1) < 10).sum() > 20
+    assert (np.abs(image[:, None, :] - states[None]).sum(axis=2) < 10).any(axis=1).sum() > 20
     assert (np.abs(image - docks).sum(axis=1) < 10).sum() > 20
 
 
@@ -72,3 +77,22 @@ def test_a_dir_with_two_bags_or_none_is_refused_naming_them(out_dir, tmp_path, c
         render_video(bag, tmp_path / "x.avi")
     with pytest.raises(ValueError, match="time window"):
         render_video(bag, tmp_path / "x.gif", start=1000)
+
+
+def test_the_legend_names_every_state_and_overlay_from_the_first_frame():
+    from matplotlib.legend import Legend
+
+    canvas = video_canvas.Canvas(load_scenario("queue_qmt", ["robots.count=6"]), 6, {})
+    try:
+        texts = {t.get_text() for artist in canvas.key.get_children() if isinstance(artist, Legend)
+                 for t in artist.get_texts()}
+    finally:
+        canvas.close()
+    assert {"departing", "searching", "returning", "to entry", "queued", "no status yet"} <= texts
+    assert {"depot: entry lines", "depot: docks", "depot: slots owned", "resource", "carried resource"} <= texts
+    colours = [video_canvas.PALETTE[canvas.states.index(s)] for s in ("QUEUED", "SEARCHING")]
+    assert colours[0] != colours[1]
+
+
+def test_the_scale_bar_is_a_round_length_of_about_a_fifth_of_the_arena():
+    assert [video_canvas.scale_bar_m(size) for size in (4.0, 5.0, 8.0, 10.0, 12.0, 100.0)] == [0.5, 1, 2, 2, 2, 20]

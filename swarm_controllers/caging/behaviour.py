@@ -362,4 +362,5 @@ class CagingBehaviour:
             ("dropped", str(self.dropped)),
             ("ignored_messages", str(self.ignored)),
         )
-        return BehaviourStatus(self.robot, self._stamp if stamp_ns is None else stamp_ns, self.phase.value, 0, 0, extra)
+        return BehaviourStatus(self.robot, self._stamp if stamp_ns is None else stamp_ns, self.phase.value, 0, 0, extra,
+                               self.finished)

@@ -215,3 +215,9 @@ cage_held = _field("cage_held")
 max_path_deviation_m = _field("max_path_deviation_m")
 landmark_count = _field("landmarks")
 cage_size = _field("cage_size")
+
+
+def object_delivered(trace) -> bool:
+    """Whether the transport ended: every cage robot sent its type 4 for the final landmark (the
+    object is at p_r*^0; ``transport_time_s`` is then known)."""
+    return caging_report(trace).transport_time_s is not None

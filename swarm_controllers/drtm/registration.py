@@ -1,7 +1,7 @@
 """The DRTM paper's registry records (drtm_task_allocation.md, Pang et al. 2023): its nest task,
 DRTM and the ARTM baseline, both served by the nest."""
 
-from swarm_sim.registry import Algorithm, Measure, Metric, ServerSpec, TaskSpec, register, register_task
+from swarm_sim.registry import Algorithm, Measure, Metric, Panel, ServerSpec, TaskSpec, register, register_task
 
 register_task(TaskSpec(
     name="nest",
@@ -9,6 +9,8 @@ register_task(TaskSpec(
     sensing="swarm_controllers.drtm.sensing:SENSING",
     metrics="swarm_sim.analysis.metrics:foraging_metrics",
     extends="foraging",
+    panels=(Panel("food tokens delivered, F_t", "F_t [tokens]", "swarm_sim.analysis.metrics:delivered_series",
+                  integer=True),),
 ))
 
 _SECTIONS = (("nest", "swarm_controllers.drtm.config:NestConfig"),
@@ -23,9 +25,18 @@ _METRICS = tuple(
                  "nest_food_series", "active_robots_series", "oae_series")
 )
 
-_HEADLINE = (Measure("food_deviation"), Measure("energy_efficiency"), Measure("oae_total"),
-             Measure("oae_per_robot"), Measure("food_collected"), Measure("nest_food_final"))
+_HEADLINE = (Measure("food_deviation", "tokens", "V_f"), Measure("energy_efficiency", "%", "E_e", scale=100.0),
+             Measure("oae_total", "events", "M_T"), Measure("oae_per_robot", "events/robot", "M_v"),
+             Measure("food_collected", "tokens", "F_t"), Measure("nest_food_final", "tokens", "F(T)"))
 """The paper's V_f [tokens], E_e, M_T, M_v, F_t [tokens] and F(T) [tokens] (Sec. 3, eqs. (8)-(9))."""
+_FIGURES = "swarm_controllers.drtm.figures"
+_PANELS = (
+    Panel("food in the nest, F(t)", "F(t) [tokens]", "nest_food", references=f"{_FIGURES}:desired_food"),
+    Panel("robots foraging, N_r - N_W", "robots foraging [robots]", f"{_FIGURES}:foraging_robots", integer=True),
+    Panel("obstacle-avoidance events so far, M_T(t)", "OAEs [events]", "nest_oaes", integer=True),
+    Panel("obstacle-avoidance events per robot", "OAEs [events]", "oae_by_robot", integer=True),
+)
+"""Figs. 5-6 (food and robots foraging over time) and the OAE counts behind M_T and M_v."""
 
 for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
                              ("artm", "ArtmBehaviour", "ARTM (Castello et al.), the baseline")):
@@ -40,4 +51,6 @@ for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
         metrics=_METRICS,
         comparison="swarm_controllers.drtm.comparison:DRTM_COMPARISON",
         headline=_HEADLINE,
+        panels=_PANELS,
+        states=("waiting", "searching", "returning"),
     ))

@@ -2,13 +2,14 @@
 docks in `depot_manager.docks`) and the queue strategies, the robots' side here, the depot
 manager's server in the top-level `depot_manager` package."""
 
-from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES
+from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES, STATES
 from swarm_controllers.cpfa.registration import SECTION as CPFA_SECTION
 from swarm_sim.registry import (
     Algorithm,
     DeliveryKind,
     Measure,
     Metric,
+    Panel,
     Probe,
     ServerSpec,
     register,
@@ -47,6 +48,11 @@ register(Algorithm(
         Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
     ),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
-    headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s"), Measure("deliveries_outside_docks"),
-              Measure("queue_length_mean"), Measure("queue_length_max")),
+    headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s", "time delay"),
+              Measure("queue_length_mean", "robots"), Measure("queue_length_max", "robots")),
+    panels=(Panel("robots queued on each entry line", "robots queued [robots]", "queue_lengths",
+                  legend=("entry line {i}",), integer=True),),
+    backdrop="swarm_controllers.queue.figures:layout",
+    states=(*STATES, "TO_ENTRY", "SEEKING", "JOINING", "QUEUED", "LEAVING"),
+    # foraging: the CPFA's states; at the depot: its `Phase` names
 ))

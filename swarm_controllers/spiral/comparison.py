@@ -398,7 +398,8 @@ def spiral_headlines(rows: Sequence[dict], experiment: int, cells: Sequence[int]
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--experiment", type=int, choices=sorted(SPIRAL_EXPERIMENTS), required=True)
+    parser.add_argument("--experiment", type=int, choices=sorted(SPIRAL_EXPERIMENTS), required=True,
+                        help="the paper's experiment: 1 (regions, Figs. 6-7), 2 (robots, Figs. 8-9), 3 (resources, Fig. 10)")
     parser.add_argument("--values", type=int, nargs="+",
                         help="the swept setting's values (default: the paper's; regions, robots or resources)")
     parser.add_argument("--layout", choices=LAYOUTS, default=LAYOUTS[0],

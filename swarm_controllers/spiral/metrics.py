@@ -35,3 +35,10 @@ def resources_per_robot_per_min(trace: Any) -> list[list[float]]:
         if 0 <= m < minutes:
             counts[m] += 1
     return [[60.0 * (m + 1), round(c / robots, 6)] for m, c in enumerate(counts)]
+
+
+def resources_per_robot_per_min_mean(trace: Any) -> float | None:
+    """The mean over the run's complete minutes of `resources_per_robot_per_min`: resources per
+    robot per minute (the spiral paper's foraging rate as one number); None under a minute."""
+    per_minute = resources_per_robot_per_min(trace)
+    return round(sum(v for _, v in per_minute) / len(per_minute), 6) if per_minute else None

@@ -2,16 +2,22 @@
 MDBSA with centralized (C) and distributed (D) delivery, both served by the center and both
 declaring the ``regions`` world section; MDBSA-D's ``region_centers`` delivery kind."""
 
-from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, ServerSpec, register, register_delivery
+from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, Panel, ServerSpec, register, register_delivery
 
 _SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
 _CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
-_METRICS = (Metric("resources_per_robot_per_min",
-                   "swarm_controllers.spiral.metrics:resources_per_robot_per_min", None),)
-_HEADLINE = (Measure("resources_per_robot"), Measure("resources_per_robot_per_min", "/min"),
-             Measure("resources_collected_pct", "%"), Measure("collision_time_per_robot_s", "s"))
-"""The spiral paper's measures (Figs. 6-10): resources per robot, their rate, collision time."""
+_METRICS = tuple(Metric(name, f"swarm_controllers.spiral.metrics:{name}", None)
+                 for name in ("resources_per_robot_per_min", "resources_per_robot_per_min_mean"))
+_HEADLINE = (Measure("resources_per_robot", "resources", "collected per robot"),
+             Measure("resources_per_robot_per_min_mean", "resources/min", "foraging rate per robot"),
+             Measure("resources_collected_pct", "%"),
+             Measure("collision_time_per_robot_s", "s", "collision time per robot"))
+"""The spiral paper's measures (Figs. 6-10): resources per robot, their rate per minute (the
+per-minute series itself is in the JSON), collision time per robot."""
 _COMPARISON = "swarm_controllers.spiral.comparison:SPIRAL_COMPARISON"
+_PANELS = (Panel("foraging rate per minute", "collected per robot [resources/min]",
+                 "swarm_controllers.spiral.figures:rate_per_minute"),)
+"""Figs. 7 and 9: resources collected per robot in each minute."""
 _REGIONS = ("regions", "swarm_controllers.spiral.regions:RegionConfig")
 _CENTER = ServerSpec(
     channel="center", core="swarm_controllers.spiral.center:CenterServer",
@@ -34,6 +40,8 @@ register(Algorithm(
     paths="swarm_controllers.spiral.ddsa:planned_paths",
     comparison=_COMPARISON,
     headline=_HEADLINE,
+    panels=_PANELS,
+    states=("SEARCHING", "RETURNING", "RESUMING", "DONE"),
 ))
 
 for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
@@ -49,5 +57,8 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
         paths="swarm_controllers.spiral.center:planned_paths",
         comparison=_COMPARISON,
-        headline=(*_HEADLINE, Measure("regions")),
+        headline=(*_HEADLINE, Measure("regions", symbol="N_regions")),
+        panels=_PANELS,
+        backdrop="swarm_controllers.spiral.figures:regions",
+        states=("TO_CENTER", "WAITING", "IDLE", "TRAVELING", "SEARCHING", "DELIVERING", "RESUMING"),
     ))

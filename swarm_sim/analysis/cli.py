@@ -17,7 +17,7 @@ from swarm_sim.analysis.plots import plot_run, plot_trajectories
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.analysis.text import summary_lines
 from swarm_sim.analysis.video import render_video
-from swarm_sim.cli import number
+from swarm_sim.cli import first_paragraph, number
 from swarm_sim.recording import BagError, repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
 
@@ -36,11 +36,11 @@ def find_bag(path: Path) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="swarm-analyze", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-analyze", description=first_paragraph(__doc__))
     parser.add_argument("bags", nargs="+", type=Path, help="bag directories written by swarm-run")
     parser.add_argument("--json", action="store_true", help="print one JSON object per run")
     parser.add_argument("--plot", type=Path, help="PNG path (default: <bag>/summary.png)")
-    parser.add_argument("--no-plot", action="store_true")
+    parser.add_argument("--no-plot", action="store_true", help="write no summary.png")
     parser.add_argument("--trajectories", action="store_true",
                         help="also draw <bag>/trajectories.png (odometry over the planned paths) and the "
                              "algorithm's own figures (caging: <bag>/transport.png)")
@@ -70,8 +70,8 @@ def main(argv: list[str] | None = None) -> int:
             status = 1
             continue
         summary = summarize(trace)
-        if not args.no_plot:
-            summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
+        if not args.no_plot and (plot := plot_run(trace, args.plot or bag / "summary.png")) is not None:
+            summary["plot"] = str(plot)
         if args.trajectories:
             summary["trajectories"] = str(plot_trajectories(bag, bag / "trajectories.png"))
             figures = registry.of(trace.config).figures

@@ -63,12 +63,10 @@ def resources_delivered(trace: RunTrace) -> int:
     return len(trace.drops)
 
 
-def delivered_over_time(trace: RunTrace, bin_s: float = 10.0) -> tuple[np.ndarray, np.ndarray]:
-    """Cumulative deliveries at the end of each `bin_s` bin: (times [s], counts)."""
-    edges = np.arange(0.0, trace.sim_seconds + bin_s, bin_s)
-    times = np.array([d.stamp_ns / NS_PER_S for d in trace.drops])
-    counts = np.searchsorted(np.sort(times), edges, side="right")
-    return edges, counts
+def delivered_series(trace: RunTrace) -> list[tuple[float, int]]:
+    """(t [s], deliveries so far) from 0 and at every drop: the summary figure's step line."""
+    times = sorted(d.stamp_ns / NS_PER_S for d in trace.drops)
+    return [(0.0, 0), *((t, k + 1) for k, t in enumerate(times))]
 
 
 def collision_time_by_robot(trace: RunTrace) -> dict[RobotId, float]:

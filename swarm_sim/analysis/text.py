@@ -1,6 +1,8 @@
 """A run's summary as text: the run's own facts, then the measures its world task and its
-algorithm declare (`swarm_sim.registry.Measure`), each with its unit; every other field of the
-JSON result (one schema for all runs) stays out of the text."""
+algorithm declare (`swarm_sim.registry.Measure`), each with its unit and the paper's symbol;
+every other field of the JSON result (one schema for all runs) stays out of the text, and so do
+time series and per-robot tables, which only ``--json`` prints. ``swarm-run`` ends with these
+lines and ``swarm-analyze`` prints them, so both read the same."""
 
 from __future__ import annotations
 
@@ -18,6 +20,8 @@ RUN = (Measure("scenario"), Measure("seed"), Measure("robots"), Measure("mode"),
 _QUIET_WHEN_EMPTY = ("dead_nodes", "rejected_messages")
 OUTPUTS = ("plot", "trajectories", "figures", "video", "video_frames")
 """Files a command wrote, shown last."""
+NAME_WIDTH = 30
+VALUE_WIDTH = 20
 
 
 def measures(scenario: Scenario | None) -> tuple[Measure, ...]:
@@ -29,20 +33,53 @@ def measures(scenario: Scenario | None) -> tuple[Measure, ...]:
     return tuple({m.field: m for m in (*RUN, *own)}.values())
 
 
-def _value(value: Any, unit: str) -> str:
+def _count(value: Any) -> int:
+    """The total of a nested {key: count} table (``rejected_messages``)."""
+    return sum(map(_count, value.values())) if isinstance(value, Mapping) else int(value)
+
+
+def _value(value: Any, m: Measure) -> str:
     if value is None:
-        return "n/a"
+        return m.missing
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, Mapping):  # {where: {reason: count}}: the total, the first few places
+        places = ", ".join(list(value)[:3]) + (" ..." if len(value) > 3 else "")
+        return f"{_count(value)} ({places})"
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        return ", ".join(value)
+    if isinstance(value, (int, float)) and m.scale != 1.0:
+        value = value * m.scale
     if isinstance(value, float):
         value = f"{value:.6g}"
-    return f"{value} {unit}" if unit else str(value)
+    return f"{value} {m.unit}" if m.unit else str(value)
+
+
+def _is_series(value: Any) -> bool:
+    """A time series or a table of numbers: JSON only."""
+    return isinstance(value, (list, tuple)) and not all(isinstance(v, str) for v in value)
 
 
 def summary_lines(summary: Mapping[str, Any], scenario: Scenario | None) -> list[str]:
-    """``  name   value unit`` for each measure the summary has, then the files written."""
+    """``  field   value unit   symbol`` for each measure the summary has, then the files written."""
     lines = []
     for m in measures(scenario):
-        if m.field not in summary or (m.field in _QUIET_WHEN_EMPTY and not summary[m.field]):
+        value = summary.get(m.field)
+        if m.field not in summary or _is_series(value) or (m.field in _QUIET_WHEN_EMPTY and not value):
             continue
-        lines.append(f"  {m.field:28s} {_value(summary[m.field], m.unit)}")
-    lines += [f"  {key:28s} {summary[key]}" for key in OUTPUTS if key in summary]
+        lines.append(f"  {m.field:{NAME_WIDTH}s} {_value(value, m):{VALUE_WIDTH}s} {m.symbol}".rstrip())
+    for key in OUTPUTS:
+        if key in summary:
+            value = summary[key]
+            lines.append(f"  {key:{NAME_WIDTH}s} {', '.join(value) if isinstance(value, list) else value}")
     return lines
+
+
+def summary_line(summary: Mapping[str, Any], scenario: Scenario | None) -> str:
+    """One line per run (``swarm-batch``): what ran, then its task's and algorithm's measures."""
+    own = measures(scenario)[len(RUN):] if scenario is not None else ()
+    shown = [f"{m.field} {_value(summary[m.field], m)}" for m in own
+             if summary.get(m.field) is not None and not _is_series(summary[m.field])]
+    head = (f"{summary.get('scenario')} seed={summary.get('seed')} robots={summary.get('robots')}: "
+            f"{summary.get('sim_seconds', 0):.0f} s sim, {summary.get('wall_seconds', 0):.1f} s wall")
+    return "; ".join([head, *shown])

@@ -12,11 +12,18 @@ the sim clock passes the next frame time, so memory stays flat however long the 
 - robots at their recorded odometry, true size, with a heading tick, coloured by the behaviour
   state they last reported (``/<robot>/status``), with a resource drawn on each carrier (between
   its pick-up and drop events);
-- the sim clock and the deliveries so far.
+- the sim clock and the deliveries so far (or what the algorithm's record makes of the robots'
+  statuses, `swarm_sim.registry.Algorithm.progress`: the caging stage);
+- the algorithm's planned paths when no server draws what it plans (DDSA's spirals);
+- a scale bar, and beside the arena a legend fixed from the first frame: every state the
+  algorithm's record lists (`Algorithm.states`), each in its own colour, and every server overlay
+  by namespace, in the server's colours (its core drawn once from the scenario).
 
-Frames are taken every ``speedup / fps`` sim seconds between `start` and `end`, rendered with
-matplotlib and encoded with imageio (its ffmpeg plugin for .mp4, Pillow for .gif). Markers are
-decoded with rosbags' Jazzy typestore; our own topics with the `swarm_msgs_py` codecs.
+The frame itself is drawn by `swarm_sim.analysis.video_canvas`. Frames are taken every
+``speedup / fps`` sim seconds between `start` and `end`, rendered with
+matplotlib and encoded with imageio (its ffmpeg plugin for .mp4, Pillow for .gif), with a
+progress bar on a terminal. Markers are decoded with rosbags' Jazzy typestore; our own topics with
+the `swarm_msgs_py` codecs.
 """
 
 from __future__ import annotations
@@ -28,22 +35,34 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
-from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_msgs_py import diagnostics, topics
+from swarm_sim import registry
+from swarm_sim.analysis.video_canvas import SIZE_PX, WIDTH_PX, Canvas
 from swarm_sim.recording import BagError, bag_info, read_bag
-from swarm_sim.scenario import Scenario, scenario_from_dict
-from swarm_sim.sites import drop_zones
-from swarm_sim.types import NS_PER_S, DropEvent, PickupEvent
+from swarm_sim.scenario import scenario_from_dict
+from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent
+
+__all__ = ("FORMATS", "SIZE_PX", "WIDTH_PX", "VideoInfo", "frames", "render_video", "resource_points", "save_frame")
 
 FORMATS = (".mp4", ".gif")
-SIZE_PX = 720
-"""Frame width and height [px] (a multiple of 16, as H.264 wants)."""
-_DPI = 100
-_PALETTE = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink",
-            "tab:olive", "tab:cyan", "tab:gray")
 _MARKER_TYPES = "visualization_msgs/msg/MarkerArray"
 _LINE_STRIP, _CUBE_LIST, _SPHERE_LIST = 4, 6, 7
 """visualization_msgs/Marker types drawn from the servers' markers."""
+_NOT_PLACED = frozenset({"walls", "drop_zones", "obstacles", "robots", "resources"})
+"""``/world/markers`` namespaces that are not a task's placed point sets."""
+
+
+@dataclass(frozen=True)
+class _Watch:
+    """What the bag's messages are read for besides robots, events and the world's markers."""
+
+    robots: dict[str, int]
+    overlays: frozenset[str]
+    """The servers' marker topics."""
+    bodies: dict[str, object]
+    """State topic -> its `StateTopic`, for the task's bodies (`TaskSpec.bodies`)."""
 
 
 @dataclass
@@ -52,7 +71,8 @@ class _State:
 
     odom: dict[int, bytes] = field(default_factory=dict)
     """Robot index -> its last odometry message (decoded only when a frame is drawn)."""
-    state: dict[int, str] = field(default_factory=dict)
+    status: dict[str, BehaviourStatus] = field(default_factory=dict)
+    """Robot -> its last reported status."""
     carrying: set[str] = field(default_factory=set)
     resources: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     delivered: int = 0
@@ -60,6 +80,11 @@ class _State:
     """Servers' line strips by (topic, namespace): (points [m], RGBA, width [m]) each."""
     points: dict[tuple[str, str], tuple[np.ndarray, tuple[float, ...], float, str]] = field(default_factory=dict)
     """Servers' point lists by (topic, namespace): (points [m], RGBA, size [m], matplotlib marker)."""
+    placed: dict[str, tuple[np.ndarray, tuple[float, ...]]] = field(default_factory=dict)
+    """What the world task placed besides resources (the caging landmarks), by name: (points
+    [m], RGBA), from ``/world/markers``."""
+    bodies: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """The task's bodies at their last state-topic position [m] (the caging object), by field."""
 
 
 @dataclass(frozen=True)
@@ -82,6 +107,11 @@ def _markers(data: bytes) -> list:
 _STORE = None
 
 
+def resource_points(data: bytes) -> np.ndarray:
+    """(n, 2) the resources lying on the ground in a ``/world/markers`` message [m]."""
+    return next((_xy(m) for m in _markers(data) if m.ns == "resources"), np.zeros((0, 2)))
+
+
 def _xy(marker) -> np.ndarray:
     return np.array([(p.x, p.y) for p in marker.points], dtype=float).reshape(-1, 2)
 
@@ -91,8 +121,9 @@ def _rgba(marker) -> tuple[float, ...]:
     return tuple(min(max(float(v), 0.0), 1.0) if math.isfinite(v) else 0.5 for v in (c.r, c.g, c.b, c.a))
 
 
-def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int], overlays: frozenset[str]) -> None:
-    """Fold one recorded message into the state; `overlays`: the servers' marker topics."""
+def _apply(state: _State, topic: str, data: bytes, watch: _Watch) -> None:
+    """Fold one recorded message into the state."""
+    robots = watch.robots
     if topic.endswith("/" + topics.ODOM):
         i = robots.get(topic[1:].partition("/")[0])
         if i is not None:
@@ -100,7 +131,7 @@ def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int], overl
     elif topic.endswith("/" + topics.STATUS):
         status = diagnostics.decode_status(data)
         if status.robot in robots:
-            state.state[robots[status.robot]] = status.state
+            state.status[status.robot] = status
     elif topic == topics.WORLD_EVENTS:
         for event in diagnostics.decode_events(data)[1]:
             if isinstance(event, PickupEvent):
@@ -115,7 +146,13 @@ def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int], overl
         for m in _markers(data):
             if m.ns == "resources":
                 state.resources = _xy(m)
-    elif topic in overlays:
+            elif m.ns not in _NOT_PLACED and m.type == _SPHERE_LIST:
+                state.placed[m.ns] = (_xy(m), _rgba(m))
+    elif topic in watch.bodies:
+        st = watch.bodies[topic]
+        _, (x, y) = st.decode(data)
+        state.bodies[st.field] = (float(x), float(y))
+    elif topic in watch.overlays:
         lines: dict[tuple[str, str], list] = {}
         for m in _markers(data):
             if m.type == _LINE_STRIP:
@@ -123,106 +160,6 @@ def _apply(state: _State, topic: str, data: bytes, robots: dict[str, int], overl
             elif m.type in (_CUBE_LIST, _SPHERE_LIST):
                 state.points[(topic, m.ns)] = (_xy(m), _rgba(m), float(m.scale.x), "s" if m.type == _CUBE_LIST else "o")
         state.lines.update(lines)
-
-
-class _Canvas:
-    """One matplotlib figure whose artists are updated per frame."""
-
-    def __init__(self, scenario: Scenario, robots: int) -> None:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        from matplotlib.collections import EllipseCollection, LineCollection
-
-        self.scenario = scenario
-        inch = SIZE_PX / _DPI
-        self.fig, ax = plt.subplots(figsize=(inch, inch), dpi=_DPI)
-        self.ax = ax
-        half = scenario.arena.size / 2
-        ax.plot([-half, half, half, -half, -half], [-half, -half, half, half, -half], color="black", lw=1.5)
-        for zone in drop_zones(scenario):
-            ax.add_patch(plt.Circle(zone.center, zone.radius, color="tab:green", alpha=0.25, lw=0))
-        for ob in scenario.obstacles:
-            w, h = ob.size
-            ax.add_patch(plt.Rectangle((ob.center[0] - w / 2, ob.center[1] - h / 2), w, h, color="tab:brown",
-                                       alpha=0.7))
-        margin = 0.05 * scenario.arena.size
-        ax.set(xlim=(-half - margin, half + margin), ylim=(-half - margin, half + margin), aspect="equal",
-               xticks=[], yticks=[])
-        self.server_lines = LineCollection([], linewidths=0.8, zorder=1)
-        ax.add_collection(self.server_lines)
-        self.server_points: dict[tuple[str, str], object] = {}
-        """A scatter per server point list: markers drawn at the size [m] the server gave them."""
-        self.resources = ax.scatter([], [], s=4, color="goldenrod", zorder=3, lw=0)
-        d = scenario.robots.diameter
-        self.robots = EllipseCollection(np.full(robots, d), np.full(robots, d), np.zeros(robots), units="xy",
-                                        offsets=np.zeros((robots, 2)), offset_transform=ax.transData,
-                                        edgecolors="black", linewidths=0.3, zorder=4)
-        ax.add_collection(self.robots)
-        self.headings = LineCollection([], colors="black", linewidths=0.6, zorder=5)
-        ax.add_collection(self.headings)
-        self.carried = ax.scatter([], [], s=6, color="gold", edgecolors="black", linewidths=0.2, zorder=6)
-        self.title = ax.set_title(f"{scenario.name}  t = 0.0 s", fontsize=10, family="monospace")
-        self.legend_states: list[str] = []
-        self.fig.tight_layout()
-        self._pt_per_m = ax.transData.get_matrix()[0, 0] * 72.0 / _DPI
-        """Points per metre at this figure's scale (a scatter's size is in points squared)."""
-
-    def _colour(self, state: str) -> str:
-        if state not in self.legend_states:
-            self.legend_states.append(state)
-            self._legend()
-        return _PALETTE[self.legend_states.index(state) % len(_PALETTE)]
-
-    def _legend(self) -> None:
-        from matplotlib.patches import Patch
-
-        handles = [Patch(facecolor=_PALETTE[i % len(_PALETTE)], label=s) for i, s in enumerate(self.legend_states)]
-        handles.append(Patch(facecolor="gold", label="carried resource"))
-        self.ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.8)
-
-    def draw(self, state: _State, t: float, robot_names: list[str]) -> np.ndarray:
-        segments, colours = [], []
-        for key in sorted(state.lines):
-            for xy, rgba, _ in state.lines[key]:
-                segments.append(xy)
-                colours.append(rgba)
-        self.server_lines.set_segments(segments)
-        self.server_lines.set_color(colours)
-        for key, artist in self.server_points.items():
-            if key not in state.points:
-                artist.set_offsets(np.zeros((0, 2)))
-        for key in sorted(state.points):
-            xy, rgba, size, shape = state.points[key]
-            if key not in self.server_points:
-                self.server_points[key] = self.ax.scatter([], [], marker=shape, zorder=2, lw=0)
-            artist = self.server_points[key]
-            artist.set_offsets(xy if len(xy) else np.zeros((0, 2)))
-            artist.set_sizes([max(1.0, (size * self._pt_per_m) ** 2)])
-            artist.set_color([rgba])
-        self.resources.set_offsets(state.resources if len(state.resources) else np.zeros((0, 2)))
-        poses = np.full((len(robot_names), 3), np.nan)
-        for i, data in state.odom.items():
-            _, pose, _, _ = odometry.decode_odometry(data)
-            poses[i] = (pose.x, pose.y, pose.yaw)
-        seen = ~np.isnan(poses[:, 0])
-        xy = np.where(seen[:, None], poses[:, :2], 1e6)  # robots not seen yet: off the canvas
-        self.robots.set_offsets(xy)
-        self.robots.set_facecolor([self._colour(state.state.get(i, "unknown")) for i in range(len(robot_names))])
-        reach = self.scenario.robots.diameter * 0.6
-        tips = xy + reach * np.column_stack([np.cos(np.nan_to_num(poses[:, 2])), np.sin(np.nan_to_num(poses[:, 2]))])
-        self.headings.set_segments([np.array([a, b]) for a, b, s in zip(xy, tips, seen) if s])
-        carriers = [i for i, r in enumerate(robot_names) if r in state.carrying and seen[i]]
-        self.carried.set_offsets(xy[carriers] if carriers else np.zeros((0, 2)))
-        self.title.set_text(f"{self.scenario.name}  t = {t:7.1f} s  delivered {state.delivered}")
-        self.fig.canvas.draw()
-        return np.asarray(self.fig.canvas.buffer_rgba())[..., :3].copy()
-
-    def close(self) -> None:
-        import matplotlib.pyplot as plt
-
-        plt.close(self.fig)
 
 
 def _writer(out: Path, fps: float):
@@ -251,10 +188,15 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
         raise BagError(f"{bag}: no swarmforage scenario in the bag's metadata (not a swarm-run bag?)")
     scenario = scenario_from_dict(json.loads(info.metadata["scenario"]))
     names = list(scenario.robot_names)
-    robots = {r: i for i, r in enumerate(names)}
-    overlays = frozenset(t for t, i in info.topics.items() if i.type_name == _MARKER_TYPES and t != topics.WORLD_MARKERS)
+    task = registry.task(registry.of(scenario).task)
+    sizes = registry.resolve(task.bodies)(scenario) if task.bodies else {}
+    watch = _Watch(
+        robots={r: i for i, r in enumerate(names)},
+        overlays=frozenset(t for t, i in info.topics.items() if i.type_name == _MARKER_TYPES and t != topics.WORLD_MARKERS),
+        bodies={st.topic: st for st in (registry.resolve(task.state) if task.state else ()) if st.field in sizes},
+    )
     state = _State()
-    canvas = _Canvas(scenario, len(names))
+    canvas = Canvas(scenario, len(names), sizes)
     done = 0
     try:
         for m in read_bag(bag):
@@ -264,7 +206,7 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
             if done == len(times):
                 return
             try:
-                _apply(state, m.topic, m.data, robots, overlays)
+                _apply(state, m.topic, m.data, watch)
             except (ValueError, TypeError, AttributeError):
                 continue  # a malformed recorded message: swarm-analyze's metrics count these
         for t in times[done:]:
@@ -274,10 +216,12 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
 
 
 def render_video(bag: Path | str, out: Path | str, *, speedup: float = 10.0, fps: float = 10.0,
-                 start: float = 0.0, end: float | None = None, max_frames: int | None = None) -> VideoInfo:
+                 start: float = 0.0, end: float | None = None, max_frames: int | None = None,
+                 progress: bool | None = None) -> VideoInfo:
     """Render the run in `bag` to `out` (.mp4 or .gif): `speedup` sim seconds per video second,
     `fps` frames per video second, sim times [`start`, `end`] [s] (default: the whole run),
-    at most `max_frames` frames. Raises BagError / ValueError naming what is wrong."""
+    at most `max_frames` frames, with a progress bar on standard error (`progress` None: when it
+    is a terminal). Raises BagError / ValueError naming what is wrong."""
     bag, out = Path(bag), Path(out)
     if out.suffix not in FORMATS:
         raise ValueError(f"--video {out}: expected a file ending in {' or '.join(FORMATS)}")
@@ -285,10 +229,12 @@ def render_video(bag: Path | str, out: Path | str, *, speedup: float = 10.0, fps
         raise ValueError("--speedup and --fps must be positive numbers")
     times = _window(bag_info(bag), start, end, speedup, fps)[:max_frames]
     count = 0
-    with _writer(out, fps) as writer:
+    with _writer(out, fps) as writer, tqdm(total=len(times), unit="frame", desc=f"rendering {out.name}",
+                                            disable=None if progress is None else not progress, leave=False) as bar:
         for frame in frames(bag, times):
             writer.append_data(frame)
             count += 1
+            bar.update()
     return VideoInfo(out, count, float(times[0]), float(times[-1]))
 
 

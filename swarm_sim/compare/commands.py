@@ -9,7 +9,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from swarm_sim import compare
-from swarm_sim.cli import number
+from swarm_sim.cli import first_paragraph, number
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import note_cut_runs
 from swarm_sim.compare.sweep import FAILED, RESULTS, RunFunction, run_sweep
@@ -46,7 +46,7 @@ def common_arguments(p: argparse.ArgumentParser, out: str, *, strategies: bool =
 
 
 def build_parser(comparisons: Mapping[str, Comparison]) -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="swarm-compare", description=compare.__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-compare", description=first_paragraph(compare.__doc__))
     sub = parser.add_subparsers(dest="command", required=True)
     for name, comparison in comparisons.items():
         if name == ALL:

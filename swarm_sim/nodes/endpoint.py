@@ -49,8 +49,9 @@ class EndpointConfig:
 def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
     """``--scenario``, ``--set KEY=VALUE`` (repeatable) and ``--seed`` (`endpoint_config`)."""
     parser.add_argument("--scenario", default="", help="scenario name or YAML path (default: the default scenario)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a scenario field (repeatable; the value is YAML)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
 
 
 def endpoint_config(args: argparse.Namespace) -> EndpointConfig:

@@ -9,17 +9,25 @@ capability and broadcasts the sim clock, so Foxglove's timeline follows sim time
 subscribes to a latched topic (state, markers) is sent its last message at once, as a
 transient-local DDS subscriber would be. No rclpy here: the recorder calls `add` and `write`.
 
-It binds 127.0.0.1 unless told otherwise; the SDK's global context is not used, so nothing else
-in the process can log to it. The server starts (`start`) once the run's topics exist: foxglove-sdk
-0.30 advertises a channel created while a client is connected before it can take that client's
-subscription ("Unknown channel ID"), so a client that subscribes at once (as Foxglove does) would
-miss it; channels that exist when a client connects are advertised safely.
+Clients connect to a `swarm_sim.nodes.ws_proxy.SubprotocolProxy`, which listens where the user
+asked (127.0.0.1 unless told otherwise) and lets a client offering either subprotocol name in
+(``foxglove.sdk.v1``, which the SDK accepts, or the classic ``foxglove.websocket.v1``); the SDK
+itself listens on an ephemeral port of 127.0.0.1. The proxy binds its port when the view is made,
+so a busy port fails at once (`ws_proxy.check_port` lets the launcher ask before anything runs).
+The SDK's global context is not used, so nothing else in the process can log to it. The server
+starts (`start`) once the run's topics exist: foxglove-sdk 0.30 advertises a channel created while
+a client is connected before it can take that client's subscription ("Unknown channel ID"), so a
+client that subscribes at once (as Foxglove does) would miss it; channels that exist when a
+client connects are advertised safely.
 """
 
 from __future__ import annotations
 
 import threading
 
+from foxglove.websocket import ServerListener
+
+from swarm_sim.nodes.ws_proxy import SubprotocolProxy
 from swarm_sim.recording.metadata import _msgdef, _normalize_type
 
 DEFAULT_PORT = 8765
@@ -28,13 +36,16 @@ LOOPBACK = "127.0.0.1"
 CLOCK_TOPIC = "/clock"
 
 
-class LiveView:
-    """A Foxglove WebSocket server publishing recorded topics as they are written."""
+class LiveView(ServerListener):
+    """A Foxglove WebSocket server publishing recorded topics as they are written. As a
+    `ServerListener` it has every callback the SDK may call (a client's unsubscribing and
+    disconnecting need nothing from us)."""
 
     def __init__(self, port: int = DEFAULT_PORT, host: str = LOOPBACK, name: str = "swarmforage") -> None:
-        """`port` 0 lets the OS choose (see `port`)."""
+        """`port` 0 lets the OS choose (see `port`); OSError if it cannot listen there."""
         import foxglove
 
+        self.proxy = SubprotocolProxy(host, port)
         self._foxglove = foxglove
         self.context = foxglove.Context()
         self._channels: dict[str, object] = {}
@@ -42,7 +53,7 @@ class LiveView:
         self._last: dict[str, tuple[bytes, int]] = {}
         self._lock = threading.Lock()
         self.server = None
-        self.host, self._port, self._name = host, port, name
+        self.host, self._name = host, name
         self.closed = False
 
     def start(self) -> None:
@@ -52,17 +63,20 @@ class LiveView:
 
         if self.server is None and not self.closed:
             self.server = self._foxglove.start_server(
-                name=self._name, host=self.host, port=self._port, capabilities=[Capability.Time],
+                name=self._name, host=LOOPBACK, port=0, capabilities=[Capability.Time],
                 server_listener=self, context=self.context,
             )
+            self.proxy.start(self.server.port)
 
     @property
     def port(self) -> int:
-        return self.server.port
+        """Where clients connect (the proxy's port)."""
+        return self.proxy.port
 
     @property
     def url(self) -> str:
-        return f"ws://{self.host}:{self.port}"
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"ws://{host}:{self.port}"
 
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
         """Advertise `topic` (idempotent)."""
@@ -100,6 +114,7 @@ class LiveView:
     def close(self) -> None:
         """Stop the server (idempotent)."""
         self.closed = True
+        self.proxy.close()
         if self.server is not None:
             self.server.stop()
             self.server = None

@@ -40,6 +40,7 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_msgs_py.server_outputs import MARKER_ARRAY, StateWatch, outputs_of
 from swarm_sim import registry
+from swarm_sim.cli import first_paragraph
 from swarm_sim.inbound import Reason
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
 from swarm_sim.protocol import Drawing, Lines, Server
@@ -159,7 +160,7 @@ class ServerNode(Node):
 
 
 def parse_args(argv: list[str]) -> tuple[str, ServerNodeConfig, list[str]]:
-    parser = argparse.ArgumentParser(prog="swarm-server", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-server", description=first_paragraph(__doc__))
     parser.add_argument("--channel", required=True, help="the server's channel, e.g. depot, center, nest")
     add_endpoint_arguments(parser)
     args, ros_args = parser.parse_known_args(argv)

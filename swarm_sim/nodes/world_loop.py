@@ -62,10 +62,13 @@ class WorldLoop:
             node.publish_tick(obs)
             if cfg.mode == "lockstep":
                 self.await_commands(executor)
+                if cfg.pace > 0:
+                    self.pace(executor, wall0 + (k + 1) * sim.dt / cfg.pace)
             else:
                 self.await_wall(executor, wall0 + (k + 1) * sim.dt / cfg.real_time_factor)
             obs = world.step(node.commands())
             node.publish_world_state()
+            node.check_finished(executor)
             if now - last_progress >= cfg.progress_period:
                 last_progress = now
                 self.print_progress(now - wall0)
@@ -134,6 +137,12 @@ class WorldLoop:
         for r in node.barrier.waiting(stamp, node.robots):
             node.world.stats[r].stale_ticks += 1
 
+    def pace(self, executor: Executor, until: float) -> None:
+        """Lockstep at a watchable pace: spin (the next tick's answers may not come before it is
+        sent, so nothing is missed) until `until` (wall)."""
+        while (remaining := until - time.monotonic()) > 0:
+            self.spin(executor, min(0.05, remaining))
+
     def print_startup(self, missing: list[str], waited: float) -> None:
         """What the start-up is waiting for (nodes starting and discovering each other)."""
         node = self.node
@@ -153,6 +162,6 @@ class WorldLoop:
         stale = sum(s.stale_ticks for s in node.world.stats.values())
         print(
             f"[world] t={t:7.1f}/{node.scenario.sim.duration:.0f} s  rtf={t / max(wall, 1e-9):5.2f}x  "
-            f"{node.world.task.progress()}  stale={stale}",
+            f"{node.progress_text()}  stale={stale}",
             flush=True,
         )

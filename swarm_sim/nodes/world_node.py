@@ -40,15 +40,16 @@ from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
-from swarm_sim.cli import number
+from swarm_sim.cli import first_paragraph, number
 from swarm_sim.inbound import Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.status_watch import StatusWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
+from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 
 
@@ -71,6 +72,9 @@ class WorldNodeConfig:
     dead: with the default tick timeout, 6 s of silence."""
     real_time_factor: float = 1.0
     """Realtime mode: target sim seconds per wall second."""
+    pace: float = 0.0
+    """Lockstep: at most this many sim seconds per wall second, so a live view can be watched
+    (0: as fast as every node answers). Only adds waits: the run's results do not change."""
     bag: str = ""
     """Bag directory to record to ('' records nothing)."""
     startup_timeout: float = 120.0
@@ -137,7 +141,8 @@ class WorldNode(Node):
         """Nodes declared dead, in order."""
         self._down_events: list[NodeDownEvent] = []
         self.ended = "complete"
-        """How the run ended: ``complete``, ``interrupted`` or ``server <channel> died``."""
+        """How the run ended: ``complete``, ``finished`` (``sim.stop_when_finished``), ``interrupted``
+        or ``server <channel> died``."""
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
@@ -154,6 +159,8 @@ class WorldNode(Node):
             )
         self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
+        self.statuses = StatusWatch(self, self.robots, self.inbound, self.recording, self.scenario.dt_ns)
+        self._progress = registry.resolve(algorithm.progress) if algorithm.progress else None
         self.loop = WorldLoop(self)
 
     stop_requested = False
@@ -236,6 +243,23 @@ class WorldNode(Node):
                                         "the run ends here")
                 self.ended = f"server {r} died"
 
+    # ------------------------------------------------------------------ the run's course
+
+    def progress_text(self) -> str:
+        """What the progress line says of the run: the algorithm's reading of the robots'
+        statuses if its record declares one (the caging stage), else the task's (deliveries)."""
+        if self._progress is not None:
+            return self._progress(self.statuses.by_robot())
+        return self.world.task.progress()
+
+    def check_finished(self, executor: Executor) -> None:
+        """``sim.stop_when_finished``: end the run once every live robot reports its task over
+        (`swarm_sim.nodes.status_watch`); the bag's ``ended`` says ``finished``."""
+        if self.scenario.sim.stop_when_finished and self.ended == "complete":
+            self.statuses.settle(executor)
+            if self.statuses.all_finished(self.barrier.dead):
+                self.ended = FINISHED
+
     # ------------------------------------------------------------------ discovery
 
     def discover(self) -> None:
@@ -313,22 +337,30 @@ class WorldNode(Node):
 
 
 def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
-    parser = argparse.ArgumentParser(prog="swarm-world", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="swarm-world", description=first_paragraph(__doc__))
     parser.add_argument("--scenario", default="", help="scenario name or YAML path (default: the default scenario)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
-    parser.add_argument("--seed", type=number(int, 0, 2**63 - 1), default=0)
-    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-    parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout)
-    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0)
-    parser.add_argument("--bag", default="")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a scenario field (repeatable; the value is YAML)")
+    parser.add_argument("--seed", type=number(int, 0, 2**63 - 1), default=0, help="random seed (default 0)")
+    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep",
+                        help="lockstep: wait for every controller's answer to each tick (default); realtime: "
+                             "step at --real-time-factor with the commands that arrived")
+    parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout,
+                        help=f"lockstep: wall seconds to wait for a tick's answers (default {WorldNodeConfig.tick_timeout:g})")
+    parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0,
+                        help="realtime: target sim seconds per wall second (default 1)")
+    parser.add_argument("--pace", type=number(float, 0, 1e6, open_low=True),
+                        help="lockstep: at most this many sim seconds per wall second (default: no limit)")
+    parser.add_argument("--bag", default="", help="bag directory to record to (default: record nothing)")
     parser.add_argument("--foxglove", type=number(int, 0, 65535), default=-1, metavar="PORT",
                         help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
-    parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host)
+    parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host,
+                        help=f"address the live view binds (default {WorldNodeConfig.foxglove_host})")
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
-        foxglove_port=args.foxglove, foxglove_host=args.foxglove_host,
+        foxglove_port=args.foxglove, foxglove_host=args.foxglove_host, pace=args.pace or 0.0,
     )
     return config, ros_args
 

@@ -10,6 +10,7 @@ live view every hook does nothing.
 from __future__ import annotations
 
 import json
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -38,7 +39,7 @@ class WorldRecording:
                 "mode": config.mode,
                 "robots": str(robots),
             }
-            live = LiveView(config.foxglove_port, config.foxglove_host) if config.foxglove_port >= 0 else None
+            live = _live_view(config.foxglove_host, config.foxglove_port)
             self.recorder = Recorder(node, Path(config.bag) if config.bag else None, meta, now_ns, live)
 
     def publisher(self, topic: str, qos, type_name: str | None = None):
@@ -88,3 +89,16 @@ class WorldRecording:
         """Write the run's totals into the bag's metadata and close it."""
         if self.recorder is not None:
             self.recorder.close(**metadata)
+
+
+def _live_view(host: str, port: int) -> LiveView | None:
+    """The live view asked for (port -1: none). A port taken since the launcher checked it
+    (`swarm_sim.nodes.ws_proxy.check_port`) costs the live view, not the run: one line says so."""
+    if port < 0:
+        return None
+    try:
+        return LiveView(port, host)
+    except OSError as exc:
+        print(f"[world] live view: cannot listen on {host}:{port} ({exc.strerror or exc}); the run goes on "
+              "and is recorded, without a live view", file=sys.stderr, flush=True)
+        return None

@@ -42,9 +42,10 @@ class SimConfig:
     duration: float = 1080.0
     """Run length [s of sim time]."""
     stop_when_finished: bool = False
-    """Batch runner only: end a run as soon as every behaviour says its task is over (a
-    ``finished`` attribute, e.g. the caging robots once the object is delivered); the run's
-    ``sim_seconds`` then says when. For sweeps: a graph run always lasts ``duration``."""
+    """End a run as soon as every behaviour says its task is over (a ``finished`` attribute, e.g.
+    the caging robots once the object is delivered): the batch runner after that tick, the world
+    node once every live robot's status says so (at that tick, or the next at the latest); the
+    run's ``sim_seconds`` then says when, and its ``run_ended`` is ``finished``."""
 
 
 @dataclass(frozen=True)

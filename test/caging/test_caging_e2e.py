@@ -1,6 +1,7 @@
 """Caging on the ROS graph: one controller node per robot, the five message types on their
-/caging/ topics in the bag in the order the algorithms require, and the bag's metrics equal to
-the batch run's."""
+/caging/ topics in the bag in the order the algorithms require, the bag's metrics equal to the
+batch run's, and the run over when the object is delivered (the scenario's
+``sim.stop_when_finished``), at the batch run's tick (one tick later at worst)."""
 
 from __future__ import annotations
 
@@ -19,7 +20,8 @@ from swarm_sim.scenario import load_scenario
 
 SETTINGS = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=130"]
 SEED = 3
-"""Six robots on a 2 x 2 m grid; with this seed the whole protocol is over after ~115 s of sim."""
+"""Six robots on a 2 x 2 m grid; with this seed the whole protocol is over after ~122 s of sim,
+before the 130 s the run may last."""
 CAGING_FIELDS = ("search_time_s", "recruitment_time_s", "transport_time_s", "total_time_s", "planned_path_m",
                  "object_path_m", "trajectory_error_m", "trajectory_error_pct", "cage_held",
                  "max_path_deviation_m", "landmarks", "cage_size")
@@ -58,5 +60,9 @@ def test_caging_graph_run_records_the_protocol_and_equals_batch(tmp_path):
     bagged = summarize(trace)
     for key in CAGING_FIELDS:
         assert graph[key] == bagged[key] == batch[key], key
-    assert batch["transport_time_s"] is not None and batch["cage_held"] is True
+    assert batch["transport_time_s"] is not None and batch["cage_held"] is True and batch["object_delivered"]
+    # the run ended when the object was delivered, on the graph as in batch, and the bag says why
+    assert batch["run_ended"] == graph["run_ended"] == bagged["run_ended"] == "finished"
+    assert batch["sim_seconds"] < 130.0 and 0 <= graph["sim_seconds"] - batch["sim_seconds"] <= 0.1 + 1e-9
+    assert graph["total_time_s"] <= graph["sim_seconds"] <= graph["total_time_s"] + 0.3
     assert polyline_length(np.array([v for _, v in trace.series["object"]])) > 0.5  # it was carried

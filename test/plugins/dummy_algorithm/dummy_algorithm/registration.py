@@ -2,7 +2,7 @@
 point: its own behaviour, world task (a beacon, sensed on ``/<robot>/beacon``), server (a ping
 counter), message family (``/dummy/pings``) and metric."""
 
-from swarm_sim.registry import Algorithm, Metric, ServerSpec, TaskSpec, register, register_task
+from swarm_sim.registry import Algorithm, Metric, Panel, ServerSpec, TaskSpec, register, register_task
 
 register_task(TaskSpec(name="beacon", core="dummy_algorithm.task:BeaconTask",
                        sensing="dummy_algorithm.codec:SENSING"))
@@ -14,4 +14,5 @@ register(Algorithm(
     servers=(ServerSpec(channel="counter", core="dummy_algorithm.server:CounterServer",
                         family="dummy_algorithm.codec:PINGS", outputs="dummy_algorithm.codec:OUTPUTS"),),
     metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard", None),),
+    panels=(Panel("collision time per robot", "collision time [s]", "collision_time_s_by_robot"),),
 ))
