@@ -197,7 +197,8 @@ def main(argv: list[str] | None = None) -> int:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
         children += [start(label, [*cmd, *common], robots_env) for label, cmd in controllers]
         children += [start(f"server {spec.channel} ({spec.node_name})",
-                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, *common])
+                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, "--mode", args.mode,
+                            *common])
                      for spec in servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)

@@ -7,9 +7,11 @@ from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviou
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
 
-Messages from other nodes are untrusted: they are checked before the behaviour sees them
-(`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
-and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
+Everything from the bus is untrusted: the world's observations and other nodes' messages pass
+the endpoint's guard before the behaviour sees them (`swarm_sim.inbound`: within their topic's
+size cap, decodable, stamped for a tick of the run or one it can take, numbers finite and within
+the arena and the robot's limits, robots of this run), and what is dropped, here or by the
+behaviour itself, is counted on ``/diagnostics``.
 
 The node serves the standard parameter services (``ros2 param list/get``), created with it:
 twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
@@ -84,20 +86,33 @@ class ControllerNode(Node):
         self._last_status: tuple | None = None
         self._answered_stamp = -1
         self._answer = b""
-        decoders = {
-            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry),
-            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan),
-            **{t.name: (t.type_name, t.decode) for t in self.sensing.topics},
-        }
-        self._expected = len(decoders)
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
         self.endpoint = Endpoint(self, self.scenario, *registry.robot_topics(algorithm))
-        for name, (type_name, decode) in decoders.items():
-            self.create_subscription(
-                topics.import_type(type_name), name,
-                lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
-            )
+        guard = self.endpoint.inbound
+        checks = {  # topic -> (type, decoder, check of the decoded value)
+            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry,
+                          lambda where, d: guard.odometry(where, d[0], d[1].x, d[1].y, d[1].yaw, d[2], d[3])),
+            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan,
+                          lambda where, d: guard.scan(where, d[0], d[1])),
+            **{t.name: (t.type_name, t.decode, lambda where, d: guard.observation(where, d[0], d[1]))
+               for t in self.sensing.topics},
+        }
+        self._expected = len(checks)
+        cap = guard.bounds.sense_bytes
+        for name, (type_name, decode, check) in checks.items():
+            where = topics.robot_topic(robot, name)
+
+            def on_message(data: bytes, name: str = name, where: str = where, decode=decode, check=check) -> None:
+                # The guard first (size, then decode), then the numbers: nothing from the bus
+                # raises in this callback or reaches the behaviour unchecked.
+                decoded = guard.decode(where, decode, data, cap)
+                if decoded is not None and check(where, decoded):
+                    self._on_observation(name, decoded)
+                else:  # counted: say so now, the robot may not tick again soon
+                    self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)
+
+            self.create_subscription(topics.import_type(type_name), name, on_message, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)

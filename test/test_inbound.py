@@ -124,3 +124,68 @@ def test_core_counts_are_merged_with_the_nodes():
     core.add("RadioReply", Reason.REFUSED)
     assert merged(node, core, None) == {("/radio", "malformed"): 1, ("RadioReply", "refused"): 2}
     assert np.sum(list(merged(node, core).values())) == 3
+
+
+# --------------------------------------------------------------------------- the guard (issue 25)
+
+def _guarded(scenario_overrides=("robots.count=2",)):
+    from swarm_sim.inbound import Bounds
+
+    scenario = load_scenario("queue_qmt", scenario_overrides)
+    logged: list[str] = []
+    gate = Inbound(scenario.robot_names, scenario.dt_ns, Rejections(), logged.append, Bounds.of(scenario))
+    gate.now_ns = gate.released_ns = 10 * scenario.dt_ns
+    return gate, scenario, logged
+
+
+def test_the_guard_refuses_big_messages_unread_and_survives_any_decoder_failure():
+    gate, _, _ = _guarded()
+    read: list[bytes] = []
+
+    def decoder(data):
+        read.append(data)
+        raise OverflowError("1e308 squared")  # not a ValueError: the guard still holds
+
+    assert gate.decode("/x", decoder, bytes(100), max_bytes=10) is None and read == []
+    assert gate.decode("/x", decoder, bytes(5), max_bytes=10) is None and len(read) == 1
+    assert gate.decode("/x", lambda d: ("ok", d), b"ab", max_bytes=10) == ("ok", b"ab")
+    assert gate.rejections.counts == {("/x", "too big"): 1, ("/x", "malformed"): 1}
+
+
+def test_a_19_mb_array_of_grants_is_refused_by_size_before_it_is_decoded():
+    gate, scenario, _ = _guarded()
+    grants = [DepotGrant(0, "robot_999", "entry_line_0", k) for k in range(20_000)]
+    (data,) = DEPOT.encode(0, grants)
+    assert len(data) > gate.bounds.message_bytes
+    assert gate.post_all("/depot/grants", DEPOT, data, lambda m: None) == 0
+    assert gate.rejections.counts == {("/depot/grants", "too big"): 1}
+
+
+def test_coordinates_beyond_the_arena_are_refused_before_any_core_computes_with_them():
+    gate, scenario, logged = _guarded()
+    edge = scenario.arena.size / 2 + scenario.arena.wall_thickness
+    ok = RadioReply(10 * DT, "robot_1", "robot_0", edge, -edge, "l", 1, False)
+    far = RadioReply(10 * DT, "robot_1", "robot_0", 1e6, 0.0, "l", 1, False)
+    assert gate.admit("/radio", ok) and not gate.admit("/radio", far)
+    assert gate.rejections.counts == {("/radio", "out of bounds"): 1} and "RadioReply.x" in logged[0]
+
+
+def test_observations_are_checked_for_their_tick_and_their_numbers():
+    gate, scenario, _ = _guarded()
+    dt, b = scenario.dt_ns, gate.bounds
+    assert gate.odometry("/r/odom", dt, 1.0, -1.0, 3.0, 0.1, -1.0)
+    for stamp, x, v, w in ((dt, float("nan"), 0.0, 0.0), (dt, 1e308, 0.0, 0.0), (dt, 0.0, b.speed * 1.01, 0.0),
+                           (dt, 0.0, 0.0, -b.turn_rate * 1.01)):
+        assert not gate.odometry("/r/odom", stamp, x, 0.0, 0.0, v, w)
+    for stamp in (dt + 1, -dt, b.end_ns + dt):
+        assert not gate.odometry("/r/odom", stamp, 0.0, 0.0, 0.0, 0.0, 0.0)
+    rays = b.rays
+    assert gate.scan("/r/scan", dt, np.array([np.inf, -np.inf, 0.5] + [1.0] * (rays - 3), np.float32))
+    assert not gate.scan("/r/scan", dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))
+    assert not gate.scan("/r/scan", dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))
+    assert not gate.scan("/r/scan", dt, np.ones(rays + 1, np.float32))
+    assert gate.observation("/r/resources", dt, ((1.0, 2.0), (-2.0, 0.5)))
+    assert not gate.observation("/r/resources", dt, ((1.0, 2.0), (float("inf"), 0.5)))
+    assert not gate.observation("/r/resources", dt, ((1e9, 2.0),))
+    assert gate.rejections.counts == {("/r/odom", "out of bounds"): 4, ("/r/odom", "wrong tick"): 3,
+                                      ("/r/scan", "out of bounds"): 3, ("/r/resources", "out of bounds"): 2}

@@ -4,9 +4,12 @@ A robot's controller node and a server node both load the scenario from the same
 (`EndpointConfig`), hear some message families' topics and send on others
 (`swarm_sim.registry.robot_topics` / `server_topics`). `Endpoint` is that plumbing, once:
 
+- the node's guard (`inbound`, a `swarm_sim.inbound.Inbound` with the run's `Bounds`): every
+  subscription of the node, this one's and the node's own (observations, ``/clock``, world
+  events), decodes through it;
 - one subscription per inbound topic, whose messages are decoded and checked
-  (`swarm_sim.inbound.Inbound`: decodable, naming robots of this run, stamped for a tick the node
-  can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
+  (`swarm_sim.inbound.Inbound`: within the size cap, decodable, naming robots of this run,
+  coordinates within the arena, stamped for a tick the node can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
   before tick k in the fixed delivery order, exactly what the batch runner hands the core;
 - one publisher per outbound topic and the topic map (message class -> topic): `send` publishes
   a core's answers of a tick grouped by topic, one encoded batch per topic;
@@ -29,7 +32,7 @@ from rclpy.node import Node
 
 from swarm_msgs_py import diagnostics, topics
 from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
-from swarm_sim.inbound import Inbound, Rejections, merged, total
+from swarm_sim.inbound import Bounds, Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import Scenario
 
@@ -44,6 +47,9 @@ class EndpointConfig:
     seed: int = 0
     startup_timeout: float = 60.0
     """Wall seconds to wait for the node's peers on its topics to be matched before going on."""
+    mode: str = "lockstep"
+    """The world's mode (`lockstep` or `realtime`): in lockstep a server takes ``/clock`` ticks
+    strictly one after another (`swarm_sim.nodes.server_node`)."""
 
 
 def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
@@ -51,10 +57,11 @@ def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", default="", help="scenario name or YAML path (default: the default scenario)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
 
 
 def endpoint_config(args: argparse.Namespace) -> EndpointConfig:
-    return EndpointConfig(args.scenario, tuple(args.overrides), args.seed)
+    return EndpointConfig(args.scenario, tuple(args.overrides), args.seed, mode=args.mode)
 
 
 class RejectionReport:
@@ -84,7 +91,9 @@ class Endpoint:
         self._name = node.get_fully_qualified_name()
         self.mailbox = Mailbox()
         self.rejections = Rejections()
-        self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning)
+        self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning,
+                               Bounds.of(scenario))
+        """The node's guard: every subscription of the node decodes through it."""
         self.subscriptions = {
             topic: node.create_subscription(
                 topics.import_type(family.type_name), topic,

@@ -41,7 +41,7 @@ from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import number
-from swarm_sim.inbound import Inbound, Reason, Rejections
+from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
@@ -50,6 +50,12 @@ from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
+
+
+COMMAND_BYTES = 512
+"""Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""
+ACK_BYTES = 256
+"""Cap on a ``/lockstep/ack`` message [bytes]."""
 
 
 @dataclass(frozen=True)
@@ -139,6 +145,7 @@ class WorldNode(Node):
         self.ended = "complete"
         """How the run ended: ``complete``, ``interrupted`` or ``server <channel> died``."""
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
+        self._topic_of_cmd = {r: t for t, r in self._cmd_topic.items()}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
             self.recording.add(topic, topics.type_string(topic))
@@ -152,7 +159,9 @@ class WorldNode(Node):
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
-        self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
+        self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning,
+                               Bounds.of(self.scenario))
+        """The world's guard: commands, acks and robots' messages decode through it."""
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
         self.loop = WorldLoop(self)
 
@@ -171,13 +180,12 @@ class WorldNode(Node):
         return sum(n for (where, _), n in self.rejections.counts.items() if where.endswith("/" + topics.CMD_VEL))
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        topic = topics.robot_topic(robot, topics.CMD_VEL)
+        topic = self._topic_of_cmd[robot]
         self.recording.write(topic, data)
-        try:
-            stamp_ns, linear, angular = twist.decode_twist(data)
-        except ValueError as exc:
-            self.inbound.reject(topic, Reason.MALFORMED, str(exc))
+        decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
+        if decoded is None:
             return
+        stamp_ns, linear, angular = decoded
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return
@@ -196,15 +204,17 @@ class WorldNode(Node):
 
     def _on_ack(self, data: bytes) -> None:
         self.recording.write(topics.LOCKSTEP_ACK, data)
-        try:
-            channel, stamp_ns = ack_codec.decode_ack(data)
-        except ValueError as exc:
-            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.MALFORMED, str(exc))
+        decoded = self.inbound.decode(topics.LOCKSTEP_ACK, ack_codec.decode_ack, data, ACK_BYTES)
+        if decoded is None:
             return
+        channel, stamp_ns = decoded
         if channel not in self.servers:
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
         elif channel in self.barrier.dead:
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
+        elif stamp_ns > self.world.t_ns:  # no server can have finished a tick not yet published
+            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.WRONG_TICK,
+                                f"ack of tick {stamp_ns} ns at tick {self.world.t_ns} ns")
         elif stamp_ns < self.world.t_ns:
             self.barrier.heard(channel)  # an ack for a tick already closed: slow, not dead
         else:
