@@ -101,6 +101,9 @@ def load_run(path: Path | str) -> RunTrace:
         trace.ended = "cut off"
         trace.sim_seconds = last_clock / NS_PER_S
     trace.perimeter_entries, trace.perimeter_exits = _perimeter_log(trace, positions)
+    trace.lost = list(info.lost)
+    if trace.lost and trace.ended == "complete":  # what is missing may be anything: never "complete"
+        trace.ended = "incomplete bag"
     return trace
 
 
