@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import secrets
 import shutil
 import signal
 import subprocess
@@ -43,6 +44,7 @@ from launch_py.dds import (
     robot_profile,
     server_profile,
 )
+from swarm_msgs_py import auth
 from swarm_sim import registry
 from swarm_sim.cli import add_scenario_arguments, number, scenario_fields
 from swarm_sim.nodes.lifetime import die_with_parent
@@ -57,6 +59,8 @@ EXIT_CODES = {
     3: "a server (depot manager, center) died: the run ended early",
     4: "the run is complete, but robots were declared dead on the way (named in the output)",
     5: "the world node died: the bag was repaired and analysed up to its last flushed data",
+    6: "the run is tainted: a process outside the run published on one of its topics where its messages "
+       "may have reached the robots (named in the output); the results may hold what it sent",
     130: "interrupted (Ctrl-C, SIGTERM or SIGHUP): the bag holds the run up to then",
 }
 """swarm-run's exit codes."""
@@ -226,8 +230,15 @@ def main(argv: list[str] | None = None) -> int:
     python = [sys.executable, "-m"]
     me = os.getpid()
 
+    run_key = secrets.token_bytes(auth.KEY_BYTES)  # this run's credential (`swarm_msgs_py.auth`)
+
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
-        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: die_with_parent(me))
+        key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
+        try:
+            proc = subprocess.Popen(cmd, env={**env, auth.ENV: str(key_fd)}, pass_fds=(key_fd,),
+                                    start_new_session=True, preexec_fn=lambda: die_with_parent(me))
+        finally:
+            os.close(key_fd)
         return label, proc
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
@@ -328,10 +339,16 @@ def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
         say(f"lockstep ticks answered late: {summary['stale_ticks']} by controllers, {summary['server_stale_ticks']} "
             "by servers (a slow machine; the run may differ from the batch run of the same seed)")
     ended = summary.get("run_ended", "complete")
+    foreign = summary.get("foreign_publishers") or []
+    if foreign:
+        say(f"the run is tainted: foreign publishers on its topics ({'; '.join(foreign[:5])}"
+            f"{' ...' if len(foreign) > 5 else ''}): its results may hold what they sent")
     if world_died:
         return 5
     if interrupted or ended == "interrupted":
         return 130
+    if foreign:
+        return 6
     if ended.startswith("server"):
         say(f"the run ended early: {ended}")
         return 3

@@ -42,7 +42,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from swarm_controllers.api import Behaviour, behaviour_rng
-from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
+from swarm_msgs_py import auth, diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
@@ -161,7 +161,7 @@ class ControllerNode(Node):
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra)
         if key != self._last_status:
             self._last_status = key
-            self._status_pub.publish(diagnostics.encode_status(status))
+            self._status_pub.publish(auth.sign(diagnostics.encode_status(status)))
         self.endpoint.report.publish(stamp_ns, self.behaviour)
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
@@ -292,6 +292,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
 
 def main(argv: list[str] | None = None) -> int:
     robots, config, ros_args, fork = parse_args(sys.argv[1:] if argv is None else argv)
+    auth.load_from_environment()  # the run's key, when the launcher handed one down (forks inherit it)
     return (serve_forked if fork else serve)(robots, config, ros_args)
 
 

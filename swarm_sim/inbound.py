@@ -64,6 +64,8 @@ class Reason(str, Enum):
     """A number in it is not finite, or beyond the arena or the robots' limits (`Bounds`)."""
     UNAUTHENTICATED = "unauthenticated"
     """It lacks the run's tag, or its tag is wrong (`swarm_msgs_py.auth`): not sent by this run."""
+    REPLAYED = "replayed"
+    """The very bytes of a message already taken: a copy, replayed from the bus."""
     FOREIGN = "foreign publisher"
     """A publisher that is not one of the run's nodes was seen on the topic (`swarm_sim.nodes.taint`)."""
 
@@ -212,6 +214,16 @@ class Inbound:
         self.bounds = bounds
         self.now_ns = 0
         self.released_ns = 0
+        self.unique = False
+        """Refuse a message's bytes seen before (`post_all`): set where messages carry the run's
+        tag (`swarm_msgs_py.auth`), so a copy of one cannot be replayed within its tick window."""
+        self._seen: dict[int, int] = {}
+        """hash of a message's bytes -> the tick it was taken at (`forget_before` prunes it)."""
+
+    def forget_before(self, stamp_ns: int) -> None:
+        """Drop the replay memory of ticks before `stamp_ns` (their stamps are out of the window)."""
+        if self._seen:
+            self._seen = {h: t for h, t in self._seen.items() if t >= stamp_ns}
 
     def reject(self, where: str, reason: Reason, detail: str = "") -> None:
         if self.rejections.add(where, reason, detail):
@@ -226,7 +238,8 @@ class Inbound:
         try:
             return decode(data)
         except Exception as exc:  # noqa: BLE001 - whatever a message makes a decoder raise, the node lives
-            self.reject(where, Reason.MALFORMED, str(exc)[:200])
+            # A decoder's error may say why in its `reason` (`swarm_msgs_py.auth.Unauthenticated`).
+            self.reject(where, getattr(exc, "reason", Reason.MALFORMED), str(exc)[:200])
             return None
 
     def observation(self, where: str, stamp_ns: int, value: Any, limit: float | None = None) -> bool:
@@ -289,13 +302,21 @@ class Inbound:
             return False
         return True
 
-    def post_all(self, where: str, family, data: bytes, post: Callable[[object], None]) -> int:
-        """A raw subscription's body: decode `data` with `family` (`decode`: capped at
-        `Bounds.message_bytes`), admit each message, `post` those admitted. Returns how many
-        were posted."""
-        messages = self.decode(where, family.decode, data, self.bounds and self.bounds.message_bytes)
+    def post_all(self, where: str, family, data: bytes, post: Callable[[object], None],
+                 decode: Callable[[bytes], Any] | None = None) -> int:
+        """A raw subscription's body: decode `data` with `decode` (default `family.decode`; the
+        guard: capped at `Bounds.message_bytes`), admit each message, `post` those admitted.
+        Returns how many were posted. With `unique` on, the very bytes of a message taken within
+        the last two ticks are refused as a replay (ours send each array once)."""
+        messages = self.decode(where, decode or family.decode, data, self.bounds and self.bounds.message_bytes)
         if messages is None:
             return 0
+        if self.unique:
+            digest = hash(data)
+            if digest in self._seen:
+                self.reject(where, Reason.REPLAYED, "the same bytes again (a replay of a message of this run?)")
+                return 0
+            self._seen[digest] = self.now_ns
         posted = 0
         for m in messages:
             if self.admit(where, m):

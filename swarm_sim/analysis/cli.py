@@ -79,6 +79,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"swarm-analyze: {bag}: the bag lost data, its results are incomplete: {'; '.join(trace.lost)[:500]}",
                   file=sys.stderr)
             status = 1
+        if trace.foreign:
+            print(f"swarm-analyze: {bag}: the run is tainted, its results may hold what foreign publishers sent: "
+                  f"{'; '.join(trace.foreign)[:500]}", file=sys.stderr)
+            status = 1
         if not args.no_plot:
             summary["plot"] = str(plot_run(trace, args.plot or bag / "summary.png"))
         if args.trajectories:

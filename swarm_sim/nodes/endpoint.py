@@ -8,11 +8,12 @@ A robot's controller node and a server node both load the scenario from the same
   subscription of the node, this one's and the node's own (observations, ``/clock``, world
   events), decodes through it;
 - one subscription per inbound topic, whose messages are decoded and checked
-  (`swarm_sim.inbound.Inbound`: within the size cap, decodable, naming robots of this run,
-  coordinates within the arena, stamped for a tick the node can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
+  (`swarm_sim.inbound.Inbound`: within the size cap, tagged by this run when it has a key
+  (`swarm_msgs_py.auth`) and not a copy of one already taken, decodable, naming robots of this
+  run, coordinates within the arena, stamped for a tick the node can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
   before tick k in the fixed delivery order, exactly what the batch runner hands the core;
 - one publisher per outbound topic and the topic map (message class -> topic): `send` publishes
-  a core's answers of a tick grouped by topic, one encoded batch per topic;
+  a core's answers of a tick grouped by topic, one encoded batch per topic, tagged;
 - `RejectionReport`: the messages dropped, by the node or by its core, on ``/diagnostics``
   whenever the count grew (the world node reports its own drops the same way).
 
@@ -30,7 +31,7 @@ from typing import Any
 
 from rclpy.node import Node
 
-from swarm_msgs_py import diagnostics, topics
+from swarm_msgs_py import auth, diagnostics, topics
 from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
 from swarm_sim.inbound import Bounds, Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
@@ -79,8 +80,8 @@ class RejectionReport:
         theirs = getattr(core, "rejections", None)
         if (dropped := total(self.rejections, theirs)) != self._published:
             self._published = dropped
-            self._pub.publish(diagnostics.encode_rejections(
-                stamp_ns, self._node.get_fully_qualified_name(), merged(self.rejections, theirs)))
+            self._pub.publish(auth.sign(diagnostics.encode_rejections(
+                stamp_ns, self._node.get_fully_qualified_name(), merged(self.rejections, theirs))))
 
 
 class Endpoint:
@@ -94,10 +95,12 @@ class Endpoint:
         self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning,
                                Bounds.of(scenario))
         """The node's guard: every subscription of the node decodes through it."""
+        self.inbound.unique = auth.key() is not None
         self.subscriptions = {
             topic: node.create_subscription(
                 topics.import_type(family.type_name), topic,
-                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
+                lambda data, t=topic, f=family, d=auth.verified(family.decode):
+                    self.inbound.post_all(t, f, data, self.mailbox.post, d),
                 EVENTS, raw=True,
             )
             for topic, family in inbound.items()
@@ -111,6 +114,7 @@ class Endpoint:
     def take(self, stamp_ns: int) -> tuple[object, ...]:
         """Tick `stamp_ns` begins: the messages stamped before it, in delivery order."""
         self.inbound.now_ns = self.inbound.released_ns = stamp_ns
+        self.inbound.forget_before(stamp_ns - 2 * self.inbound.dt_ns)
         return self.mailbox.take_before(stamp_ns)
 
     def send(self, stamp_ns: int, messages: Iterable[object]) -> None:
@@ -124,7 +128,7 @@ class Endpoint:
         for topic, group in by_topic.items():
             family, pub = self.publishers[topic]
             for data in family.encode(stamp_ns, group):
-                pub.publish(data)
+                pub.publish(auth.sign(data))
 
     def unmatched(self, peers: int) -> list[str]:
         """Topics with fewer than `peers` nodes on their other end (publishers of what this node

@@ -35,7 +35,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, diagnostics, markers, topics
+from swarm_msgs_py import ack, auth, diagnostics, markers, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
@@ -81,6 +81,7 @@ class ServerNode(Node):
         self.lost: list[str] = []
         """Robots the world declared dead, not yet told to the core."""
         self._done = -1
+        self._decode_events = auth.verified(diagnostics.decode_events)
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,
                                  SENSOR_LOCKSTEP, raw=True)
         self.create_subscription(topics.type_of(topics.WORLD_EVENTS), topics.WORLD_EVENTS, self._on_world_events,
@@ -113,7 +114,7 @@ class ServerNode(Node):
 
     def _on_world_events(self, data: bytes) -> None:
         inbound = self.endpoint.inbound
-        decoded = inbound.decode(topics.WORLD_EVENTS, diagnostics.decode_events, data, inbound.bounds.message_bytes)
+        decoded = inbound.decode(topics.WORLD_EVENTS, self._decode_events, data, inbound.bounds.message_bytes)
         if decoded is None:
             return
         for e in decoded[1]:
@@ -145,7 +146,7 @@ class ServerNode(Node):
             self.endpoint.report.publish(stamp, self.server)
             self._done = stamp
         if stamp == self._done:
-            self._ack_pub.publish(ack.encode_ack(self.spec.channel, stamp))
+            self._ack_pub.publish(auth.sign(ack.encode_ack(self.spec.channel, stamp)))
 
     def _on_schedule(self, stamp: int) -> bool:
         """Whether tick `stamp` (after the last one done) is the run's next: in lockstep exactly
@@ -164,7 +165,7 @@ class ServerNode(Node):
             return
         changed = self._state.changed(self.server.state())
         for st, value in changed:
-            self._state_pubs[st.topic].publish(st.encode(stamp_ns, value))
+            self._state_pubs[st.topic].publish(auth.sign_if(st.type_name, st.encode(stamp_ns, value)))
         period = self._markers.period if self._markers is not None else None
         if changed and period is not None and (self._markers_at < 0 or stamp_ns - self._markers_at >= period * NS_PER_S):
             self._draw(stamp_ns)
@@ -185,6 +186,7 @@ def parse_args(argv: list[str]) -> tuple[str, ServerNodeConfig, list[str]]:
 def main(argv: list[str] | None = None) -> int:
     """One server node in its own process, spun until shut down."""
     channel, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-server", *ros_args])
     node = None
     try:

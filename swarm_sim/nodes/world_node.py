@@ -33,6 +33,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
+from swarm_msgs_py import auth
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
@@ -44,6 +45,7 @@ from swarm_sim.cli import number
 from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
@@ -56,6 +58,8 @@ COMMAND_BYTES = 512
 """Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""
 ACK_BYTES = 256
 """Cap on a ``/lockstep/ack`` message [bytes]."""
+_DECODE_ACK = auth.verified(ack_codec.decode_ack)
+"""An ack must carry the run's tag when the run has a key (`swarm_msgs_py.auth`)."""
 
 
 @dataclass(frozen=True)
@@ -103,7 +107,13 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns)
+        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self.count_publishers)
+        """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
+        self.foreign: list[str] = []
+        """The foreign publishers found whose messages may have reached a core: the run is tainted."""
+        self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns,
+                                        {t: spec.type_name for t, spec in self.watch.topics.items()},
+                                        self._ours)
         self.recorder = self.recording.recorder
         """The bag (and live view) writer; None when the run records nothing."""
         self.rejections = Rejections()
@@ -177,11 +187,23 @@ class WorldNode(Node):
     @property
     def rejected_commands(self) -> int:
         """Commands dropped so far (any reason)."""
-        return sum(n for (where, _), n in self.rejections.counts.items() if where.endswith("/" + topics.CMD_VEL))
+        return sum(n for (where, reason), n in self.rejections.counts.items()
+                   if where.endswith("/" + topics.CMD_VEL) and reason != Reason.FOREIGN.value)
+
+    def _ours(self, topic: str, data: bytes) -> bool:
+        """Whether a message the recorder found on `topic` is the run's: on a topic whose messages
+        carry the run's tag, only with the tag (`swarm_msgs_py.auth`)."""
+        spec = self.watch.topics.get(topic)
+        return spec is None or not spec.tagged or auth.verify(data) is not None
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
+        refused = self.rejections.total
+        self._take_cmd(robot, data)
         topic = self._topic_of_cmd[robot]
-        self.recording.write(topic, data)
+        self.recording.write_taken(topic, data, self.rejections.total == refused)
+
+    def _take_cmd(self, robot: RobotId, data: bytes) -> None:
+        topic = self._topic_of_cmd[robot]
         decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
             return
@@ -203,8 +225,12 @@ class WorldNode(Node):
         self.barrier.answered(robot, stamp_ns)
 
     def _on_ack(self, data: bytes) -> None:
-        self.recording.write(topics.LOCKSTEP_ACK, data)
-        decoded = self.inbound.decode(topics.LOCKSTEP_ACK, ack_codec.decode_ack, data, ACK_BYTES)
+        refused = self.rejections.total
+        self._take_ack(data)
+        self.recording.write_taken(topics.LOCKSTEP_ACK, data, self.rejections.total == refused)
+
+    def _take_ack(self, data: bytes) -> None:
+        decoded = self.inbound.decode(topics.LOCKSTEP_ACK, _DECODE_ACK, data, ACK_BYTES)
         if decoded is None:
             return
         channel, stamp_ns = decoded
@@ -249,8 +275,24 @@ class WorldNode(Node):
     # ------------------------------------------------------------------ discovery
 
     def discover(self) -> None:
-        """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
+        """Record every topic other nodes publish (and warn about unknown robot namespaces), and
+        look for foreign publishers on the run's topics."""
         self.recording.discover(self._warn_unknown_commands)
+        self.check_foreign()
+
+    def check_foreign(self) -> None:
+        """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
+        line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
+        (an untagged topic) taints the run."""
+        for f in self.watch.check():
+            self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
+            if f.tainting:
+                self.foreign.append(str(f))
+                self.get_logger().error(f"a foreign publisher, {f}: none of this run's nodes; what it sends may "
+                                        "reach the robots, so the run is tainted (swarm-run exits 6)")
+            else:
+                self.get_logger().error(f"a foreign publisher, {f}: none of this run's nodes; its messages lack "
+                                        "the run's tag and are refused")
 
     def _warn_unknown_commands(self, topic: str) -> None:
         if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
@@ -264,8 +306,11 @@ class WorldNode(Node):
             if self._cmd_subs[r].get_publisher_count() == 0
             or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
         ]
-        if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
-            missing.append("servers (" + ", ".join(self.servers) + ")")
+        if self.servers:  # by their nodes' names: a foreign ack publisher must not stand in for one
+            ready = self.watch.ready(topics.LOCKSTEP_ACK)
+            waiting = [spec.node_name for spec in registry.of(self.scenario).servers if spec.node_name not in ready]
+            if waiting:
+                missing.append("servers (" + ", ".join(waiting) + ")")
         return missing
 
     # ------------------------------------------------------------------ publishing
@@ -318,6 +363,7 @@ class WorldNode(Node):
             server_stale_ticks=json.dumps(self.server_stale_ticks),
             ended=self.ended,
             dead_nodes=json.dumps([e.node for e in self.down]),
+            foreign_publishers=json.dumps(self.foreign),
         )
         self.world.close()
 
@@ -348,6 +394,7 @@ def main(argv: list[str] | None = None) -> int:
     # Our own signal handling: rclpy's handler shuts the context down under the running loop,
     # which then waited out tick timeouts instead of stopping. A flag checked at every spin
     # stops the run promptly wherever it is.
+    auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
