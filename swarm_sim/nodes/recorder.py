@@ -28,10 +28,11 @@ class Recorder:
 
     def __init__(self, node: Node, path: Path | None, metadata: dict[str, str], now_ns: Callable[[], int],
                  live: LiveView | None = None, types: Mapping[str, str] | None = None,
-                 accept: Callable[[str, bytes], bool] | None = None) -> None:
+                 accept: Callable[[str, bytes], bool | None] | None = None) -> None:
         """`types`: the run's topics' own types, recorded whatever type a foreign publisher on
         one announces; `accept(topic, data)`: whether a discovered topic's message is the run's
-        (False: recorded on the topic's refused channel, `swarm_msgs_py.topics.refused`)."""
+        (False: recorded on the topic's refused channel, `swarm_msgs_py.topics.refused`; None:
+        not recorded)."""
         self._node = node
         self._types = dict(types or {})
         self._accept = accept
@@ -69,9 +70,10 @@ class Recorder:
         self.write(channel, data)
 
     def _discovered(self, topic: str, data: bytes) -> None:
-        if self._accept is None or self._accept(topic, data):
+        verdict = True if self._accept is None else self._accept(topic, data)
+        if verdict:
             self.write(topic, data)
-        else:
+        elif verdict is not None:  # None: not to be recorded at all
             self.write_refused(topic, data)
 
     def write(self, topic: str, data: bytes) -> None:

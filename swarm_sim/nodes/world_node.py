@@ -190,11 +190,17 @@ class WorldNode(Node):
         return sum(n for (where, reason), n in self.rejections.counts.items()
                    if where.endswith("/" + topics.CMD_VEL) and reason != Reason.FOREIGN.value)
 
-    def _ours(self, topic: str, data: bytes) -> bool:
-        """Whether a message the recorder found on `topic` is the run's: on a topic whose messages
-        carry the run's tag, only with the tag (`swarm_msgs_py.auth`)."""
+    def _ours(self, topic: str, data: bytes) -> bool | None:
+        """Whether a message the recorder found on a run's `topic` is the run's: with the run's tag
+        where its messages carry one (`swarm_msgs_py.auth`; False: it is recorded apart); None
+        (not recorded, counted ``too big``) if it is longer than any the run sends."""
         spec = self.watch.topics.get(topic)
-        return spec is None or not spec.tagged or auth.verify(data) is not None
+        if spec is None:
+            return True
+        if len(data) > self.inbound.bounds.message_bytes:
+            self.inbound.reject(topic, Reason.TOO_BIG, f"{len(data)} bytes, not recorded")
+            return None
+        return not spec.tagged or auth.verify(data) is not None
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
         refused = self.rejections.total

@@ -28,7 +28,8 @@ class WorldRecording:
     ``foxglove_port``; `now_ns` gives the sim time to stamp messages with."""
 
     def __init__(self, node: Node, config, scenario: Scenario, robots: int, now_ns: Callable[[], int],
-                 types: Mapping[str, str] | None = None, accept: Callable[[str, bytes], bool] | None = None) -> None:
+                 types: Mapping[str, str] | None = None,
+                 accept: Callable[[str, bytes], bool | None] | None = None) -> None:
         """`types`, `accept`: the run's topics' own types and the check of a discovered topic's
         messages (`swarm_sim.nodes.recorder.Recorder`)."""
         self._node = node
