@@ -90,24 +90,20 @@ class ControllerNode(Node):
         # rclpy runs the earlier subscription first.
         self.endpoint = Endpoint(self, self.scenario, *registry.robot_topics(algorithm))
         guard = self.endpoint.inbound
-        checks = {  # topic -> (type, decoder, check of the decoded value)
-            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry,
-                          lambda where, d: guard.odometry(where, d[0], d[1].x, d[1].y, d[1].yaw, d[2], d[3])),
-            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan,
-                          lambda where, d: guard.scan(where, d[0], d[1])),
-            **{t.name: (t.type_name, t.decode, lambda where, d: guard.observation(where, d[0], d[1]))
-               for t in self.sensing.topics},
+        observations = {  # topic -> (type, decoder, the guard's check of its values)
+            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry, "odometry"),
+            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan, "scan"),
+            **{t.name: (t.type_name, t.decode, "value") for t in self.sensing.topics},
         }
-        self._expected = len(checks)
-        cap = guard.bounds.sense_bytes
-        for name, (type_name, decode, check) in checks.items():
-            where = topics.robot_topic(robot, name)
+        self._expected = len(observations)
+        for name, (type_name, decode, kind) in observations.items():
+            guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind)
 
-            def on_message(data: bytes, name: str = name, where: str = where, decode=decode, check=check) -> None:
-                # The guard first (size, then decode), then the numbers: nothing from the bus
-                # raises in this callback or reaches the behaviour unchecked.
-                decoded = guard.decode(where, decode, data, cap)
-                if decoded is not None and check(where, decoded):
+            def on_message(data: bytes, name: str = name, guarded=guarded) -> None:
+                # The guard first (size, decode, numbers, tick): nothing from the bus raises in
+                # this callback or reaches the behaviour unchecked.
+                decoded = guarded(data)
+                if decoded is not None:
                     self._on_observation(name, decoded)
                 else:  # counted: say so now, the robot may not tick again soon
                     self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)

@@ -189,3 +189,30 @@ def test_observations_are_checked_for_their_tick_and_their_numbers():
     assert not gate.observation("/r/resources", dt, ((1e9, 2.0),))
     assert gate.rejections.counts == {("/r/odom", "out of bounds"): 4, ("/r/odom", "wrong tick"): 3,
                                       ("/r/scan", "out of bounds"): 3, ("/r/resources", "out of bounds"): 2}
+
+
+def test_the_sense_guard_decodes_and_checks_in_one_call():
+    from swarm_msgs_py import gripper, odometry, resources, scan
+    from swarm_sim.types import Pose2D
+
+    gate, scenario, _ = _guarded()
+    dt, sc = scenario.dt_ns, scenario.sensors.scan
+    odom = gate.sense_guard("/r/odom", odometry.decode_odometry, "odometry")
+    ranges = gate.sense_guard("/r/scan", scan.decode_scan, "scan")
+    seen = gate.sense_guard("/r/resources", resources.decode_resources)
+    grip = gate.sense_guard("/r/gripper", gripper.decode_gripper)
+    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))[0] == dt
+    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1e308, 2.0, 0.5), 0.1, 0.0)) is None
+    assert odom(odometry.encode_odometry("robot_0", dt + 1, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0)) is None
+    assert odom(b"\x00\x01\x00\x00") is None and odom(bytes(gate.bounds.sense_bytes + 1)) is None
+    good = np.full(sc.rays, np.inf, np.float32)
+    good[0] = -np.inf
+    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is not None
+    good[1] = np.nan
+    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is None
+    assert seen(resources.encode_resources(dt, [(1.0, 1.0)])) is not None
+    assert seen(resources.encode_resources(dt, [(1.0, float("nan"))])) is None
+    assert grip(gripper.encode_gripper(dt, True)) == (dt, True)
+    assert gate.rejections.counts == {("/r/odom", "out of bounds"): 1, ("/r/odom", "wrong tick"): 1,
+                                      ("/r/odom", "malformed"): 1, ("/r/odom", "too big"): 1,
+                                      ("/r/scan", "out of bounds"): 1, ("/r/resources", "out of bounds"): 1}
