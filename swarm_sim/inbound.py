@@ -8,7 +8,7 @@ its core sees it: a message of another node (`Inbound.admit`) must name robots o
 every field annotated `swarm_sim.types.RobotId`, hold coordinates within the arena in every field
 annotated `swarm_sim.types.Coordinate`, and be stamped for a tick the node can still take
 (`swarm_sim.messaging`: a message sent at tick k is taken at tick k+1); an observation from the
-world (`Inbound.observation`) must be stamped on a tick of the run and hold finite numbers within
+world (`Inbound.sense_guard`) must be stamped on a tick of the run and hold finite numbers within
 the arena and the robots' limits (`Bounds`). Numbers are checked before a core computes with
 them: a 1e308 coordinate made a core raise OverflowError.
 
@@ -251,50 +251,14 @@ class Inbound:
             self.reject(where, getattr(exc, "reason", Reason.MALFORMED), str(exc)[:200])
             return None
 
-    def observation(self, where: str, stamp_ns: int, value: Any, limit: float | None = None) -> bool:
-        """Whether a decoded observation from the world may reach the behaviour: stamped on a tick
-        of the run, every float in `value` within +-`limit` (default: the coordinate bound)."""
-        b = self.bounds
-        if b is None:
-            return True
-        if not (0 <= stamp_ns <= b.end_ns and stamp_ns % b.dt_ns == 0):
-            self.reject(where, Reason.WRONG_TICK, f"stamped {stamp_ns} ns: no tick of this run")
-            return False
-        if not within(value, b.coordinate if limit is None else limit):
-            self.reject(where, Reason.OUT_OF_BOUNDS, "a number not finite or beyond the arena")
-            return False
-        return True
-
-    def odometry(self, where: str, stamp_ns: int, x: float, y: float, yaw: float, v: float, w: float) -> bool:
-        """`observation` for odometry: the pose within the arena, speeds within the limits."""
-        b = self.bounds
-        if b is None:
-            return True
-        c = b.coordinate
-        if not (-c <= x <= c and -c <= y <= c and -4.0 <= yaw <= 4.0
-                and -b.speed <= v <= b.speed and -b.turn_rate <= w <= b.turn_rate):
-            self.reject(where, Reason.OUT_OF_BOUNDS, f"pose ({x:.3g}, {y:.3g}, {yaw:.3g}), speeds ({v:.3g}, {w:.3g})")
-            return False
-        return self.observation(where, stamp_ns, ())
-
-    def scan(self, where: str, stamp_ns: int, ranges: np.ndarray) -> bool:
-        """`observation` for a scan: one range per ray, none NaN or negative (REP 117: inf for
-        no return, -inf for too close)."""
-        b = self.bounds
-        if b is None:
-            return True
-        if ranges.shape != (b.rays,):
-            self.reject(where, Reason.OUT_OF_BOUNDS, f"{ranges.size} ranges for a {b.rays}-ray scan")
-            return False
-        if not ranges.min(initial=0.0) >= 0.0 and not ((ranges >= 0.0) | (ranges == -np.inf)).all():  # NaN fails both
-            self.reject(where, Reason.OUT_OF_BOUNDS, "a NaN or negative range")
-            return False
-        return self.observation(where, stamp_ns, ())
-
     def sense_guard(self, where: str, decode: Callable[[bytes], Any], kind: str = "value") -> Callable[[bytes], Any]:
-        """One observation topic's whole guard as one function, bytes -> decoded or None
-        (counted): `decode` then `odometry`, `scan` or `observation` (`kind`), inlined (every
-        robot, every tick: a 112-robot controller process runs it 450 times a tick)."""
+        """One observation topic's whole guard as one function, bytes -> decoded (stamp, value,
+        ...) or None (counted): within `Bounds.sense_bytes`, decodable, its numbers finite and
+        within bounds (`kind`: ``odometry``: the pose within the arena, speeds within the robot's
+        limits; ``scan``: one range per ray, none NaN or negative but -inf, REP 117's too close;
+        ``value``: every float within the coordinate bound, `within`), stamped on a tick of the
+        run. All inlined: every robot runs it on every observation (450 times a tick in a
+        112-robot controller process)."""
         b = self.bounds
         if b is None:
             return decode

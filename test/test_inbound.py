@@ -171,22 +171,28 @@ def test_coordinates_beyond_the_arena_are_refused_before_any_core_computes_with_
 
 
 def test_observations_are_checked_for_their_tick_and_their_numbers():
+    from swarm_sim.types import Pose2D
+
     gate, scenario, _ = _guarded()
     dt, b = scenario.dt_ns, gate.bounds
-    assert gate.odometry("/r/odom", dt, 1.0, -1.0, 3.0, 0.1, -1.0)
+    as_is = lambda d: d  # noqa: E731 - the guard's decoder: the "bytes" are the decoded tuple here
+    odom = gate.sense_guard("/r/odom", as_is, "odometry")
+    assert odom((dt, Pose2D(1.0, -1.0, 3.0), 0.1, -1.0))
     for stamp, x, v, w in ((dt, float("nan"), 0.0, 0.0), (dt, 1e308, 0.0, 0.0), (dt, 0.0, b.speed * 1.01, 0.0),
                            (dt, 0.0, 0.0, -b.turn_rate * 1.01)):
-        assert not gate.odometry("/r/odom", stamp, x, 0.0, 0.0, v, w)
+        assert odom((stamp, Pose2D(x, 0.0, 0.0), v, w)) is None
     for stamp in (dt + 1, -dt, b.end_ns + dt):
-        assert not gate.odometry("/r/odom", stamp, 0.0, 0.0, 0.0, 0.0, 0.0)
+        assert odom((stamp, Pose2D(0.0, 0.0, 0.0), 0.0, 0.0)) is None
+    ranges = gate.sense_guard("/r/scan", as_is, "scan")
     rays = b.rays
-    assert gate.scan("/r/scan", dt, np.array([np.inf, -np.inf, 0.5] + [1.0] * (rays - 3), np.float32))
-    assert not gate.scan("/r/scan", dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))
-    assert not gate.scan("/r/scan", dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))
-    assert not gate.scan("/r/scan", dt, np.ones(rays + 1, np.float32))
-    assert gate.observation("/r/resources", dt, ((1.0, 2.0), (-2.0, 0.5)))
-    assert not gate.observation("/r/resources", dt, ((1.0, 2.0), (float("inf"), 0.5)))
-    assert not gate.observation("/r/resources", dt, ((1e9, 2.0),))
+    assert ranges((dt, np.array([np.inf, -np.inf, 0.5] + [1.0] * (rays - 3), np.float32)))
+    assert ranges((dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))) is None
+    assert ranges((dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))) is None
+    assert ranges((dt, np.ones(rays + 1, np.float32))) is None
+    seen = gate.sense_guard("/r/resources", as_is)
+    assert seen((dt, ((1.0, 2.0), (-2.0, 0.5))))
+    assert seen((dt, ((1.0, 2.0), (float("inf"), 0.5)))) is None
+    assert seen((dt, ((1e9, 2.0),))) is None
     assert gate.rejections.counts == {("/r/odom", "out of bounds"): 4, ("/r/odom", "wrong tick"): 3,
                                       ("/r/scan", "out of bounds"): 3, ("/r/resources", "out of bounds"): 2}
 
