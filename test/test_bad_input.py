@@ -136,3 +136,18 @@ def test_a_bag_that_lost_data_never_analyses_as_complete(tmp_path, damage):
     summary = json.loads(result.stdout.strip().splitlines()[-1])
     assert summary["run_ended"] == "incomplete bag" and summary["bag_lost"]
     assert summary["resources_delivered"] < 10
+
+
+def test_a_taken_discovery_port_is_one_line(tmp_path):
+    import socket
+
+    from launch_py import dds
+
+    domain, lock = dds.claim_free_domain()
+    os.close(lock)
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as squatter:  # anyone's, not a run's
+        squatter.bind(("127.0.0.1", dds.discovery_port(domain)))
+        result = run("launch_py.run", "--duration", "1", "--domain-id", str(domain), cwd=tmp_path)
+    assert_one_line(result, 2, f"domain {domain} is in use", f"port 127.0.0.1:{dds.discovery_port(domain)} is taken",
+                    "--domain-id auto")
+    assert "[world]" not in result.stdout
