@@ -348,7 +348,7 @@ def test_a_swarm_run_and_the_test_process_bind_loopback_only(tmp_path) -> None:
     rclpy.init(context=context)
     node = rclpy.create_node("binding_probe", context=context)
     cmd = [sys.executable, "-m", "launch_py.run", "--scenario", "queue_qmt", "--robots", "4", "--duration", "600",
-           "--bag", str(tmp_path / "bag"), "--domain-id", os.environ["ROS_DOMAIN_ID"]]
+           "--bag", str(tmp_path / "bag"), "--domain-id", "auto"]  # ours holds ROS_DOMAIN_ID: a run refuses it
     launcher = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 start_new_session=True)
     try:
@@ -408,6 +408,10 @@ def test_robots_do_not_read_graph_announcements_but_everyone_sees_their_nodes(tm
     )
     env = {**dds.loopback_env(domain, processes=2, server_port=dds.discovery_port(domain)), "ROS_SUPER_CLIENT": "TRUE"}
     try:
+        deadline = time.monotonic() + 60  # the probe joins once the world is up: before, it would hold
+        while not (tmp_path / "bag" / "metadata.yaml").exists():  # the domain and the run refuse it
+            assert time.monotonic() < deadline and launcher.poll() is None, launcher.stdout.read()[-2000:]
+            time.sleep(0.1)
         out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120)
         names = set(json.loads(out.stdout.strip().splitlines()[-1]))
         assert {"/robot_0/controller", "/robot_1/controller", "/robot_2/controller", "/world"} <= names, names
