@@ -2,7 +2,10 @@
 
 Like ``ros2 bag record -a``: the world writes what it publishes (and the commands and acks it
 receives) as the very bytes on the wire, and `discover` subscribes to every topic other nodes
-publish, recording each message stamped with the sim time at which it arrives. Latched topics
+publish, recording each message stamped with the sim time at which it arrives. A run's topic is
+recorded with the run's own type (and that type's hash in metadata.yaml), whatever a foreign
+publisher announces; what the run refuses goes to the topic's refused channel
+(`swarm_msgs_py.topics.refused`), so analysis reads only what the run took. Latched topics
 (servers' state and markers) are subscribed transient-local, so their last message is recorded
 even if it was published before the recorder subscribed. With a `LiveView` every topic and
 message also goes to the Foxglove clients, as the same bytes.

@@ -16,6 +16,11 @@ itself: its observation publishers, its intake of commands and acks, and its com
 
 Observations (and the task's state topics, e.g. the caging object's pose) are encoded straight
 to CDR bytes, published raw and written to the bag as the same bytes.
+
+What it hears is untrusted (`swarm_sim.inbound`): commands, acks (which must carry the run's tag,
+`swarm_msgs_py.auth`) and robots' messages pass its guard, and what it refuses is recorded on the
+topic's refused channel. It watches the graph for foreign publishers on the run's topics
+(`swarm_sim.nodes.taint`), and starts only once every server's own node acknowledges.
 """
 
 from __future__ import annotations
