@@ -27,7 +27,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import typing
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from enum import Enum
@@ -226,13 +226,16 @@ class Inbound:
         self.unique = False
         """Refuse a message's bytes seen before (`post_all`): set where messages carry the run's
         tag (`swarm_msgs_py.auth`), so a copy of one cannot be replayed within its tick window."""
-        self._seen: dict[int, int] = {}
-        """hash of a message's bytes -> the tick it was taken at (`forget_before` prunes it)."""
+        self._seen: set[int] = set()
+        """Hashes of the bytes of the messages taken lately (`forget_before` prunes them)."""
+        self._seen_order: deque[tuple[int, int]] = deque()
+        """(the tick a message was taken at, its hash), oldest first."""
 
     def forget_before(self, stamp_ns: int) -> None:
         """Drop the replay memory of ticks before `stamp_ns` (their stamps are out of the window)."""
-        if self._seen:
-            self._seen = {h: t for h, t in self._seen.items() if t >= stamp_ns}
+        order, seen = self._seen_order, self._seen
+        while order and order[0][0] < stamp_ns:
+            seen.discard(order.popleft()[1])
 
     def reject(self, where: str, reason: Reason, detail: str = "") -> None:
         if self.rejections.add(where, reason, detail):
@@ -328,7 +331,8 @@ class Inbound:
             if digest in self._seen:
                 self.reject(where, Reason.REPLAYED, "the same bytes again (a replay of a message of this run?)")
                 return 0
-            self._seen[digest] = self.now_ns
+            self._seen.add(digest)
+            self._seen_order.append((self.now_ns, digest))
         posted = 0
         for m in messages:
             if self.admit(where, m):
