@@ -12,7 +12,7 @@ from enum import Enum
 from typing import ClassVar
 
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import RobotId
+from swarm_sim.types import Coordinate, RobotId
 
 DEPOT = "depot"
 """The depot manager's channel."""
@@ -77,9 +77,9 @@ class RadioQuery:
     CHANNEL: ClassVar[str] = ROBOTS
     stamp_ns: int
     sender: RobotId
-    x: float
+    x: Coordinate
     """Sender position [m, world frame]: receivers farther than the range drop the message."""
-    y: float
+    y: Coordinate
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,8 +90,8 @@ class RadioReply:
     stamp_ns: int
     sender: RobotId
     to: RobotId
-    x: float
-    y: float
+    x: Coordinate
+    y: Coordinate
     line: str
     cell: int
     last: bool

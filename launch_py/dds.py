@@ -17,7 +17,11 @@ this module never imports rclpy.
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import os
+import socket
+import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
@@ -170,3 +174,88 @@ def apply_to_current_process(env: Mapping[str, str]) -> None:
         if key not in env:
             os.environ.pop(key, None)
     os.environ.update(env)
+
+
+# --------------------------------------------------------------------------- one run per domain
+
+PROBED_PARTICIPANTS = 8
+"""Participant ids whose well-known ports `domain_in_use` probes: a graph's first processes take
+the lowest free ids, so a live graph holds some of the first few."""
+
+
+def participant_ports(domain_id: int, participant: int) -> tuple[int, int]:
+    """The UDP ports a Fast DDS participant binds on 127.0.0.1 (RTPS well-known ports): its
+    metatraffic and its user-data unicast ports."""
+    base = 7400 + 250 * domain_id + 10 + 2 * participant
+    return base, base + 1
+
+
+def udp_port_taken(port: int, host: str = "127.0.0.1") -> bool:
+    """Whether a UDP socket of any process is bound to `port` on `host` (or on every address)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.bind((host, port))
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                return True
+            raise
+    return False
+
+
+def domain_in_use(domain_id: int) -> str | None:
+    """Why `domain_id` is in use on this machine, or None if it looks free: the graph's discovery
+    server port is bound (another run's world, or any other program), or a DDS participant of the
+    domain is up (both well-known ports of one of its first participant ids bound: one port alone
+    may be another program's ephemeral socket)."""
+    port = discovery_port(domain_id)
+    if udp_port_taken(port):
+        return f"its discovery server port 127.0.0.1:{port} is taken"
+    for participant in range(PROBED_PARTICIPANTS):
+        meta, user = participant_ports(domain_id, participant)
+        if udp_port_taken(meta) and udp_port_taken(user):
+            return f"a DDS participant is on it (UDP ports {meta} and {user} are bound)"
+    return None
+
+
+class DomainTaken(Exception):
+    """The domain a run asked for is in use; the message says why and what to do."""
+
+
+def _lock_path(domain_id: int) -> Path:
+    return Path(tempfile.gettempdir()) / f"swarmforage-domain-{domain_id}.lock"
+
+
+def claim_domain(domain_id: int) -> int:
+    """Reserve `domain_id` for this process's run: an exclusive lock on a per-domain file (two
+    launchers starting at once cannot both pass), then `domain_in_use` (anything else on it).
+    Returns the lock's file descriptor (keep it open for the run: closing it, or the process
+    ending however it ends, frees the domain); raises DomainTaken."""
+    try:
+        fd = os.open(_lock_path(domain_id), os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    except OSError as exc:  # another user's lock file, or a symlink planted in its place
+        raise DomainTaken(f"domain {domain_id} is in use (its lock {_lock_path(domain_id)}: {exc.strerror})") from None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        raise DomainTaken(f"domain {domain_id} is in use by another swarmforage run on this machine") from None
+    why = domain_in_use(domain_id)
+    if why is not None:
+        os.close(fd)
+        raise DomainTaken(f"domain {domain_id} is in use: {why}")
+    return fd
+
+
+def claim_free_domain(first: int | None = None) -> tuple[int, int]:
+    """A free domain of `DOMAIN_RANGE`, claimed (`claim_domain`), trying from `first` (default:
+    the one this process's pid gives) upwards; (domain, lock fd). Raises DomainTaken if none is
+    free."""
+    lo, hi = DOMAIN_RANGE
+    start = lo + os.getpid() % (hi - lo + 1) if first is None else first
+    for k in range(hi - lo + 1):
+        domain = lo + (start - lo + k) % (hi - lo + 1)
+        try:
+            return domain, claim_domain(domain)
+        except DomainTaken:
+            continue
+    raise DomainTaken(f"every domain {lo}-{hi} is in use")

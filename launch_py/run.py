@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import secrets
 import shutil
 import signal
 import subprocess
@@ -32,14 +33,18 @@ from pathlib import Path
 
 from launch_py.dds import (
     MAX_DOMAIN_ID,
+    PROFILE_MAX_PROCESSES,
     PROFILE_PATH,
+    DomainTaken,
+    claim_domain,
+    claim_free_domain,
     discovery_port,
     discovery_server_env,
     loopback_env,
-    private_domain_id,
     robot_profile,
     server_profile,
 )
+from swarm_msgs_py import auth
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
@@ -55,10 +60,12 @@ from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 EXIT_CODES = {
     0: "the run is complete and every node lived to its end",
     1: "the bag could not be read",
-    2: "bad flags or scenario (nothing was started)",
+    2: "bad flags or scenario, or the DDS domain is in use (nothing was started)",
     3: "a server (depot manager, center) died: the run ended early",
     4: "the run is complete, but robots were declared dead on the way (named in the output)",
     5: "the world node died: the bag was repaired and analysed up to its last flushed data",
+    6: "the run is tainted: a process outside the run published on one of its topics where its messages "
+       "may have reached the robots (named in the output); the results may hold what it sent",
     130: "interrupted (Ctrl-C, SIGTERM or SIGHUP): the bag holds the run up to then",
 }
 """swarm-run's exit codes."""
@@ -109,6 +116,49 @@ def _raise_interrupt(*_: object) -> None:
     raise KeyboardInterrupt
 
 
+def domain_option(text: str) -> int | str:
+    """``--domain-id``: an id 0-`MAX_DOMAIN_ID`, or ``auto`` (a free one)."""
+    return "auto" if text == "auto" else number(int, 0, MAX_DOMAIN_ID)(text)
+
+
+def claim_run_domain(requested: int | str | None) -> tuple[int, int]:
+    """The run's DDS domain, claimed for the run (`launch_py.dds.claim_domain`): the one asked
+    for (``--domain-id N``, else the user's ``ROS_DOMAIN_ID``), refused if anything uses it; with
+    ``auto``, or when nothing was asked for, a free one. Returns (domain, the claim's lock fd);
+    raises DomainTaken (or ValueError for a bad ``ROS_DOMAIN_ID``) with the one line to print."""
+    user = os.environ.get("ROS_DOMAIN_ID", "").strip()
+    if requested == "auto" or (requested is None and not user):
+        return claim_free_domain()
+    if requested is None:
+        if not user.isdigit() or int(user) > MAX_DOMAIN_ID:
+            raise ValueError(f"ROS_DOMAIN_ID={user[:20]!r}: expected an id 0-{MAX_DOMAIN_ID} (or use --domain-id auto)")
+        requested = int(user)
+    try:
+        return requested, claim_domain(requested)
+    except DomainTaken as exc:
+        raise DomainTaken(f"{exc}; pick another with --domain-id N, or --domain-id auto for a free one") from None
+
+
+def output_directory(args: argparse.Namespace, scenario: Scenario) -> Path:
+    """The run's bag directory, created (its parents too); raises ValueError with the one line to
+    print when it cannot be (not an empty directory, outside ``--out``, not writable)."""
+    bag = args.bag or default_bag_dir(args.out, scenario)
+    if args.bag is None and args.out.resolve() not in bag.resolve().parents:  # the scenario names it
+        raise ValueError(f"scenario name {scenario.name!r} would put the bag outside --out {args.out}")
+    try:
+        if bag.exists() and (not bag.is_dir() or any(bag.iterdir())):
+            raise ValueError(f"--bag {bag}: already exists and is not an empty directory (a run never "
+                             "overwrites a recording)")
+        bag.parent.mkdir(parents=True, exist_ok=True)
+        if not os.access(bag.parent, os.W_OK | os.X_OK):
+            raise PermissionError(13, "Permission denied")
+    except OSError as exc:
+        existing = next((p for p in bag.parents if p.exists()), None)
+        why = f"{existing} is not a directory" if existing is not None and not existing.is_dir() else exc.strerror
+        raise ValueError(f"cannot record to {bag}: {why or exc}") from None
+    return bag
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="swarm-run", description=first_paragraph(__doc__), formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -127,8 +177,9 @@ def main(argv: list[str] | None = None) -> int:
                              "the fastest it may go (default: as fast as the nodes answer; 1 with --foxglove)")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
-    parser.add_argument("--domain-id", type=number(int, 0, MAX_DOMAIN_ID),
-                        help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID} (default: a private one)")
+    parser.add_argument("--domain-id", type=domain_option,
+                        help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID}, or auto: a free one (default: the user's ROS_DOMAIN_ID, "
+                             "else a free one); a run refuses a domain anything else uses")
     parser.add_argument("--discovery", choices=("server", "simple"), default="server",
                         help="DDS discovery: the world node as discovery server for every other node (default; "
                              "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
@@ -153,17 +204,22 @@ def main(argv: list[str] | None = None) -> int:
         print(f"swarm-run: {problem}", file=sys.stderr)
         return 2
     pace = _pace(args)
-    bag = args.bag or default_bag_dir(args.out, scenario)
-    if bag.exists() and (not bag.is_dir() or any(bag.iterdir())):
-        print(f"swarm-run: --bag {bag}: already exists and is not an empty directory (a run never "
-              "overwrites a recording)", file=sys.stderr)
-        return 2
-    bag.parent.mkdir(parents=True, exist_ok=True)
     groups = split_robots(scenario.robot_names, args.controller_processes)
-    domain = args.domain_id if args.domain_id is not None else private_domain_id()
     servers = registry.of(scenario).servers
+    processes = len(groups) + len(servers) + 1
+    if processes > PROFILE_MAX_PROCESSES:
+        print(f"swarm-run: {scenario.robots.count} robots in {len(groups)} controller processes make {processes} DDS "
+              f"processes; the loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use --controller-processes "
+              "K with fewer processes)", file=sys.stderr)
+        return 2
+    try:
+        domain, domain_lock = claim_run_domain(args.domain_id)  # held (open) until this process ends
+        bag = output_directory(args, scenario)
+    except (ValueError, DomainTaken) as exc:
+        print(f"swarm-run: {exc}", file=sys.stderr)
+        return 2
     port = discovery_port(domain) if args.discovery == "server" else None
-    env = loopback_env(domain, processes=len(groups) + len(servers) + 1, base=os.environ, server_port=port)
+    env = loopback_env(domain, processes=processes, base=os.environ, server_port=port)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
@@ -191,8 +247,15 @@ def main(argv: list[str] | None = None) -> int:
     python = [sys.executable, "-m"]
     me = os.getpid()
 
+    run_key = secrets.token_bytes(auth.KEY_BYTES)  # this run's credential (`swarm_msgs_py.auth`)
+
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
-        proc = subprocess.Popen(cmd, env=env, start_new_session=True, preexec_fn=lambda: die_with_parent(me))
+        key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
+        try:
+            proc = subprocess.Popen(cmd, env={**env, auth.ENV: str(key_fd)}, pass_fds=(key_fd,),
+                                    start_new_session=True, preexec_fn=lambda: die_with_parent(me))
+        finally:
+            os.close(key_fd)
         return label, proc
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
@@ -216,7 +279,8 @@ def main(argv: list[str] | None = None) -> int:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
         children += [start(label, [*cmd, *common], robots_env) for label, cmd in controllers]
         children += [start(f"server {spec.channel} ({spec.node_name})",
-                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, *common])
+                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, "--mode", args.mode,
+                            *common])
                      for spec in servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)
@@ -241,6 +305,7 @@ def main(argv: list[str] | None = None) -> int:
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
         shutil.rmtree(profiles, ignore_errors=True)
+        os.close(domain_lock)  # every node is stopped: the domain is free again
 
     if world is None:  # interrupted before anything ran
         return 130
@@ -316,10 +381,16 @@ def _verdict(summary: dict, *, world_died: bool, interrupted: bool) -> int:
         say(f"lockstep ticks answered late: {summary['stale_ticks']} by controllers, {summary['server_stale_ticks']} "
             "by servers (a slow machine; the run may differ from the batch run of the same seed)")
     ended = summary.get("run_ended", "complete")
+    foreign = summary.get("foreign_publishers") or []
+    if foreign:
+        say(f"the run is tainted: foreign publishers on its topics ({'; '.join(foreign[:5])}"
+            f"{' ...' if len(foreign) > 5 else ''}): its results may hold what they sent")
     if world_died:
         return 5
     if interrupted or ended == "interrupted":
         return 130
+    if foreign:
+        return 6
     if ended.startswith("server"):
         say(f"the run ended early: {ended}")
         return 3

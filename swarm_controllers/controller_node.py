@@ -7,9 +7,11 @@ from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviou
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
 with the tick it answers. The tick drives all work; there are no timers.
 
-Messages from other nodes are untrusted: they are checked before the behaviour sees them
-(`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick it can take),
-and what is dropped, here or by the behaviour itself, is counted on ``/diagnostics``.
+Everything from the bus is untrusted: the world's observations and other nodes' messages pass
+the endpoint's guard before the behaviour sees them (`swarm_sim.inbound`: within their topic's
+size cap, decodable, stamped for a tick of the run or one it can take, numbers finite and within
+the arena and the robot's limits, robots of this run), and what is dropped, here or by the
+behaviour itself, is counted on ``/diagnostics``.
 
 The node serves the standard parameter services (``ros2 param list/get``), created with it:
 twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
@@ -39,7 +41,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
+from swarm_msgs_py import auth, diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor, share_sim_time
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
@@ -85,20 +87,29 @@ class ControllerNode(Node):
         self._last_status: tuple | None = None
         self._answered_stamp = -1
         self._answer = b""
-        decoders = {
-            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry),
-            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan),
-            **{t.name: (t.type_name, t.decode) for t in self.sensing.topics},
-        }
-        self._expected = len(decoders)
         # Subscribe to other nodes' messages first: in a wait set where both are ready,
         # rclpy runs the earlier subscription first.
         self.endpoint = Endpoint(self, self.scenario, *registry.robot_topics(algorithm))
-        for name, (type_name, decode) in decoders.items():
-            self.create_subscription(
-                topics.import_type(type_name), name,
-                lambda data, n=name, d=decode: self._on_observation(n, d(data)), SENSOR_LOCKSTEP, raw=True,
-            )
+        guard = self.endpoint.inbound
+        observations = {  # topic -> (type, decoder, the guard's check of its values)
+            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry, "odometry"),
+            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan, "scan"),
+            **{t.name: (t.type_name, t.decode, "value") for t in self.sensing.topics},
+        }
+        self._expected = len(observations)
+        for name, (type_name, decode, kind) in observations.items():
+            guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind)
+
+            def on_message(data: bytes, name: str = name, guarded=guarded) -> None:
+                # The guard first (size, decode, numbers, tick): nothing from the bus raises in
+                # this callback or reaches the behaviour unchecked.
+                decoded = guarded(data)
+                if decoded is not None:
+                    self._on_observation(name, decoded)
+                else:  # counted: say so now, the robot may not tick again soon
+                    self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)
+
+            self.create_subscription(topics.import_type(type_name), name, on_message, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
@@ -147,7 +158,7 @@ class ControllerNode(Node):
         key = (status.state, status.obstacle_avoidance_events, status.trips, status.extra, status.finished)
         if key != self._last_status:
             self._last_status = key
-            self._status_pub.publish(diagnostics.encode_status(status))
+            self._status_pub.publish(auth.sign(diagnostics.encode_status(status)))
         self.endpoint.report.publish(stamp_ns, self.behaviour)
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
@@ -278,6 +289,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
 
 def main(argv: list[str] | None = None) -> int:
     robots, config, ros_args, fork = parse_args(sys.argv[1:] if argv is None else argv)
+    auth.load_from_environment()  # the run's key, when the launcher handed one down (forks inherit it)
     return (serve_forked if fork else serve)(robots, config, ros_args)
 
 

@@ -35,6 +35,10 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
 _MIN_STATUS_SIZE = 1 + 3 * 5 + 4
 """level, three empty strings, values count (padding aside): bounds a status count."""
+MAX_STATUSES = 65536
+"""The most statuses an array may hold (ours: one per robot, event or message of a tick)."""
+MAX_VALUES = 4096
+"""The most key/value pairs a status may hold (ours: a depot's owned slots at most)."""
 
 
 class Status(NamedTuple):
@@ -81,12 +85,37 @@ def decode_diagnostics(data: bytes) -> DiagnosticsData:
     r = Reader(data)
     stamp_ns, _ = r.header()
     statuses = []
-    for _ in range(r.sequence_length(_MIN_STATUS_SIZE)):
+    count = r.sequence_length(_MIN_STATUS_SIZE)
+    if count > MAX_STATUSES:  # refused before any status is read
+        raise ValueError(f"{count} statuses (at most {MAX_STATUSES})")
+    for _ in range(count):
         level = r.u8()
         name, message, hardware_id = r.string(), r.string(), r.string()
-        values = tuple((r.string(), r.string()) for _ in range(r.sequence_length(10)))
+        n = r.sequence_length(10)
+        if n > MAX_VALUES:
+            raise ValueError(f"status {name[:40]!r}: {n} values (at most {MAX_VALUES})")
+        values = tuple((r.string(), r.string()) for _ in range(n))
         statuses.append(Status(level, name, message, hardware_id, values))
     return DiagnosticsData(stamp_ns, tuple(statuses))
+
+
+def count(text: str, key: str) -> int:
+    """A counter's text -> its value: a decimal int in 0..2**63-1, else a ValueError naming `key`
+    (a recorded 10**39 once reached numpy and crashed the plots)."""
+    if not (text.isascii() and text.isdigit()) or len(text) > 19 or int(text) >= 2**63:
+        raise ValueError(f"{key}: expected a count in 0..2**63-1, got {text[:40]!r}")
+    return int(text)
+
+
+def finite(text: str, key: str) -> float:
+    """A float's text -> its value, refused unless finite."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"{key}: expected a number, got {text[:40]!r}") from None
+    if value != value or value in (float("inf"), float("-inf")):
+        raise ValueError(f"{key}: expected a finite number, got {text[:40]!r}")
+    return value
 
 
 def _fields(status: Status, expected: Sequence[str], what: str) -> dict[str, str]:
@@ -143,23 +172,24 @@ def decode_events(data: bytes) -> tuple[int, tuple[WorldEvent, ...]]:
             f = _fields(s, _PICKUP_KEYS, "event")
             events.append(
                 PickupEvent(
-                    s.hardware_id, int(f["stamp_ns"]), int(f["resource"]),
-                    float(f["x"]), float(f["y"]),
+                    s.hardware_id, count(f["stamp_ns"], "stamp_ns"), count(f["resource"], "resource"),
+                    finite(f["x"], "x"), finite(f["y"], "y"),
                 )  # fmt: skip
             )
         elif s.name == "drop":
             f = _fields(s, _DROP_KEYS, "event")
             events.append(
                 DropEvent(
-                    s.hardware_id, int(f["stamp_ns"]), int(f["resource"]), f["zone"],
-                    float(f["x"]), float(f["y"]),
+                    s.hardware_id, count(f["stamp_ns"], "stamp_ns"), count(f["resource"], "resource"), f["zone"],
+                    finite(f["x"], "x"), finite(f["y"], "y"),
                 )  # fmt: skip
             )
         elif s.name == "node_down":
             f = _fields(s, _DOWN_KEYS, "event")
             if f["kind"] not in NODE_KINDS:
                 raise ValueError(f"event node_down: kind {f['kind']!r} not one of {NODE_KINDS}")
-            events.append(NodeDownEvent(s.hardware_id, int(f["stamp_ns"]), f["kind"], int(f["ticks"])))
+            events.append(NodeDownEvent(s.hardware_id, count(f["stamp_ns"], "stamp_ns"), f["kind"],
+                                        count(f["ticks"], "ticks")))
         else:
             raise ValueError(f"unknown event {s.name!r} (expected 'pickup', 'drop' or 'node_down')")
     return stamp_ns, tuple(events)
@@ -207,8 +237,9 @@ def decode_robot_stats(data: bytes) -> tuple[int, dict[RobotId, RobotStats]]:
         if s.name in out:
             raise ValueError(f"robot {s.name!r} appears twice")
         out[s.name] = RobotStats(
-            float(f["collision_time_s"]), int(f["pickups"]), int(f["deliveries"]),
-            int(f["clamped_commands"]), int(f["stale_ticks"]), float(f["avoidance_time_s"]),
+            finite(f["collision_time_s"], "collision_time_s"), count(f["pickups"], "pickups"),
+            count(f["deliveries"], "deliveries"), count(f["clamped_commands"], "clamped_commands"),
+            count(f["stale_ticks"], "stale_ticks"), finite(f["avoidance_time_s"], "avoidance_time_s"),
         )  # fmt: skip
     return stamp_ns, out
 
@@ -246,7 +277,8 @@ def decode_status(data: bytes) -> BehaviourStatus:
         raise ValueError(f"status {s.name!r}: leading keys {keys}, expected {_BEHAVIOUR_KEYS}")
     (_, state), (_, avoid), (_, trips) = s.values[:3]
     finished = s.values[3:4] == (_FINISHED,)
-    return BehaviourStatus(s.name, stamp_ns, state, int(avoid), int(trips), s.values[3 + finished:], finished)
+    return BehaviourStatus(s.name, stamp_ns, state, count(avoid, "obstacle_avoidance_events"), count(trips, "trips"),
+                           s.values[3 + finished:], finished)
 
 
 # --------------------------------------------------------------------------- /diagnostics
@@ -274,8 +306,8 @@ def decode_rejections(data: bytes) -> tuple[int, dict[str, dict[tuple[str, str],
         counts: dict[tuple[str, str], int] = {}
         for key, value in s.values:
             where, sep, reason = key.rpartition(_SEP)
-            if not sep or not value.isdigit():
-                raise ValueError(f"rejections of {s.name!r}: bad entry {key!r} = {value!r}")
-            counts[(where, reason)] = int(value)
+            if not sep:
+                raise ValueError(f"rejections of {s.name[:40]!r}: bad entry {key[:80]!r}")
+            counts[(where, reason)] = count(value, f"rejections of {s.name[:40]!r}: {key[:80]!r}")
         out[s.name] = counts
     return stamp_ns, out

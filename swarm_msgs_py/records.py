@@ -17,14 +17,16 @@ constant ``TYPE`` (a paper's message type number) shows it first, as the value `
 
 Decoding is strict: an unknown message name, an unknown or missing field, or a value that is not
 of the field's declared type (int, float, bool, str, an Enum, or ``X | None``) is refused with a
-ValueError naming ``Class.field`` and the text.
+ValueError naming ``Class.field`` and the text. So is a value no message of ours can hold, before
+any core computes with it: a float that is not finite or beyond ``MAX_MAGNITUDE``, an int outside
+int64, a tuple of more than ``MAX_ITEMS`` items (what a node refuses on physical grounds, such as
+a position beyond the arena, is `swarm_sim.inbound`'s).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import enum
-import math
 import types
 import typing
 from collections.abc import Callable, Iterable, Mapping
@@ -58,6 +60,14 @@ def topic_of(family: MessageFamily, message: Any) -> str:
         raise TypeError(f"{family.name}: no topic for message type {type(message).__name__}") from None
 
 
+MAX_MAGNITUDE = 1e9
+"""The largest magnitude of a float field: positions [m], arc lengths [m], energies, all far
+below; squaring it cannot overflow (a 1e308 coordinate raised OverflowError in a core)."""
+MAX_ITEMS = 4096
+"""The most items a ``tuple[X, ...]`` field may hold (a caging trajectory: tens of landmarks)."""
+_INT64 = 2**63
+
+
 def field_text(value: Any) -> str:
     """A field's value as record text (what `field_parser` reads back)."""
     if isinstance(value, tuple):
@@ -79,7 +89,15 @@ def field_parser(tp: Any, key: str) -> Callable[[str], Any]:
         if len(args) != 2 or args[1] is not Ellipsis:
             raise TypeError(f"{key}: only tuple[X, ...] tuples are supported")
         item = field_parser(args[0], key)
-        return lambda text: tuple(item(t) for t in text.split(" ")) if text else ()
+
+        def parse_tuple(text: str) -> tuple:
+            if not text:
+                return ()
+            if text.count(" ") >= MAX_ITEMS:  # counted before any item is parsed
+                raise ValueError(f"{key}: more than {MAX_ITEMS} items")
+            return tuple(item(t) for t in text.split(" "))
+
+        return parse_tuple
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(tp) if a is not type(None)]
         if len(args) != 1:
@@ -104,8 +122,8 @@ def field_parser(tp: Any, key: str) -> Callable[[str], Any]:
         return parse_bool
     if tp is int:
         def parse_int(text: str) -> int:
-            if not text.lstrip("-").isdigit() or len(text) > 40:
-                raise ValueError(f"{key}: expected an integer, got {text!r}")
+            if not text.lstrip("-").isdigit() or len(text) > 20 or not -_INT64 <= int(text) < _INT64:
+                raise ValueError(f"{key}: expected a 64-bit integer, got {text[:40]!r}")
             return int(text)
 
         return parse_int
@@ -114,9 +132,9 @@ def field_parser(tp: Any, key: str) -> Callable[[str], Any]:
             try:
                 value = float(text)
             except ValueError:
-                raise ValueError(f"{key}: expected a number, got {text!r}") from None
-            if not math.isfinite(value):
-                raise ValueError(f"{key}: expected a finite number, got {text!r}")
+                raise ValueError(f"{key}: expected a number, got {text[:40]!r}") from None
+            if not -MAX_MAGNITUDE <= value <= MAX_MAGNITUDE:  # NaN fails too
+                raise ValueError(f"{key}: expected a finite number within +-{MAX_MAGNITUDE:g}, got {text[:40]!r}")
             return value
 
         return parse_float

@@ -101,6 +101,16 @@ def heard(topic: str) -> str:
     return f"{topic}/{HEARD}"
 
 
+REFUSED = "refused"
+
+
+def refused(topic: str) -> str:
+    """The bag channel of the messages the run refused on `topic` (``/robot_1/cmd_vel`` ->
+    ``/robot_1/cmd_vel/refused``): recorded as they came, apart, so analysis reads what the nodes
+    took (a suffix: no reader that picks topics by their last name takes it for the topic)."""
+    return f"{topic}/{REFUSED}"
+
+
 def robot_topic(robot: RobotId, name: str) -> str:
     """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"`` (any relative name: tasks add
     their own sense topics)."""

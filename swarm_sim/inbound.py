@@ -1,12 +1,21 @@
 """What a node accepts from the bus: every message is untrusted input (ROS-free).
 
-A node checks each message it decodes before its core sees it (`Inbound.admit`): every field
-that names a robot (annotated `swarm_sim.types.RobotId`) must name a robot of this run, and the
-message must be stamped for a tick the node can still take (`swarm_sim.messaging`: a message
-sent at tick k is taken at tick k+1). What fails is dropped and counted in `Rejections` by
-(where, reason); the node logs the first of each kind and then every 10th, 100th, ... one
-(rate limiting without a wall clock), and publishes the counts on ``/diagnostics`` so they reach
-the bag and the run's summary (``rejected_messages``).
+Every subscription of every node hands its bytes to one guard, `Inbound.decode`, before any
+other work: a message longer than its topic's cap (`Bounds`) is refused unread (a 19 MB array
+took 1.5 s to decode in every robot node), then it is decoded, and whatever the decoder raises
+is a refusal, never an exception in the node's callback. A decoded message is then checked before
+its core sees it: a message of another node (`Inbound.admit`) must name robots of this run in
+every field annotated `swarm_sim.types.RobotId`, hold coordinates within the arena in every field
+annotated `swarm_sim.types.Coordinate`, and be stamped for a tick the node can still take
+(`swarm_sim.messaging`: a message sent at tick k is taken at tick k+1); an observation from the
+world (`Inbound.sense_guard`) must be stamped on a tick of the run and hold finite numbers within
+the arena and the robots' limits (`Bounds`). Numbers are checked before a core computes with
+them: a 1e308 coordinate made a core raise OverflowError.
+
+What fails is dropped and counted in `Rejections` by (where, reason); the node logs the first of
+each kind and then every 10th, 100th, ... one (rate limiting without a wall clock), and publishes
+the counts on ``/diagnostics`` so they reach the bag and the run's summary
+(``rejected_messages``).
 
 Cores keep their own invariants too (a grant naming a slot the layout lacks, a report the depot
 cannot apply): they count what they refuse in a `Rejections` of their own, keyed by the message
@@ -16,13 +25,18 @@ class, which their node merges into what it publishes.
 from __future__ import annotations
 
 import dataclasses
+import math
 import typing
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from enum import Enum
 from functools import cache
+from typing import Any
 
-from swarm_sim.types import ROBOT_ID
+import numpy as np
+
+from swarm_sim.types import COORDINATE, ROBOT_ID
 
 
 class Reason(str, Enum):
@@ -44,6 +58,16 @@ class Reason(str, Enum):
     """It comes from, or is addressed to, a node this run does not have."""
     REFUSED = "refused"
     """It decoded and named known robots, but the core could not apply it."""
+    TOO_BIG = "too big"
+    """It is longer than its topic's cap (`Bounds`): refused before it was decoded."""
+    OUT_OF_BOUNDS = "out of bounds"
+    """A number in it is not finite, or beyond the arena or the robots' limits (`Bounds`)."""
+    UNAUTHENTICATED = "unauthenticated"
+    """It lacks the run's tag, or its tag is wrong (`swarm_msgs_py.auth`): not sent by this run."""
+    REPLAYED = "replayed"
+    """The very bytes of a message already taken: a copy, replayed from the bus."""
+    FOREIGN = "foreign publisher"
+    """A publisher that is not one of the run's nodes was seen on the topic (`swarm_sim.nodes.taint`)."""
 
 
 class Rejections:
@@ -91,15 +115,91 @@ def merged(*sources: Rejections | None) -> dict[tuple[str, str], int]:
 
 
 @cache
-def robot_fields(cls: type) -> tuple[str, ...]:
-    """The fields of message dataclass `cls` that name a robot (annotated `RobotId`)."""
+def marked_fields(cls: type, mark: object) -> tuple[str, ...]:
+    """The fields of message dataclass `cls` annotated with `mark` (``Annotated[X, mark]``)."""
     if not dataclasses.is_dataclass(cls):
         return ()
     hints = typing.get_type_hints(cls, include_extras=True)
     return tuple(
         f.name for f in dataclasses.fields(cls)
-        if typing.get_origin(hints.get(f.name)) is typing.Annotated and ROBOT_ID in hints[f.name].__metadata__
+        if typing.get_origin(hints.get(f.name)) is typing.Annotated and mark in hints[f.name].__metadata__
     )
+
+
+def robot_fields(cls: type) -> tuple[str, ...]:
+    """The fields of message dataclass `cls` that name a robot (annotated `RobotId`)."""
+    return marked_fields(cls, ROBOT_ID)
+
+
+COORDINATE_MARGIN = 1.0
+"""How far beyond the arena's walls a coordinate may lie [m] (a robot pushed against a wall, a
+rounding): farther is no place of this run."""
+SPEED_SLACK = 2.0
+"""Measured speeds may exceed a robot's limits when others push it (0.181 m/s measured at a
+0.16 m/s limit): up to `SPEED_SLACK` times the limit plus 0.5 m/s or 2 pi rad/s passes."""
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """What a message of a run can physically hold, from its scenario."""
+
+    coordinate: float
+    """|x|, |y| of any position [m, world frame]: the arena's half side, its walls and
+    `COORDINATE_MARGIN`; every other number a sense holds (intensities, ids) is smaller."""
+    speed: float
+    """|forward speed| in odometry [m/s]."""
+    turn_rate: float
+    """|turn rate| in odometry [rad/s]."""
+    dt_ns: int
+    end_ns: int
+    """The run's last tick [ns]: observations are stamped on the ticks 0, dt, ..., end."""
+    rays: int
+    """Ranges in a scan."""
+    message_bytes: int
+    """Cap on a message of another node (a family's array of one tick) [bytes]: 64 KiB plus
+    2 KiB per robot (measured: at most 0.6 KiB per robot per tick, caging's type 4 messages)."""
+    sense_bytes: int
+    """Cap on an observation from the world [bytes]: 64 KiB plus 64 bytes per resource and per
+    robot (a PoseArray pose is 56) and 4 per scan ray."""
+
+    @classmethod
+    def of(cls, scenario: Any) -> Bounds:
+        robots, arena = scenario.robots, scenario.arena
+        return cls(
+            coordinate=arena.size / 2 + arena.wall_thickness + COORDINATE_MARGIN,
+            speed=SPEED_SLACK * robots.max_linear_speed + 0.5,
+            turn_rate=SPEED_SLACK * robots.max_angular_speed + 2 * math.pi,
+            dt_ns=scenario.dt_ns,
+            end_ns=scenario.ticks * scenario.dt_ns,
+            rays=scenario.sensors.scan.rays,
+            message_bytes=65536 + 2048 * robots.count,
+            sense_bytes=65536 + 64 * (scenario.resources.count + robots.count) + 4 * scenario.sensors.scan.rays,
+        )
+
+
+def within(value: Any, limit: float) -> bool:
+    """Whether every float in `value` (nested tuples, lists, dataclasses, float arrays) is finite
+    and within +-`limit`; ints, bools and strings pass. (Type tests by identity first: it runs on
+    every observation of every robot.)"""
+    t = type(value)
+    if t is float:
+        return -limit <= value <= limit  # NaN fails
+    if t is bool or t is int or t is str or value is None:
+        return True
+    if t is tuple or t is list or isinstance(value, tuple):  # NamedTuples too
+        for v in value:
+            if not within(v, limit):
+                return False
+        return True
+    if t is np.ndarray:
+        if value.dtype.kind != "f" or value.size == 0:
+            return True
+        return bool(-limit <= value.min() and value.max() <= limit)  # NaN fails
+    if isinstance(value, float):  # numpy scalars
+        return -limit <= value <= limit
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return all(within(getattr(value, f.name), limit) for f in dataclasses.fields(value))
+    return True
 
 
 class Inbound:
@@ -113,39 +213,126 @@ class Inbound:
     """
 
     def __init__(self, robots: Iterable[str], dt_ns: int, rejections: Rejections,
-                 log: Callable[[str], None]) -> None:
+                 log: Callable[[str], None], bounds: Bounds | None = None) -> None:
+        """`bounds`: the run's (`Bounds.of`); None checks no numbers and caps no size (tests of
+        the other rules)."""
         self.robots = frozenset(robots)
         self.dt_ns = dt_ns
         self.rejections = rejections
         self._log = log
+        self.bounds = bounds
         self.now_ns = 0
         self.released_ns = 0
+        self.unique = False
+        """Refuse a message's bytes seen before (`post_all`): set where messages carry the run's
+        tag (`swarm_msgs_py.auth`), so a copy of one cannot be replayed within its tick window."""
+        self._seen: set[int] = set()
+        """Hashes of the bytes of the messages taken lately (`forget_before` prunes them)."""
+        self._seen_order: deque[tuple[int, int]] = deque()
+        """(the tick a message was taken at, its hash), oldest first."""
+
+    def forget_before(self, stamp_ns: int) -> None:
+        """Drop the replay memory of ticks before `stamp_ns` (their stamps are out of the window)."""
+        order, seen = self._seen_order, self._seen
+        while order and order[0][0] < stamp_ns:
+            seen.discard(order.popleft()[1])
 
     def reject(self, where: str, reason: Reason, detail: str = "") -> None:
         if self.rejections.add(where, reason, detail):
             self._log(self.rejections.log_line(where, reason))
 
+    def decode(self, where: str, decode: Callable[[bytes], Any], data: bytes, max_bytes: int | None) -> Any:
+        """The guard every subscription's bytes pass first: None (counted) if `data` is longer than
+        `max_bytes` or `decode` raises anything at all, else what `decode` returns."""
+        if max_bytes is not None and len(data) > max_bytes:
+            self.reject(where, Reason.TOO_BIG, f"{len(data)} bytes (at most {max_bytes})")
+            return None
+        try:
+            return decode(data)
+        except Exception as exc:  # noqa: BLE001 - whatever a message makes a decoder raise, the node lives
+            # A decoder's error may say why in its `reason` (`swarm_msgs_py.auth.Unauthenticated`).
+            self.reject(where, getattr(exc, "reason", Reason.MALFORMED), str(exc)[:200])
+            return None
+
+    def sense_guard(self, where: str, decode: Callable[[bytes], Any], kind: str = "value") -> Callable[[bytes], Any]:
+        """One observation topic's whole guard as one function, bytes -> decoded (stamp, value,
+        ...) or None (counted): within `Bounds.sense_bytes`, decodable, its numbers finite and
+        within bounds (`kind`: ``odometry``: the pose within the arena, speeds within the robot's
+        limits; ``scan``: one range per ray, none NaN or negative but -inf, REP 117's too close;
+        ``value``: every float within the coordinate bound, `within`), stamped on a tick of the
+        run. All inlined: every robot runs it on every observation (450 times a tick in a
+        112-robot controller process)."""
+        b = self.bounds
+        if b is None:
+            return decode
+        reject = self.reject
+        cap, c, end, dt = b.sense_bytes, b.coordinate, b.end_ns, b.dt_ns
+        speed, turn, rays = b.speed, b.turn_rate, b.rays
+
+        def guarded(data: bytes) -> Any:
+            if len(data) > cap:
+                reject(where, Reason.TOO_BIG, f"{len(data)} bytes (at most {cap})")
+                return None
+            try:
+                d = decode(data)
+            except Exception as exc:  # noqa: BLE001 - whatever a message makes a decoder raise, the node lives
+                reject(where, getattr(exc, "reason", Reason.MALFORMED), str(exc)[:200])
+                return None
+            stamp, value = d[0], d[1]
+            if kind == "odometry":
+                v, w = d[2], d[3]
+                ok = (-c <= value.x <= c and -c <= value.y <= c and -4.0 <= value.yaw <= 4.0
+                      and -speed <= v <= speed and -turn <= w <= turn)
+            elif kind == "scan":  # REP 117: inf for no return, -inf for too close; NaN fails both tests
+                ok = len(value) == rays and (value.min() >= 0.0 or bool(((value >= 0.0) | (value == -np.inf)).all()))
+            else:
+                ok = within(value, c)
+            if not ok:
+                reject(where, Reason.OUT_OF_BOUNDS, "a number not finite, or beyond the arena or the robot's limits")
+                return None
+            if not (0 <= stamp <= end and stamp % dt == 0):
+                reject(where, Reason.WRONG_TICK, f"stamped {stamp} ns: no tick of this run")
+                return None
+            return d
+
+        return guarded
+
     def admit(self, where: str, message: object) -> bool:
         """Whether `message` (decoded from topic `where`) may reach the core; counts it if not."""
-        for name in robot_fields(type(message)):
+        cls = type(message)
+        for name in robot_fields(cls):
             robot = getattr(message, name)
             if robot not in self.robots:
-                self.reject(where, Reason.UNKNOWN_ROBOT, f"{type(message).__name__}.{name} = {robot[:40]!r}")
+                self.reject(where, Reason.UNKNOWN_ROBOT, f"{cls.__name__}.{name} = {robot[:40]!r}")
                 return False
+        if self.bounds is not None:
+            c = self.bounds.coordinate
+            for name in marked_fields(cls, COORDINATE):
+                if not -c <= getattr(message, name) <= c:
+                    self.reject(where, Reason.OUT_OF_BOUNDS, f"{cls.__name__}.{name} = {getattr(message, name):.3g} m")
+                    return False
         stamp = getattr(message, "stamp_ns", None)
         if stamp is not None and not self.released_ns - self.dt_ns <= stamp <= self.now_ns + self.dt_ns:
             self.reject(where, Reason.WRONG_TICK, f"{type(message).__name__} stamped {stamp} ns at tick {self.now_ns} ns")
             return False
         return True
 
-    def post_all(self, where: str, family, data: bytes, post: Callable[[object], None]) -> int:
-        """A raw subscription's body: decode `data` with `family`, admit each message, `post`
-        those admitted. Returns how many were posted."""
-        try:
-            messages = family.decode(data)
-        except ValueError as exc:
-            self.reject(where, Reason.MALFORMED, str(exc)[:200])
+    def post_all(self, where: str, family, data: bytes, post: Callable[[object], None],
+                 decode: Callable[[bytes], Any] | None = None) -> int:
+        """A raw subscription's body: decode `data` with `decode` (default `family.decode`; the
+        guard: capped at `Bounds.message_bytes`), admit each message, `post` those admitted.
+        Returns how many were posted. With `unique` on, the very bytes of a message taken within
+        the last two ticks are refused as a replay (ours send each array once)."""
+        messages = self.decode(where, decode or family.decode, data, self.bounds and self.bounds.message_bytes)
+        if messages is None:
             return 0
+        if self.unique:
+            digest = hash(data)
+            if digest in self._seen:
+                self.reject(where, Reason.REPLAYED, "the same bytes again (a replay of a message of this run?)")
+                return 0
+            self._seen.add(digest)
+            self._seen_order.append((self.now_ns, digest))
         posted = 0
         for m in messages:
             if self.admit(where, m):

@@ -31,6 +31,19 @@ ROBOT_ID = _RobotIdMark()
 RobotId = Annotated[str, ROBOT_ID]
 """A robot's name, which is also its ROS namespace (``robot_0``, ``robot_1``, ...)."""
 
+
+class _CoordinateMark:
+    """Marks a message field that holds a position coordinate [m, world frame], so a node can
+    refuse one beyond the arena before any core computes with it (`swarm_sim.inbound`)."""
+
+    def __repr__(self) -> str:
+        return "coordinate"
+
+
+COORDINATE = _CoordinateMark()
+Coordinate = Annotated[float, COORDINATE]
+"""An x or y position [m, world frame] in a message from another node."""
+
 NS_PER_S = 1_000_000_000
 
 

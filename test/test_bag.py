@@ -583,3 +583,39 @@ def test_a_run_is_one_file_by_default_however_long(tmp_path: Path) -> None:
             w.write("/robot_0/cmd_vel", i * NS, twist(i))
     assert [p.name for p in bag.glob("*.mcap")] == ["run_0.mcap"]
     assert len(list(read_bag(bag))) == 200
+
+
+def test_analysis_takes_no_more_than_the_live_graph(tmp_path: Path) -> None:
+    """Issue 25 item 4: what the run refused (its /refused channels) is not read; a status counts
+    only on its own robot's topic and with counts a run can reach (5000 OAEs in 10 ticks, or 1e39,
+    once crashed the plots); nothing recorded crashes the analysis or its plots."""
+    import json
+
+    from swarm_msgs_py import clock, diagnostics
+    from swarm_sim.analysis.cli import main as analyze
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.analysis.replay import load_run
+    from swarm_sim.scenario import load_scenario, scenario_to_dict
+    from swarm_sim.types import BehaviourStatus
+
+    scenario = load_scenario("cpfa", ["robots.count=2", "sim.duration=1"])
+    bag = tmp_path / "forged"
+    meta = {"scenario": json.dumps(scenario_to_dict(scenario)), "sim_seconds": "1.0"}
+    status = lambda robot, oae: diagnostics.encode_status(BehaviourStatus(robot, 0, "search", oae, 0))  # noqa: E731
+    big = diagnostics.encode_diagnostics(0, [(0, "robot_1", "", "robot_1", (
+        ("state", "search"), ("obstacle_avoidance_events", "1" + "0" * 39), ("trips", "0")))])
+    with BagWriter(bag, metadata=meta) as w:
+        w.add_topic("/clock", "rosgraph_msgs/msg/Clock")
+        for topic in ("/robot_0/status", "/robot_1/status", "/robot_0/status/refused"):
+            w.add_topic(topic, "diagnostic_msgs/msg/DiagnosticArray")
+        w.write("/clock", 0, clock.encode_clock(10**9))
+        w.write("/robot_0/status", 1, status("robot_0", 3))
+        w.write("/robot_0/status/refused", 2, status("robot_0", 4))  # refused live: not read
+        w.write("/robot_0/status", 3, status("robot_1", 7))  # robot_1's status on robot_0's topic
+        w.write("/robot_1/status", 4, status("robot_1", 5000))  # more events than ticks
+        w.write("/robot_1/status", 5, big)
+    with pytest.warns(UserWarning):
+        summary = summarize(load_run(bag))
+    assert summary["oae_by_robot"] == {"robot_0": 3, "robot_1": 0}
+    assert summary["malformed_messages"] == 3
+    assert analyze([str(bag), "--json", "--plot", str(tmp_path / "plot.png")]) == 0

@@ -397,11 +397,12 @@ def test_diagnostics_refuse_unencodable_values():
         diagnostics.encode_diagnostics(0, [Status(0, "a\x00b")])
 
 
-FLOATS_EXACT = st.floats(allow_nan=False)  # repr() round-trips every non-NaN float
+FLOATS_EXACT = FINITE  # repr() round-trips every finite float; events refuse the others
+EVENT_STAMPS = st.integers(min_value=0, max_value=2**63 - 1)  # sim time: never negative
 EVENT_ST = st.one_of(
-    st.builds(PickupEvent, st.sampled_from(ROBOTS), STAMPS, st.integers(0, 10**6), FLOATS_EXACT,
+    st.builds(PickupEvent, st.sampled_from(ROBOTS), EVENT_STAMPS, st.integers(0, 10**6), FLOATS_EXACT,
               FLOATS_EXACT),
-    st.builds(DropEvent, st.sampled_from(ROBOTS), STAMPS, st.integers(0, 10**6),
+    st.builds(DropEvent, st.sampled_from(ROBOTS), EVENT_STAMPS, st.integers(0, 10**6),
               st.sampled_from(["depot", "dock_1", "région"]), FLOATS_EXACT, FLOATS_EXACT),
 )  # fmt: skip
 
@@ -434,6 +435,14 @@ def test_events_numpy_scalars_travel_as_plain_numbers():
     assert back == PickupEvent("robot_1", 0, 3, 0.5, 0.25)
 
 
+def test_events_refuse_numbers_no_run_can_hold():
+    for key, value in (("x", "inf"), ("x", "nan"), ("stamp_ns", "-1"), ("resource", "1" * 40), ("stamp_ns", "1e39")):
+        values = dict((("resource", "1"), ("x", "0.5"), ("y", "0.5"), ("stamp_ns", "0")), **{key: value})
+        data = diagnostics.encode_diagnostics(0, [Status(0, "pickup", "", "robot_1", tuple(values.items()))])
+        with pytest.raises(CodecError, match=key):
+            diagnostics.decode_events(data)
+
+
 def test_events_refuse_unknown_status():
     data = diagnostics.encode_diagnostics(0, [Status(0, "teleport", "", "robot_1", ())])
     with pytest.raises(CodecError, match="DiagnosticArray.*teleport"):
@@ -444,8 +453,8 @@ def test_events_refuse_unknown_status():
 
 
 STATS_ST = st.builds(
-    RobotStats, st.floats(min_value=0, allow_nan=False), *[st.integers(0, 10**9)] * 4,
-    st.floats(min_value=0, allow_nan=False),
+    RobotStats, st.floats(min_value=0, allow_nan=False, allow_infinity=False), *[st.integers(0, 10**9)] * 4,
+    st.floats(min_value=0, allow_nan=False, allow_infinity=False),
 )
 
 

@@ -348,7 +348,7 @@ def test_a_swarm_run_and_the_test_process_bind_loopback_only(tmp_path) -> None:
     rclpy.init(context=context)
     node = rclpy.create_node("binding_probe", context=context)
     cmd = [sys.executable, "-m", "launch_py.run", "--scenario", "queue_qmt", "--robots", "4", "--duration", "600",
-           "--bag", str(tmp_path / "bag"), "--domain-id", os.environ["ROS_DOMAIN_ID"]]
+           "--bag", str(tmp_path / "bag"), "--domain-id", "auto"]  # ours holds ROS_DOMAIN_ID: a run refuses it
     launcher = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 start_new_session=True)
     try:
@@ -408,8 +408,47 @@ def test_robots_do_not_read_graph_announcements_but_everyone_sees_their_nodes(tm
     )
     env = {**dds.loopback_env(domain, processes=2, server_port=dds.discovery_port(domain)), "ROS_SUPER_CLIENT": "TRUE"}
     try:
+        deadline = time.monotonic() + 60  # the probe joins once the world is up: before, it would hold
+        while not (tmp_path / "bag" / "metadata.yaml").exists():  # the domain and the run refuse it
+            assert time.monotonic() < deadline and launcher.poll() is None, launcher.stdout.read()[-2000:]
+            time.sleep(0.1)
         out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120)
         names = set(json.loads(out.stdout.strip().splitlines()[-1]))
         assert {"/robot_0/controller", "/robot_1/controller", "/robot_2/controller", "/world"} <= names, names
     finally:
         _stop_launcher(launcher)
+
+
+# --------------------------------------------------------------------------- one run per domain
+
+
+def test_a_domain_is_in_use_while_its_discovery_port_is_bound_or_a_participant_is_on_it() -> None:
+    domain = _domain(5)
+    assert dds.domain_in_use(domain) is None
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as squatter:
+        squatter.bind(("127.0.0.1", dds.discovery_port(domain)))
+        assert f"discovery server port 127.0.0.1:{dds.discovery_port(domain)}" in dds.domain_in_use(domain)
+        with pytest.raises(dds.DomainTaken, match=f"domain {domain} is in use"):
+            os.close(dds.claim_domain(domain))
+    assert dds.domain_in_use(domain) is None
+    with _children() as procs:
+        procs.append(worker := _spawn(dds.loopback_env(domain, 2), "worker", 0, 30.0))
+        deadline = time.monotonic() + 20
+        while dds.domain_in_use(domain) is None and time.monotonic() < deadline and worker.poll() is None:
+            time.sleep(0.1)
+        assert "a DDS participant is on it" in (dds.domain_in_use(domain) or ""), _stderr(worker)[-2000:]
+    assert dds.domain_in_use(domain) is None  # the participant left with its process
+
+
+def test_a_claimed_domain_is_refused_to_a_second_claim_until_released() -> None:
+    domain = _domain(6)
+    lock = dds.claim_domain(domain)
+    try:
+        with pytest.raises(dds.DomainTaken, match="another swarmforage run"):
+            dds.claim_domain(domain)
+        other, other_lock = dds.claim_free_domain(first=domain)  # auto: the next free one
+        os.close(other_lock)
+        assert other != domain and dds.DOMAIN_RANGE[0] <= other <= dds.DOMAIN_RANGE[1]
+    finally:
+        os.close(lock)
+    os.close(dds.claim_domain(domain))

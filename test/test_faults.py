@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import rclpy
+from graph_helpers import launch, overrides  # noqa: F401 - launch: a fixture
+from launch_py.dds import discovery_port
 from rclpy.node import Node
 
 from depot_manager.codec import DEPOT, DEPOT_REPORTS, DEPOT_STATE, RADIO, RADIO_TOPIC
@@ -32,102 +34,6 @@ from swarm_sim.types import NS_PER_S, NodeDownEvent
 REPO = Path(__file__).resolve().parents[1]
 # Q_MT in a 7 x 7 m arena with 200 uniform resources: the first deliveries within a minute.
 BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
-
-
-class Launch:
-    """swarm-run in its own session; `stop` kills whatever is left of its process group."""
-
-    def __init__(self, bag: Path, *args: str) -> None:
-        self.bag = bag
-        cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json",
-               "--domain-id", os.environ["ROS_DOMAIN_ID"], *args]
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                     cwd=REPO, start_new_session=True)
-        self.pids: dict[int, str] = {}
-
-    def children(self) -> dict[int, str]:
-        """The launcher's descendants: pid -> "<name> <command line>" (remembered for `alive`)."""
-        parents: dict[int, int] = {}
-        for p in Path("/proc").iterdir():
-            if p.name.isdigit():
-                try:
-                    parents[int(p.name)] = int((p / "stat").read_text().rsplit(")", 1)[1].split()[1])
-                except (OSError, ValueError, IndexError):
-                    continue
-        mine, grew = {self.proc.pid}, True
-        while grew:
-            new = {pid for pid, ppid in parents.items() if ppid in mine} - mine
-            mine |= new
-            grew = bool(new)
-        for pid in mine - {self.proc.pid}:
-            try:
-                name = Path(f"/proc/{pid}/comm").read_text().strip()
-                cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
-            except OSError:
-                continue
-            self.pids[pid] = f"{name} {cmdline}"
-        return dict(self.pids)
-
-    def child(self, module: str, robot: str | None = None) -> int:
-        """The process running `module`, or with --fork the one named after `robot`."""
-        found = [pid for pid, text in self.children().items()
-                 if f"-m {module} " in text and (robot is None or text.startswith(robot + " "))]
-        assert len(found) == 1, (module, robot, self.pids)
-        return found[0]
-
-    def alive(self) -> list[int]:
-        """Processes this launcher started that still exist (zombies count as gone)."""
-        out = []
-        for pid in self.pids:
-            try:
-                state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-            except OSError:
-                continue
-            if state != "Z":
-                out.append(pid)
-        return out
-
-    def sim_time(self) -> float:
-        """The last /clock recorded so far [s] (0 before the bag exists)."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BagTruncatedWarning)
-                return bag_info(self.bag).end_ns / NS_PER_S
-        except Exception:  # noqa: BLE001 - not there yet, or mid-write
-            return 0.0
-
-    def wait_until(self, predicate, timeout: float = 90.0, what: str = "") -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            assert self.proc.poll() is None, f"swarm-run ended early ({what}): {self.proc.stderr.read()[-3000:]}"
-            assert time.monotonic() < deadline, f"timed out waiting for {what}"
-            time.sleep(0.3)
-
-    def finish(self, timeout: float = 240.0) -> tuple[int, dict | None, str]:
-        out, err = self.proc.communicate(timeout=timeout)
-        lines = out.strip().splitlines()
-        summary = json.loads(lines[-1]) if lines and lines[-1].startswith("{") else None
-        return self.proc.returncode, summary, err
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait()
-        for pid in self.alive():  # children live in their own sessions
-            os.killpg(pid, signal.SIGKILL)
-
-
-@pytest.fixture
-def launch(tmp_path):
-    started: list[Launch] = []
-
-    def start(*args: str) -> Launch:
-        started.append(Launch(tmp_path / "bag", *args))
-        return started[-1]
-
-    yield start
-    for run in started:
-        run.stop()
 
 
 def _last(bag: Path, topic: str):
@@ -181,6 +87,8 @@ class Hostile(Node):
 
 def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_path):
     run = launch("--scenario", "queue_qmt", "--robots", "6", "--duration", "150", *overrides(BUSY_DEPOT))
+    # once the world is up (before, this participant would hold the domain and the run refuse it)
+    run.wait_until(lambda: (run.bag / "metadata.yaml").exists(), what="the world up")
     # a client of the run's discovery server (the world), as `ros2` on this machine would be
     os.environ["ROS_DISCOVERY_SERVER"] = f"127.0.0.1:{discovery_port(int(os.environ['ROS_DOMAIN_ID']))}"
     ctx = rclpy.Context()
@@ -208,12 +116,14 @@ def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_pa
         node.destroy_node()
         ctx.try_shutdown()
     code, summary, err = run.finish()
-    assert code == 0, err[-3000:]
+    assert code == 6, err[-3000:]  # a foreign publisher on cmd_vel, which carries no tag: tainted
+    assert "/robot_1/cmd_vel" in " ".join(summary["foreign_publishers"]) and "the run is tainted" in err
     rejected = summary["rejected_messages"]
-    assert rejected["/depot/reports"]["unknown robot"] >= 4  # by the depot manager's node
-    assert {"late", "wrong tick", "malformed"} <= set(rejected["/robot_1/cmd_vel"])  # by the world
-    assert rejected["/lockstep/ack"]["unknown node"] >= 1
-    assert summary["malformed_messages"] >= 1  # the garbage status, recorded as sent
+    assert rejected["/depot/reports"]["unauthenticated"] >= 3  # untagged: by the depot manager's node
+    assert {"late", "wrong tick", "malformed", "foreign publisher"} <= set(rejected["/robot_1/cmd_vel"])  # by the world
+    assert rejected["/lockstep/ack"]["unauthenticated"] >= 1
+    assert summary["malformed_messages"] == 0  # the garbage status was refused and recorded apart:
+    assert bag_info(run.bag).message_counts["/robot_0/status/refused"] >= 1
     assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0 and summary["run_ended"] == "complete"
     # nothing forged reached a core: the run is the batch run of the same seed
     batch = subprocess.run([sys.executable, "-m", "swarm_sim.batch", "--scenario", "queue_qmt", "--robots", "6",

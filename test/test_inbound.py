@@ -125,3 +125,101 @@ def test_core_counts_are_merged_with_the_nodes():
     core.add("RadioReply", Reason.REFUSED)
     assert merged(node, core, None) == {("/radio", "malformed"): 1, ("RadioReply", "refused"): 2}
     assert np.sum(list(merged(node, core).values())) == 3
+
+
+# --------------------------------------------------------------------------- the guard (issue 25)
+
+def _guarded(scenario_overrides=("robots.count=2",)):
+    from swarm_sim.inbound import Bounds
+
+    scenario = load_scenario("queue_qmt", scenario_overrides)
+    logged: list[str] = []
+    gate = Inbound(scenario.robot_names, scenario.dt_ns, Rejections(), logged.append, Bounds.of(scenario))
+    gate.now_ns = gate.released_ns = 10 * scenario.dt_ns
+    return gate, scenario, logged
+
+
+def test_the_guard_refuses_big_messages_unread_and_survives_any_decoder_failure():
+    gate, _, _ = _guarded()
+    read: list[bytes] = []
+
+    def decoder(data):
+        read.append(data)
+        raise OverflowError("1e308 squared")  # not a ValueError: the guard still holds
+
+    assert gate.decode("/x", decoder, bytes(100), max_bytes=10) is None and read == []
+    assert gate.decode("/x", decoder, bytes(5), max_bytes=10) is None and len(read) == 1
+    assert gate.decode("/x", lambda d: ("ok", d), b"ab", max_bytes=10) == ("ok", b"ab")
+    assert gate.rejections.counts == {("/x", "too big"): 1, ("/x", "malformed"): 1}
+
+
+def test_a_19_mb_array_of_grants_is_refused_by_size_before_it_is_decoded():
+    gate, scenario, _ = _guarded()
+    grants = [DepotGrant(0, "robot_999", "entry_line_0", k) for k in range(20_000)]
+    (data,) = DEPOT.encode(0, grants)
+    assert len(data) > gate.bounds.message_bytes
+    assert gate.post_all("/depot/grants", DEPOT, data, lambda m: None) == 0
+    assert gate.rejections.counts == {("/depot/grants", "too big"): 1}
+
+
+def test_coordinates_beyond_the_arena_are_refused_before_any_core_computes_with_them():
+    gate, scenario, logged = _guarded()
+    edge = scenario.arena.size / 2 + scenario.arena.wall_thickness
+    ok = RadioReply(10 * DT, "robot_1", "robot_0", edge, -edge, "l", 1, False)
+    far = RadioReply(10 * DT, "robot_1", "robot_0", 1e6, 0.0, "l", 1, False)
+    assert gate.admit("/radio", ok) and not gate.admit("/radio", far)
+    assert gate.rejections.counts == {("/radio", "out of bounds"): 1} and "RadioReply.x" in logged[0]
+
+
+def test_observations_are_checked_for_their_tick_and_their_numbers():
+    from swarm_sim.types import Pose2D
+
+    gate, scenario, _ = _guarded()
+    dt, b = scenario.dt_ns, gate.bounds
+    as_is = lambda d: d  # noqa: E731 - the guard's decoder: the "bytes" are the decoded tuple here
+    odom = gate.sense_guard("/r/odom", as_is, "odometry")
+    assert odom((dt, Pose2D(1.0, -1.0, 3.0), 0.1, -1.0))
+    for stamp, x, v, w in ((dt, float("nan"), 0.0, 0.0), (dt, 1e308, 0.0, 0.0), (dt, 0.0, b.speed * 1.01, 0.0),
+                           (dt, 0.0, 0.0, -b.turn_rate * 1.01)):
+        assert odom((stamp, Pose2D(x, 0.0, 0.0), v, w)) is None
+    for stamp in (dt + 1, -dt, b.end_ns + dt):
+        assert odom((stamp, Pose2D(0.0, 0.0, 0.0), 0.0, 0.0)) is None
+    ranges = gate.sense_guard("/r/scan", as_is, "scan")
+    rays = b.rays
+    assert ranges((dt, np.array([np.inf, -np.inf, 0.5] + [1.0] * (rays - 3), np.float32)))
+    assert ranges((dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))) is None
+    assert ranges((dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))) is None
+    assert ranges((dt, np.ones(rays + 1, np.float32))) is None
+    seen = gate.sense_guard("/r/resources", as_is)
+    assert seen((dt, ((1.0, 2.0), (-2.0, 0.5))))
+    assert seen((dt, ((1.0, 2.0), (float("inf"), 0.5)))) is None
+    assert seen((dt, ((1e9, 2.0),))) is None
+    assert gate.rejections.counts == {("/r/odom", "out of bounds"): 4, ("/r/odom", "wrong tick"): 3,
+                                      ("/r/scan", "out of bounds"): 3, ("/r/resources", "out of bounds"): 2}
+
+
+def test_the_sense_guard_decodes_and_checks_in_one_call():
+    from swarm_msgs_py import gripper, odometry, resources, scan
+    from swarm_sim.types import Pose2D
+
+    gate, scenario, _ = _guarded()
+    dt, sc = scenario.dt_ns, scenario.sensors.scan
+    odom = gate.sense_guard("/r/odom", odometry.decode_odometry, "odometry")
+    ranges = gate.sense_guard("/r/scan", scan.decode_scan, "scan")
+    seen = gate.sense_guard("/r/resources", resources.decode_resources)
+    grip = gate.sense_guard("/r/gripper", gripper.decode_gripper)
+    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))[0] == dt
+    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1e308, 2.0, 0.5), 0.1, 0.0)) is None
+    assert odom(odometry.encode_odometry("robot_0", dt + 1, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0)) is None
+    assert odom(b"\x00\x01\x00\x00") is None and odom(bytes(gate.bounds.sense_bytes + 1)) is None
+    good = np.full(sc.rays, np.inf, np.float32)
+    good[0] = -np.inf
+    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is not None
+    good[1] = np.nan
+    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is None
+    assert seen(resources.encode_resources(dt, [(1.0, 1.0)])) is not None
+    assert seen(resources.encode_resources(dt, [(1.0, float("nan"))])) is None
+    assert grip(gripper.encode_gripper(dt, True)) == (dt, True)
+    assert gate.rejections.counts == {("/r/odom", "out of bounds"): 1, ("/r/odom", "wrong tick"): 1,
+                                      ("/r/odom", "malformed"): 1, ("/r/odom", "too big"): 1,
+                                      ("/r/scan", "out of bounds"): 1, ("/r/resources", "out of bounds"): 1}

@@ -261,3 +261,96 @@ def test_a_dead_controllers_robot_stops_instead_of_driving_on_blind(context, tmp
     moving, after_death = rows[rows[:, 0] <= 0.3], rows[rows[:, 0] >= 0.6]
     assert np.ptp(moving[:, 1:3], axis=0).max() > 0.02  # it drove while its controller answered
     assert np.ptp(after_death[:, 1:3], axis=0).max() < 1e-9  # dead after 3 silent ticks: stopped
+
+
+def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
+    """Issue 25: a 4-byte message on every sense topic, an odometry at x = 1e308, a scan with a
+    NaN and a 19 MB array on the relay topic, between ticks: the controller answers every tick and
+    counts each by reason."""
+    from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+
+    scenario = load_scenario("cpfa", SMALL)
+    node = ControllerNode("robot_0", ControllerConfig(overrides=SMALL), context=context)
+    peer = Node("peer", context=context)
+    received, reports = [], []
+    peer.create_subscription(topics.type_of(topics.CMD_VEL), "/robot_0/cmd_vel",
+                             lambda d: received.append(twist.decode_twist(d)), SENSOR_LOCKSTEP, raw=True)
+    peer.create_subscription(topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS,
+                             lambda d: reports.append(diagnostics.decode_rejections(d)[1]), EVENTS, raw=True)
+    pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
+            for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
+    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.heard(topics.PHEROMONES), EVENTS)
+    peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    executor.add_node(peer)
+    dt = scenario.dt_ns
+    huge = encode_diagnostics(0, [(OK, "PheromoneMessage", "", "", (("stamp_ns", "0"), ("x", "1.0"), ("y", "1.0")))]
+                              * 200_000)
+    try:
+        for _ in range(100):
+            executor.spin_once(timeout_sec=0.02)
+            if all(p.get_subscription_count() for p in pubs.values()) and node.connect():
+                break
+        for k in range(3):
+            stamp = k * dt
+            for pub in pubs.values():
+                pub.publish(b"\x00\x01\x00\x00")
+            pubs[topics.ODOM].publish(odometry.encode_odometry("robot_0", stamp, Pose2D(1e308, 0.0, 0.0), 0.0, 0.0))
+            nan_scan = np.full(scenario.sensors.scan.rays, np.inf, np.float32)
+            nan_scan[0] = np.nan
+            pubs[topics.SCAN].publish(scan.encode_scan("robot_0", stamp, nan_scan, scenario.sensors.scan))
+            laid.publish(huge)
+            for name, data in _observation_bytes(scenario, "robot_0", stamp).items():
+                pubs[name].publish(data)
+            for _ in range(300):
+                executor.spin_once(timeout_sec=0.02)
+                if len(received) > k:
+                    break
+        assert [r[0] for r in received] == [0, dt, 2 * dt]
+        for _ in range(20):
+            executor.spin_once(timeout_sec=0.02)
+        counts = reports[-1]["/robot_0/controller"]
+        for name in pubs:
+            assert counts[(f"/robot_0/{name}", "malformed")] == 3
+        assert counts[("/robot_0/odom", "out of bounds")] == 3 and counts[("/robot_0/scan", "out of bounds")] == 3
+        assert counts[(topics.heard(topics.PHEROMONES), "too big")] == 3
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        peer.destroy_node()
+
+
+def test_a_clock_from_the_future_never_moves_a_server_off_the_schedule(context):
+    """Issue 25: one forged /clock 10^4 s ahead made the depot stop acknowledging the real ticks
+    (the run ended "server depot died"); now it is refused and counted."""
+    from swarm_msgs_py import ack, clock
+    from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig
+
+    config = ServerNodeConfig(scenario="queue_qmt", overrides=("robots.count=2",), startup_timeout=0.1)
+    server = ServerNode("depot", config, context=context)
+    peer = Node("peer", context=context)
+    acks = []
+    clock_pub = peer.create_publisher(topics.type_of(topics.CLOCK), topics.CLOCK, SENSOR_LOCKSTEP)
+    peer.create_subscription(topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK,
+                             lambda d: acks.append(ack.decode_ack(d)[1]), SENSOR_LOCKSTEP, raw=True)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(server)
+    executor.add_node(peer)
+    dt = server.scenario.dt_ns
+    try:
+        server.wait_for_robots(executor)
+        for _ in range(100):
+            executor.spin_once(timeout_sec=0.02)
+            if clock_pub.get_subscription_count() and peer.count_publishers(topics.LOCKSTEP_ACK):
+                break
+        for stamp in (0, 10**13, dt, 3 * dt, 2 * dt):
+            clock_pub.publish(clock.encode_clock(stamp))
+            for _ in range(10):
+                executor.spin_once(timeout_sec=0.02)
+        assert acks == [0, dt, 2 * dt]
+        assert server.endpoint.rejections.counts == {(topics.CLOCK, "wrong tick"): 2}
+    finally:
+        executor.shutdown()
+        server.destroy_node()
+        peer.destroy_node()

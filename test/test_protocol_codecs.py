@@ -23,7 +23,7 @@ from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_msgs_py.records import topic_of
 
 names = st.sampled_from(["robot_0", "robot_7", "robot_111"])
-floats = st.floats(allow_nan=False, allow_infinity=False, width=64)
+floats = st.floats(-1e9, 1e9, allow_nan=False, width=64)  # records.MAX_MAGNITUDE
 ints = st.integers(-(2**31), 2**31)
 text = st.text(st.characters(codec="utf-8", exclude_characters="\x00"), max_size=20)
 stamps = st.integers(0, 2**31 * 10**9 - 1)  # what builtin_interfaces/Time holds
@@ -79,11 +79,12 @@ def _grant_with(**changes) -> bytes:
     (encode_diagnostics(0, [(OK, "Teleport", "", "robot_0", ())]), "Teleport"),
     (_grant_with(cell=None), "DepotGrant.cell: missing"),
     (_grant_with(colour="red"), "DepotGrant.colour: unknown field"),
-    (_grant_with(cell="abc"), "DepotGrant.cell: expected an integer"),
-    (_grant_with(cell="1e3"), "DepotGrant.cell: expected an integer"),
+    (_grant_with(cell="abc"), "DepotGrant.cell: expected a 64-bit integer"),
+    (_grant_with(cell="1e3"), "DepotGrant.cell: expected a 64-bit integer"),
     (_grant_with(last="yes"), "DepotGrant.last: expected true/false"),
     (_grant_with(reason="too tired"), "DepotGrant.reason: 'too tired' is not one of"),
-    (_grant_with(stamp_ns="9" * 60), "DepotGrant.stamp_ns: expected an integer"),
+    (_grant_with(stamp_ns="9" * 60), "DepotGrant.stamp_ns: expected a 64-bit integer"),
+    (_grant_with(stamp_ns="9" * 19), "DepotGrant.stamp_ns: expected a 64-bit integer"),
 ])
 def test_malformed_protocol_messages_are_refused_naming_the_field(data, named):
     with pytest.raises(ValueError, match=named):
@@ -95,6 +96,10 @@ def test_malformed_floats_and_bytes_are_refused():
                                   (("stamp_ns", "1"), ("sender", "robot_0"), ("x", "nan"), ("y", "0.0")))])
     with pytest.raises(ValueError, match="RadioQuery.x: expected a finite number"):
         RADIO.decode(bad)
+    huge = encode_diagnostics(0, [(OK, "RadioQuery", "", "robot_0", (
+        ("stamp_ns", "1"), ("sender", "robot_0"), ("x", "1e308"), ("y", "0.0")))])
+    with pytest.raises(ValueError, match="RadioQuery.x: expected a finite number within"):
+        RADIO.decode(huge)  # squaring it raised OverflowError in the queue behaviour
     with pytest.raises(CodecError):
         DEPOT.decode(b"\x00\x01\x00\x00\x01")
 

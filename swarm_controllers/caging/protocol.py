@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import RobotId
+from swarm_sim.types import Coordinate, RobotId
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,12 +33,12 @@ class Recruitment(_Message):
     C_object and the recruiter's trajectory T_r*."""
 
     TYPE: ClassVar[int] = 0
-    object_x: float
+    object_x: Coordinate
     """C_object when detected [m, world frame]."""
-    object_y: float
-    start_x: float
+    object_y: Coordinate
+    start_x: Coordinate
     """T_r* begins with the recruiter's start p_r*^0 [m, world frame] ..."""
-    start_y: float
+    start_y: Coordinate
     trajectory: tuple[int, ...]
     """... then the indices of the landmarks it reached, in order (`swarm_controllers.caging.landmarks`)."""
 

@@ -6,12 +6,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import ClassVar, Literal
 
 from swarm_sim.scenario import ScenarioError, Section
-
-if TYPE_CHECKING:
-    from swarm_sim.scenario import Scenario
 
 
 CPFA_PARAMETER_SETS: dict[str, dict[str, float]] = {

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from swarm_sim.protocol import ROBOTS
+from swarm_sim.types import Coordinate
 
 
 @dataclass(frozen=True, slots=True)
@@ -17,8 +18,8 @@ class PheromoneMessage:
     """
 
     stamp_ns: int
-    x: float
-    y: float
+    x: Coordinate
+    y: Coordinate
 
     CHANNEL: ClassVar[str] = ROBOTS
     """Every robot hears it (`swarm_sim.protocol.channel_of`)."""

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from swarm_controllers.drtm.config import NestConfig
 from swarm_sim.compare.comparison import Comparison, Headline
@@ -145,7 +144,6 @@ def drtm_table_md(rows: Sequence[dict], conditions: Sequence[int], strategies: S
              "`ours` = this simulator, mean ± sample std (n runs); `paper` = **the paper's numbers** (ARGoS, "
              "50 runs), hard-coded reference data. E_e in %. `same way` says whether DRTM vs ARTM differ in "
              "the paper's direction (better for DRTM: lower V_f, M_T, M_v; higher E_e, F(T)).", ""]
-    better_low = {"food_deviation", "oae_total", "oae_per_robot"}
     for cell in conditions:
         c = DRTM_CONDITIONS[cell]
         lines += [f"## Sec. {c.section}: {c.what} (scenario `{c.scenario}`)", ""]

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import RobotId
+from swarm_sim.types import Coordinate, RobotId
 
 CENTER = "center"
 """The center's channel."""
@@ -29,10 +29,10 @@ class ProgressReport:
     CHANNEL: ClassVar[str] = CENTER
     stamp_ns: int
     robot: RobotId
-    x: float
+    x: Coordinate
     """Sender position when sending [m, world frame]; the center ignores reports from out of
     range."""
-    y: float
+    y: Coordinate
     region: int
     s: float
     done: bool

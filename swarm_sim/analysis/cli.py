@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from pathlib import Path
 
 from swarm_sim import registry
@@ -18,7 +19,7 @@ from swarm_sim.analysis.replay import load_run
 from swarm_sim.analysis.text import summary_lines
 from swarm_sim.analysis.video import render_video
 from swarm_sim.cli import first_paragraph, number
-from swarm_sim.recording import BagError, repair_bag
+from swarm_sim.recording import BagError, BagTruncatedWarning, repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
 
 
@@ -56,6 +57,8 @@ def main(argv: list[str] | None = None) -> int:
     video.add_argument("--start", type=number(float, 0), default=0.0, help="first sim second (default 0)")
     video.add_argument("--end", type=number(float, 0), help="last sim second (default: the end of the run)")
     args = parser.parse_args(argv)
+    # One line per warning (a bag's damage, its malformed messages), no source line of ours.
+    warnings.showwarning = lambda message, *_: print(f"swarm-analyze: warning: {message}", file=sys.stderr)
     if args.video and len(args.bags) != 1:
         parser.error("--video renders one bag")
     status = 0
@@ -64,12 +67,22 @@ def main(argv: list[str] | None = None) -> int:
             bag = find_bag(given)
             if args.repair and repair_bag(bag):
                 print(f"swarm-analyze: {bag}: repaired (its last file was cut off)", file=sys.stderr)
-            trace = load_run(bag)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", BagTruncatedWarning)  # said once below, with what was lost
+                trace = load_run(bag)
         except (BagError, ValueError) as exc:
             print(f"swarm-analyze: {exc}", file=sys.stderr)
             status = 1
             continue
         summary = summarize(trace)
+        if trace.lost:  # the summary is printed still: it is what the bag holds
+            print(f"swarm-analyze: {bag}: the bag lost data, its results are incomplete: {'; '.join(trace.lost)[:500]}",
+                  file=sys.stderr)
+            status = 1
+        if trace.foreign:
+            print(f"swarm-analyze: {bag}: the run is tainted, its results may hold what foreign publishers sent: "
+                  f"{'; '.join(trace.foreign)[:500]}", file=sys.stderr)
+            status = 1
         if not args.no_plot and (plot := plot_run(trace, args.plot or bag / "summary.png")) is not None:
             summary["plot"] = str(plot)
         if args.trajectories:

@@ -57,6 +57,12 @@ class RunTrace:
     messages: list[Any] = field(default_factory=list)
     """The robots' peer messages, in delivery order, for algorithms that ask
     (`swarm_sim.registry.Algorithm.trace_peers`; the caging paper's types 0-4)."""
+    lost: list[str] = field(default_factory=list)
+    """What the bag lost, one line per damaged file (`swarm_sim.recording.BagInfo.lost`); a run
+    whose bag lost data is never ``complete``."""
+    foreign: list[str] = field(default_factory=list)
+    """Publishers seen on the run's topics that were none of its nodes (`swarm_sim.nodes.taint`):
+    the run is tainted, its results may hold what they sent."""
 
 
 def resources_delivered(trace: RunTrace) -> int:
@@ -141,6 +147,8 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "rejected_messages": rejected_messages(trace),
         "dead_nodes": [e.node for e in trace.down],
         "run_ended": trace.ended,
+        "bag_lost": list(trace.lost),
+        "foreign_publishers": list(trace.foreign),
         **_registered_metrics(trace),
     }
 

@@ -3,6 +3,13 @@
 ``load_run(bag) -> RunTrace`` decodes the world's events and counters and the behaviours'
 status messages with the `swarm_msgs_py` codecs; the metric functions of
 `swarm_sim.analysis.metrics` then compute exactly what the batch runner computes.
+
+A bag is untrusted input, and analysis trusts no more than the live graph did: what the run
+refused was recorded apart (`swarm_msgs_py.topics.refused` channels) and is not read; the
+messages of other nodes are checked by the rules the live nodes apply (`swarm_sim.inbound`:
+robots of this run, coordinates within the arena, not stamped after they were recorded), a
+status only counts on its own robot's topic and with counts a run of this length can reach.
+What fails is skipped and counted (``malformed_messages``).
 """
 
 from __future__ import annotations
@@ -19,6 +26,7 @@ from swarm_msgs_py import diagnostics, odometry, topics
 from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
+from swarm_sim.inbound import Bounds, Inbound, Rejections
 from swarm_sim.messaging import delivery_order
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
@@ -56,8 +64,19 @@ def load_run(path: Path | str) -> RunTrace:
     index = {r: i for i, r in enumerate(trace.robots)}
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
     last_clock = 0
+    gate = Inbound(trace.robots, scenario.dt_ns, Rejections(), lambda line: None, Bounds.of(scenario))
+    families = {t: registry.resolve(spec.family) for spec in algorithm.servers
+                for t in registry.resolve(spec.family).topics.values()}
+    trace.foreign = _strings(path, "foreign_publishers", str(meta.get("foreign_publishers", "[]")))
     for m in read_bag(path):
+        if m.topic.endswith("/" + topics.REFUSED):  # what the run refused, recorded apart
+            continue
         try:
+            if m.topic in families or m.topic in peers:  # another node's messages: the live rules
+                gate.now_ns = m.stamp_ns
+                messages = (families.get(m.topic) or peers[m.topic]).decode(m.data)
+                if not all([gate.admit(m.topic, x) for x in messages]):
+                    raise ValueError(f"refused by the live rules: {_last_refusal(gate)}")
             if m.topic.endswith("/" + topics.ODOM):
                 robot = m.topic[1:].partition("/")[0]
                 if robot in index:
@@ -81,6 +100,11 @@ def load_run(path: Path | str) -> RunTrace:
                 trace.stats = diagnostics.decode_robot_stats(m.data)[1]
             elif m.topic.endswith("/" + topics.STATUS):
                 status = diagnostics.decode_status(m.data)
+                if m.topic != topics.robot_topic(status.robot, topics.STATUS) or status.robot not in index:
+                    raise ValueError(f"a status of {status.robot[:40]!r} on {m.topic}")
+                if max(status.obstacle_avoidance_events, status.trips) > scenario.ticks:
+                    raise ValueError(f"counts beyond one a tick ({status.obstacle_avoidance_events} OAE, "
+                                     f"{status.trips} trips in {scenario.ticks} ticks)")
                 trace.status[status.robot] = status
             elif m.topic in state:
                 st = state[m.topic]
@@ -90,7 +114,7 @@ def load_run(path: Path | str) -> RunTrace:
                 trace.messages.extend(peers[m.topic].decode(m.data))
             elif m.topic in server_topics:
                 servers.replay(m.topic, m.data)
-        except ValueError as exc:  # a malformed message on the bus was recorded as sent
+        except (ValueError, ArithmeticError) as exc:  # a malformed message on the bus was recorded as sent
             trace.malformed[m.topic] = trace.malformed.get(m.topic, 0) + 1
             if trace.malformed[m.topic] == 1:
                 warnings.warn(f"{path}: skipping malformed messages on {m.topic}: {exc}", MalformedMessageWarning,
@@ -102,7 +126,27 @@ def load_run(path: Path | str) -> RunTrace:
         trace.ended = "cut off"
         trace.sim_seconds = last_clock / NS_PER_S
     trace.probes = _probes(trace, positions)
+    trace.lost = list(info.lost)
+    if trace.lost and trace.ended == "complete":  # what is missing may be anything: never "complete"
+        trace.ended = "incomplete bag"
     return trace
+
+
+def _last_refusal(gate: Inbound) -> str:
+    where, reason = next(reversed(gate.rejections.details))
+    return f"{reason}: {gate.rejections.details[(where, reason)]}"
+
+
+def _strings(path: Path, key: str, text: str) -> list[str]:
+    """A JSON list of strings in the bag's metadata; anything else is reported and ignored."""
+    try:
+        value = json.loads(text)
+        if isinstance(value, list) and all(isinstance(v, str) for v in value):
+            return value
+    except ValueError:
+        pass
+    warnings.warn(f"{path}: ignoring malformed {key} metadata {text[:80]!r}", MalformedMessageWarning, stacklevel=3)
+    return []
 
 
 def _server_stale(path: Path, text: str) -> dict[str, int]:

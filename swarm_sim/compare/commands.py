@@ -12,7 +12,7 @@ from swarm_sim import compare
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import note_cut_runs
-from swarm_sim.compare.sweep import FAILED, RESULTS, RunFunction, run_sweep
+from swarm_sim.compare.sweep import FAILED, RESULTS, ResultsFileError, RunFunction, run_sweep
 from swarm_sim.executors import Executor, add_executor_arguments
 from swarm_sim.scenario import ScenarioError, load_scenario
 
@@ -78,7 +78,7 @@ def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies:
             old.unlink(missing_ok=True)
     try:
         result = run_sweep(plans, list(range(args.seeds)), path, executor=executor, run=run, resume=args.resume)
-    except FileExistsError as exc:
+    except (FileExistsError, ResultsFileError) as exc:
         print(f"swarm-compare: {exc}", file=sys.stderr)
         return 2, []
     except KeyboardInterrupt:

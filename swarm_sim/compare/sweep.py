@@ -66,12 +66,27 @@ def slim(summary: dict[str, Any]) -> dict[str, Any]:
     return row
 
 
+class ResultsFileError(ValueError):
+    """A results file that is not one of ours (not a regular file, not UTF-8 text)."""
+
+
 def read_results(path: Path) -> list[dict[str, Any]]:
-    """Rows of a results file; a line cut short by an interrupted write is skipped."""
+    """Rows of a results file; a line cut short by an interrupted write is skipped. A file that
+    cannot be ours (a FIFO or directory, not UTF-8 text: we write JSON lines) raises
+    ResultsFileError naming the problem, before anything is appended to it."""
     if not path.exists():
         return []
+    if not path.is_file():
+        raise ResultsFileError(f"{path} is not a regular file; move it away or choose another --out")
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ResultsFileError(f"{path} is not UTF-8 text (byte {exc.start}): not a results file of ours; move it "
+                               "away or use --overwrite") from None
+    except OSError as exc:
+        raise ResultsFileError(f"{path}: cannot read: {exc.strerror}") from None
     rows = []
-    for line in path.read_text().splitlines():
+    for line in text.splitlines():
         if not line.strip():
             continue
         try:

@@ -4,12 +4,16 @@ A robot's controller node and a server node both load the scenario from the same
 (`EndpointConfig`), hear some message families' topics and send on others
 (`swarm_sim.registry.robot_topics` / `server_topics`). `Endpoint` is that plumbing, once:
 
+- the node's guard (`inbound`, a `swarm_sim.inbound.Inbound` with the run's `Bounds`): every
+  subscription of the node, this one's and the node's own (observations, ``/clock``, world
+  events), decodes through it;
 - one subscription per inbound topic, whose messages are decoded and checked
-  (`swarm_sim.inbound.Inbound`: decodable, naming robots of this run, stamped for a tick the node
-  can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
+  (`swarm_sim.inbound.Inbound`: within the size cap, tagged by this run when it has a key
+  (`swarm_msgs_py.auth`) and not a copy of one already taken, decodable, naming robots of this
+  run, coordinates within the arena, stamped for a tick the node can take) and posted to a `swarm_sim.messaging.Mailbox`; `take(k)` releases those stamped
   before tick k in the fixed delivery order, exactly what the batch runner hands the core;
 - one publisher per outbound topic and the topic map (message class -> topic): `send` publishes
-  a core's answers of a tick grouped by topic, one encoded batch per topic;
+  a core's answers of a tick grouped by topic, one encoded batch per topic, tagged;
 - `RejectionReport`: the messages dropped, by the node or by its core, on ``/diagnostics``
   whenever the count grew (the world node reports its own drops the same way).
 
@@ -27,9 +31,9 @@ from typing import Any
 
 from rclpy.node import Node
 
-from swarm_msgs_py import diagnostics, topics
+from swarm_msgs_py import auth, diagnostics, topics
 from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
-from swarm_sim.inbound import Inbound, Rejections, merged, total
+from swarm_sim.inbound import Bounds, Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
 from swarm_sim.scenario import Scenario
 
@@ -44,6 +48,9 @@ class EndpointConfig:
     seed: int = 0
     startup_timeout: float = 60.0
     """Wall seconds to wait for the node's peers on its topics to be matched before going on."""
+    mode: str = "lockstep"
+    """The world's mode (`lockstep` or `realtime`): in lockstep a server takes ``/clock`` ticks
+    strictly one after another (`swarm_sim.nodes.server_node`)."""
 
 
 def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
@@ -52,10 +59,12 @@ def add_endpoint_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a scenario field (repeatable; the value is YAML)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep",
+                        help="lockstep (the world waits for every node each tick) or realtime")
 
 
 def endpoint_config(args: argparse.Namespace) -> EndpointConfig:
-    return EndpointConfig(args.scenario, tuple(args.overrides), args.seed)
+    return EndpointConfig(args.scenario, tuple(args.overrides), args.seed, mode=args.mode)
 
 
 class RejectionReport:
@@ -73,8 +82,8 @@ class RejectionReport:
         theirs = getattr(core, "rejections", None)
         if (dropped := total(self.rejections, theirs)) != self._published:
             self._published = dropped
-            self._pub.publish(diagnostics.encode_rejections(
-                stamp_ns, self._node.get_fully_qualified_name(), merged(self.rejections, theirs)))
+            self._pub.publish(auth.sign(diagnostics.encode_rejections(
+                stamp_ns, self._node.get_fully_qualified_name(), merged(self.rejections, theirs))))
 
 
 class Endpoint:
@@ -85,11 +94,15 @@ class Endpoint:
         self._name = node.get_fully_qualified_name()
         self.mailbox = Mailbox()
         self.rejections = Rejections()
-        self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning)
+        self.inbound = Inbound(scenario.robot_names, scenario.dt_ns, self.rejections, node.get_logger().warning,
+                               Bounds.of(scenario))
+        """The node's guard: every subscription of the node decodes through it."""
+        self.inbound.unique = auth.key() is not None
         self.subscriptions = {
             topic: node.create_subscription(
                 topics.import_type(family.type_name), topic,
-                lambda data, t=topic, f=family: self.inbound.post_all(t, f, data, self.mailbox.post),
+                lambda data, t=topic, f=family, d=auth.verified(family.decode):
+                    self.inbound.post_all(t, f, data, self.mailbox.post, d),
                 EVENTS, raw=True,
             )
             for topic, family in inbound.items()
@@ -103,6 +116,7 @@ class Endpoint:
     def take(self, stamp_ns: int) -> tuple[object, ...]:
         """Tick `stamp_ns` begins: the messages stamped before it, in delivery order."""
         self.inbound.now_ns = self.inbound.released_ns = stamp_ns
+        self.inbound.forget_before(stamp_ns - 2 * self.inbound.dt_ns)
         return self.mailbox.take_before(stamp_ns)
 
     def send(self, stamp_ns: int, messages: Iterable[object]) -> None:
@@ -116,7 +130,7 @@ class Endpoint:
         for topic, group in by_topic.items():
             family, pub = self.publishers[topic]
             for data in family.encode(stamp_ns, group):
-                pub.publish(data)
+                pub.publish(auth.sign(data))
 
     def unmatched(self, peers: int) -> list[str]:
         """Topics with fewer than `peers` nodes on their other end (publishers of what this node

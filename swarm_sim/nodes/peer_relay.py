@@ -2,9 +2,10 @@
 
 Robots never match each other directly (N relays, not N x N matches): each robot publishes its
 peer families' messages (`swarm_sim.registry.peer_topics`) on their topics, and the world
-republishes them on ``heard(topic)``, which every robot hears. A message is recorded as sent,
-checked (`swarm_sim.inbound`: decodable, naming robots of this run, stamped for a tick the
-world can take) and relayed just before the next tick's observations. Lockstep order makes this
+republishes them on ``heard(topic)``, which every robot hears. A message is checked
+(`swarm_sim.inbound`: within the size cap, tagged by this run, decodable, naming robots of this
+run, coordinates within the arena, stamped for a tick the world can take), recorded as sent (on
+the topic's refused channel if it failed, `swarm_msgs_py.topics.refused`) and relayed just before the next tick's observations. Lockstep order makes this
 exact: a robot publishes its messages of tick k before its command k, so they are here before
 the barrier lets tick k+1 out, and they leave before its observations, from the same sender, in
 order.
@@ -14,10 +15,10 @@ from __future__ import annotations
 
 from rclpy.node import Node
 
-from swarm_msgs_py import topics
+from swarm_msgs_py import auth, topics
 from swarm_msgs_py.qos import EVENTS
 from swarm_sim import registry
-from swarm_sim.inbound import Inbound, Reason
+from swarm_sim.inbound import Inbound
 from swarm_sim.nodes.world_recording import WorldRecording
 
 
@@ -38,14 +39,14 @@ class PeerRelay:
                                      EVENTS, raw=True)
 
     def _on_peer(self, topic: str, family, data: bytes) -> None:
-        self._recording.write(topic, data)
-        try:
-            messages = family.decode(data)
-        except ValueError as exc:
-            self._inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
-            return
-        if all([self._inbound.admit(topic, m) for m in messages]):  # a list: every bad one is counted
+        taken = self._take(topic, family, data)
+        self._recording.write_taken(topic, data, taken)
+        if taken:
             self._relayed.append((topic, data))
+
+    def _take(self, topic: str, family, data: bytes) -> bool:
+        messages = self._inbound.decode(topic, auth.verified(family.decode), data, self._inbound.bounds.message_bytes)
+        return messages is not None and all([self._inbound.admit(topic, m) for m in messages])  # a list: all counted
 
     def flush(self, *, send: bool = True) -> None:
         """Relay what robots sent at the last tick (`send=False`: drop it, the run is over)."""

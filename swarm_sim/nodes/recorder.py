@@ -2,7 +2,10 @@
 
 Like ``ros2 bag record -a``: the world writes what it publishes (and the commands and acks it
 receives) as the very bytes on the wire, and `discover` subscribes to every topic other nodes
-publish, recording each message stamped with the sim time at which it arrives. Latched topics
+publish, recording each message stamped with the sim time at which it arrives. A run's topic is
+recorded with the run's own type (and that type's hash in metadata.yaml), whatever a foreign
+publisher announces; what the run refuses goes to the topic's refused channel
+(`swarm_msgs_py.topics.refused`), so analysis reads only what the run took. Latched topics
 (servers' state and markers) are subscribed transient-local, so their last message is recorded
 even if it was published before the recorder subscribed. With a `LiveView` every topic and
 message also goes to the Foxglove clients, as the same bytes.
@@ -10,7 +13,7 @@ message also goes to the Foxglove clients, as the same bytes.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from rclpy.node import Node
@@ -27,8 +30,16 @@ class Recorder:
     `now_ns` gives the sim time to stamp messages with."""
 
     def __init__(self, node: Node, path: Path | None, metadata: dict[str, str], now_ns: Callable[[], int],
-                 live: LiveView | None = None) -> None:
+                 live: LiveView | None = None, types: Mapping[str, str] | None = None,
+                 accept: Callable[[str, bytes], bool | None] | None = None) -> None:
+        """`types`: the run's topics' own types, recorded whatever type a foreign publisher on
+        one announces; `accept(topic, data)`: whether a discovered topic's message is the run's
+        (False: recorded on the topic's refused channel, `swarm_msgs_py.topics.refused`; None:
+        not recorded)."""
         self._node = node
+        self._types = dict(types or {})
+        self._accept = accept
+        self._recorded_types: dict[str, str] = {}
         self._now_ns = now_ns
         self.bag = BagWriter(path, metadata=metadata) if path is not None else None
         self.live = live
@@ -46,12 +57,27 @@ class Recorder:
         self._add(topic, type_name, latched)
 
     def _add(self, topic: str, type_name: str, latched: bool) -> None:
+        self._recorded_types[topic] = type_name
         if latched:
             self._latched.add(topic)
         if self.bag is not None:
             self.bag.add_topic(topic, type_name, "latched" if latched else "reliable")
         if self.live is not None:
             self.live.add(topic, type_name, latched)
+
+    def write_refused(self, topic: str, data: bytes) -> None:
+        """A message the run refused on `topic`, on its refused channel (same type)."""
+        channel = topics.refused(topic)
+        if channel not in self._recorded_types:
+            self._add(channel, self._recorded_types.get(topic) or self._types.get(topic, ""), False)
+        self.write(channel, data)
+
+    def _discovered(self, topic: str, data: bytes) -> None:
+        verdict = True if self._accept is None else self._accept(topic, data)
+        if verdict:
+            self.write(topic, data)
+        elif verdict is not None:  # None: not to be recorded at all
+            self.write_refused(topic, data)
 
     def write(self, topic: str, data: bytes) -> None:
         now = self._now_ns()
@@ -68,16 +94,17 @@ class Recorder:
                 continue
             self.known.add(topic)
             on_new(topic)
-            msg_type = topics.import_type(types[0])
+            type_name = self._types.get(topic, types[0])  # ours, whatever a foreign publisher says
+            msg_type = topics.import_type(type_name)
             if msg_type is None:
                 continue
             latched = any(
                 info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
                 for info in node.get_publishers_info_by_topic(topic)
             )
-            self._add(topic, types[0], latched)
+            self._add(topic, type_name, latched)
             node.create_subscription(
-                msg_type, topic, lambda data, t=topic: self.write(t, data),
+                msg_type, topic, lambda data, t=topic: self._discovered(t, data),
                 RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
@@ -92,6 +119,8 @@ class Recorder:
                 infos = self._node.get_publishers_info_by_topic(topic)
             except Exception:  # noqa: BLE001 - the graph is gone (shutdown): keep the defaults
                 return
+            recorded = self._recorded_types.get(topic)
+            infos = [i for i in infos if i.topic_type == recorded]  # a foreign type's publisher is not the topic's
             if not infos:
                 continue
             depth = published_depth(topic, topic in self._latched)

@@ -10,8 +10,10 @@ On each ``/clock`` tick k the node hands the core the messages stamped before k,
 core's answers stamped k (one DiagnosticArray per topic), then the core's state values that
 changed and, when due, its markers, and acknowledges tick k on ``/lockstep/ack`` so the world's
 lockstep barrier knows the answers are out. A repeated tick (the world re-sends ``/clock`` when
-an ack is late) is only acknowledged again. This is exactly what the batch runner does in
-process, so graph and batch runs agree.
+an ack is late) is only acknowledged again; in lockstep a tick other than the next one (a forged
+``/clock`` from the future) is refused and counted, so nothing on the bus moves the server off
+the run's schedule. This is exactly what the batch runner does in process, so graph and batch
+runs agree.
 
 Inbound messages are untrusted (`swarm_sim.inbound`); what is dropped, here or by the core, is
 counted on ``/diagnostics``. The node also hears the world's ``node_down`` events and, at the
@@ -33,7 +35,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, diagnostics, markers, topics
+from swarm_msgs_py import ack, auth, diagnostics, markers, topics
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
@@ -46,6 +48,9 @@ from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_argu
 from swarm_sim.protocol import Drawing, Lines, Server
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import NS_PER_S, NodeDownEvent
+
+CLOCK_BYTES = 64
+"""Cap on a ``/clock`` message [bytes] (ours are 12)."""
 
 ServerNodeConfig = EndpointConfig
 """A server node's parameters: scenario, overrides, seed and how long it waits for the robots."""
@@ -77,6 +82,7 @@ class ServerNode(Node):
         self.lost: list[str] = []
         """Robots the world declared dead, not yet told to the core."""
         self._done = -1
+        self._decode_events = auth.verified(diagnostics.decode_events)
         self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK, self._on_clock,
                                  SENSOR_LOCKSTEP, raw=True)
         self.create_subscription(topics.type_of(topics.WORLD_EVENTS), topics.WORLD_EVENTS, self._on_world_events,
@@ -109,12 +115,10 @@ class ServerNode(Node):
 
     def _on_world_events(self, data: bytes) -> None:
         inbound = self.endpoint.inbound
-        try:
-            _, events = diagnostics.decode_events(data)
-        except ValueError as exc:
-            inbound.reject(topics.WORLD_EVENTS, Reason.MALFORMED, str(exc)[:200])
+        decoded = inbound.decode(topics.WORLD_EVENTS, self._decode_events, data, inbound.bounds.message_bytes)
+        if decoded is None:
             return
-        for e in events:
+        for e in decoded[1]:
             if isinstance(e, NodeDownEvent) and e.kind == "robot":
                 if e.node in inbound.robots:
                     self.lost.append(e.node)
@@ -124,12 +128,14 @@ class ServerNode(Node):
     def _on_clock(self, data: bytes) -> None:
         if self._ack_pub is None:
             return
-        try:
-            stamp = clock_codec.decode_clock(data)
-        except ValueError as exc:
-            self.endpoint.inbound.reject(topics.CLOCK, Reason.MALFORMED, str(exc)[:200])
+        inbound = self.endpoint.inbound
+        stamp = inbound.decode(topics.CLOCK, clock_codec.decode_clock, data, CLOCK_BYTES)
+        if stamp is None:
             return
         if stamp > self._done:
+            if not self._on_schedule(stamp):
+                inbound.reject(topics.CLOCK, Reason.WRONG_TICK, f"tick {stamp} ns after tick {self._done} ns")
+                return
             messages = self.endpoint.take(stamp)
             for robot in self.lost:
                 if hasattr(self.server, "robot_lost"):
@@ -141,7 +147,18 @@ class ServerNode(Node):
             self.endpoint.report.publish(stamp, self.server)
             self._done = stamp
         if stamp == self._done:
-            self._ack_pub.publish(ack.encode_ack(self.spec.channel, stamp))
+            self._ack_pub.publish(auth.sign(ack.encode_ack(self.spec.channel, stamp)))
+
+    def _on_schedule(self, stamp: int) -> bool:
+        """Whether tick `stamp` (after the last one done) is the run's next: in lockstep exactly
+        the tick after the last (the world never publishes tick k+1 before this node acknowledged
+        k or it was declared stale, and re-sends k until then), so a forged ``/clock`` from the
+        future is refused and the node stays on the run's schedule; free-running, any later
+        tick of the run (a lost sample is not re-sent)."""
+        b = self.endpoint.inbound.bounds
+        if self.config.mode == "lockstep":
+            return stamp == (0 if self._done < 0 else self._done + b.dt_ns)
+        return stamp <= b.end_ns and stamp % b.dt_ns == 0
 
     def _publish_state(self, stamp_ns: int) -> None:
         """The state values that changed, then the markers if they are due."""
@@ -149,7 +166,7 @@ class ServerNode(Node):
             return
         changed = self._state.changed(self.server.state())
         for st, value in changed:
-            self._state_pubs[st.topic].publish(st.encode(stamp_ns, value))
+            self._state_pubs[st.topic].publish(auth.sign_if(st.type_name, st.encode(stamp_ns, value)))
         period = self._markers.period if self._markers is not None else None
         if changed and period is not None and (self._markers_at < 0 or stamp_ns - self._markers_at >= period * NS_PER_S):
             self._draw(stamp_ns)
@@ -170,6 +187,7 @@ def parse_args(argv: list[str]) -> tuple[str, ServerNodeConfig, list[str]]:
 def main(argv: list[str] | None = None) -> int:
     """One server node in its own process, spun until shut down."""
     channel, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-server", *ros_args])
     node = None
     try:

@@ -90,9 +90,12 @@ class WorldLoop:
               flush=True)
         deadline = start + node.config.startup_timeout
         missing = list(robots)
-        said = start
+        said = checked = start
         while missing and time.monotonic() < deadline:
             self.spin(executor, 0.1)
+            if time.monotonic() - checked >= 1.0:
+                checked = time.monotonic()
+                node.check_foreign()
             missing = node.unconnected()
             if missing and time.monotonic() - said >= node.config.progress_period:
                 said = time.monotonic()

@@ -16,6 +16,11 @@ itself: its observation publishers, its intake of commands and acks, and its com
 
 Observations (and the task's state topics, e.g. the caging object's pose) are encoded straight
 to CDR bytes, published raw and written to the bag as the same bytes.
+
+What it hears is untrusted (`swarm_sim.inbound`): commands, acks (which must carry the run's tag,
+`swarm_msgs_py.auth`) and robots' messages pass its guard, and what it refuses is recorded on the
+topic's refused channel. It watches the graph for foreign publishers on the run's topics
+(`swarm_sim.nodes.taint`), and starts only once every server's own node acknowledges.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
+from swarm_msgs_py import auth
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
@@ -41,16 +47,25 @@ from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph, number
-from swarm_sim.inbound import Inbound, Reason, Rejections
+from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.status_watch import StatusWatch
+from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
+
+
+COMMAND_BYTES = 512
+"""Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""
+ACK_BYTES = 256
+"""Cap on a ``/lockstep/ack`` message [bytes]."""
+_DECODE_ACK = auth.verified(ack_codec.decode_ack)
+"""An ack must carry the run's tag when the run has a key (`swarm_msgs_py.auth`)."""
 
 
 @dataclass(frozen=True)
@@ -101,7 +116,13 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns)
+        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self.count_publishers)
+        """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
+        self.foreign: list[str] = []
+        """The foreign publishers found whose messages may have reached a core: the run is tainted."""
+        self.recording = WorldRecording(self, cfg, self.scenario, len(self.robots), lambda: self.world.t_ns,
+                                        {t: spec.type_name for t, spec in self.watch.topics.items()},
+                                        self._ours)
         self.recorder = self.recording.recorder
         """The bag (and live view) writer; None when the run records nothing."""
         self.rejections = Rejections()
@@ -144,6 +165,7 @@ class WorldNode(Node):
         """How the run ended: ``complete``, ``finished`` (``sim.stop_when_finished``), ``interrupted``
         or ``server <channel> died``."""
         self._cmd_topic = {topics.robot_topic(r, topics.CMD_VEL): r for r in self.robots}
+        self._topic_of_cmd = {r: t for t, r in self._cmd_topic.items()}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
             self.recording.add(topic, topics.type_string(topic))
@@ -157,7 +179,9 @@ class WorldNode(Node):
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
-        self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning)
+        self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning,
+                               Bounds.of(self.scenario))
+        """The world's guard: commands, acks and robots' messages decode through it."""
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
         self.statuses = StatusWatch(self, self.robots, self.inbound, self.recording, self.scenario.dt_ns)
         self._progress = registry.resolve(algorithm.progress) if algorithm.progress else None
@@ -175,16 +199,33 @@ class WorldNode(Node):
     @property
     def rejected_commands(self) -> int:
         """Commands dropped so far (any reason)."""
-        return sum(n for (where, _), n in self.rejections.counts.items() if where.endswith("/" + topics.CMD_VEL))
+        return sum(n for (where, reason), n in self.rejections.counts.items()
+                   if where.endswith("/" + topics.CMD_VEL) and reason != Reason.FOREIGN.value)
+
+    def _ours(self, topic: str, data: bytes) -> bool | None:
+        """Whether a message the recorder found on a run's `topic` is the run's: with the run's tag
+        where its messages carry one (`swarm_msgs_py.auth`; False: it is recorded apart); None
+        (not recorded, counted ``too big``) if it is longer than any the run sends."""
+        spec = self.watch.topics.get(topic)
+        if spec is None:
+            return True
+        if len(data) > self.inbound.bounds.message_bytes:
+            self.inbound.reject(topic, Reason.TOO_BIG, f"{len(data)} bytes, not recorded")
+            return None
+        return not spec.tagged or auth.verify(data) is not None
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        topic = topics.robot_topic(robot, topics.CMD_VEL)
-        self.recording.write(topic, data)
-        try:
-            stamp_ns, linear, angular = twist.decode_twist(data)
-        except ValueError as exc:
-            self.inbound.reject(topic, Reason.MALFORMED, str(exc))
+        refused = self.rejections.total
+        self._take_cmd(robot, data)
+        topic = self._topic_of_cmd[robot]
+        self.recording.write_taken(topic, data, self.rejections.total == refused)
+
+    def _take_cmd(self, robot: RobotId, data: bytes) -> None:
+        topic = self._topic_of_cmd[robot]
+        decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
+        if decoded is None:
             return
+        stamp_ns, linear, angular = decoded
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return
@@ -202,16 +243,22 @@ class WorldNode(Node):
         self.barrier.answered(robot, stamp_ns)
 
     def _on_ack(self, data: bytes) -> None:
-        self.recording.write(topics.LOCKSTEP_ACK, data)
-        try:
-            channel, stamp_ns = ack_codec.decode_ack(data)
-        except ValueError as exc:
-            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.MALFORMED, str(exc))
+        refused = self.rejections.total
+        self._take_ack(data)
+        self.recording.write_taken(topics.LOCKSTEP_ACK, data, self.rejections.total == refused)
+
+    def _take_ack(self, data: bytes) -> None:
+        decoded = self.inbound.decode(topics.LOCKSTEP_ACK, _DECODE_ACK, data, ACK_BYTES)
+        if decoded is None:
             return
+        channel, stamp_ns = decoded
         if channel not in self.servers:
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.UNKNOWN_NODE, f"no server {channel[:40]!r} in this run")
         elif channel in self.barrier.dead:
             self.inbound.reject(topics.LOCKSTEP_ACK, Reason.DEAD, f"server {channel} was declared dead")
+        elif stamp_ns > self.world.t_ns:  # no server can have finished a tick not yet published
+            self.inbound.reject(topics.LOCKSTEP_ACK, Reason.WRONG_TICK,
+                                f"ack of tick {stamp_ns} ns at tick {self.world.t_ns} ns")
         elif stamp_ns < self.world.t_ns:
             self.barrier.heard(channel)  # an ack for a tick already closed: slow, not dead
         else:
@@ -263,8 +310,24 @@ class WorldNode(Node):
     # ------------------------------------------------------------------ discovery
 
     def discover(self) -> None:
-        """Record every topic other nodes publish (and warn about unknown robot namespaces)."""
+        """Record every topic other nodes publish (and warn about unknown robot namespaces), and
+        look for foreign publishers on the run's topics."""
         self.recording.discover(self._warn_unknown_commands)
+        self.check_foreign()
+
+    def check_foreign(self) -> None:
+        """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
+        line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
+        (an untagged topic) taints the run."""
+        for f in self.watch.check():
+            self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
+            if f.tainting:
+                self.foreign.append(str(f))
+                self.get_logger().error(f"a foreign publisher, {f}: none of this run's nodes; what it sends may "
+                                        "reach the robots, so the run is tainted (swarm-run exits 6)")
+            else:
+                self.get_logger().error(f"a foreign publisher, {f}: none of this run's nodes; its messages lack "
+                                        "the run's tag and are refused")
 
     def _warn_unknown_commands(self, topic: str) -> None:
         if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
@@ -278,8 +341,11 @@ class WorldNode(Node):
             if self._cmd_subs[r].get_publisher_count() == 0
             or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
         ]
-        if self.servers and self._ack_sub.get_publisher_count() < len(self.servers):
-            missing.append("servers (" + ", ".join(self.servers) + ")")
+        if self.servers:  # by their nodes' names: a foreign ack publisher must not stand in for one
+            ready = self.watch.ready(topics.LOCKSTEP_ACK)
+            waiting = [spec.node_name for spec in registry.of(self.scenario).servers if spec.node_name not in ready]
+            if waiting:
+                missing.append("servers (" + ", ".join(waiting) + ")")
         return missing
 
     # ------------------------------------------------------------------ publishing
@@ -332,6 +398,7 @@ class WorldNode(Node):
             server_stale_ticks=json.dumps(self.server_stale_ticks),
             ended=self.ended,
             dead_nodes=json.dumps([e.node for e in self.down]),
+            foreign_publishers=json.dumps(self.foreign),
         )
         self.world.close()
 
@@ -370,6 +437,7 @@ def main(argv: list[str] | None = None) -> int:
     # Our own signal handling: rclpy's handler shuts the context down under the running loop,
     # which then waited out tick timeouts instead of stopping. A flag checked at every spin
     # stops the run promptly wherever it is.
+    auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 from rclpy.node import Node
 
-from swarm_msgs_py import diagnostics, markers, topics
+from swarm_msgs_py import auth, diagnostics, markers, topics
 from swarm_msgs_py.qos import EVENTS, STATE_LATCHED
 from swarm_sim.inbound import Rejections
 from swarm_sim.nodes.endpoint import RejectionReport
@@ -46,9 +46,9 @@ class WorldOutputs:
         t_ns, publish = world.t_ns, self._recording.publish
         events = [*events, *world.drain_events()]
         if events:
-            publish(self._events_pub, diagnostics.encode_events(t_ns, events), topics.WORLD_EVENTS)
+            publish(self._events_pub, auth.sign(diagnostics.encode_events(t_ns, events)), topics.WORLD_EVENTS)
         if final or world.tick % self._stats_every == 0:
-            publish(self._stats_pub, diagnostics.encode_robot_stats(t_ns, world.stats), topics.WORLD_ROBOT_STATS)
+            publish(self._stats_pub, auth.sign(diagnostics.encode_robot_stats(t_ns, world.stats)), topics.WORLD_ROBOT_STATS)
         if final or world.tick % self._markers_every == 0:
             data = markers.encode_markers(self._scenario, t_ns, world.task.placed(), world.true_poses())
             publish(self._markers_pub, data, topics.WORLD_MARKERS)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from rclpy.node import Node
@@ -28,7 +28,11 @@ class WorldRecording:
     """The recorder of a world node (None: nothing recorded), from its config's ``bag`` and
     ``foxglove_port``; `now_ns` gives the sim time to stamp messages with."""
 
-    def __init__(self, node: Node, config, scenario: Scenario, robots: int, now_ns: Callable[[], int]) -> None:
+    def __init__(self, node: Node, config, scenario: Scenario, robots: int, now_ns: Callable[[], int],
+                 types: Mapping[str, str] | None = None,
+                 accept: Callable[[str, bytes], bool | None] | None = None) -> None:
+        """`types`, `accept`: the run's topics' own types and the check of a discovered topic's
+        messages (`swarm_sim.nodes.recorder.Recorder`)."""
         self._node = node
         self.recorder: Recorder | None = None
         if config.bag or config.foxglove_port >= 0:
@@ -40,7 +44,7 @@ class WorldRecording:
                 "robots": str(robots),
             }
             live = _live_view(config.foxglove_host, config.foxglove_port)
-            self.recorder = Recorder(node, Path(config.bag) if config.bag else None, meta, now_ns, live)
+            self.recorder = Recorder(node, Path(config.bag) if config.bag else None, meta, now_ns, live, types, accept)
 
     def publisher(self, topic: str, qos, type_name: str | None = None):
         """A publisher of the world's, on a recorded topic."""
@@ -61,6 +65,15 @@ class WorldRecording:
     def write(self, topic: str, data: bytes) -> None:
         if self.recorder is not None:
             self.recorder.write(topic, data)
+
+    def write_taken(self, topic: str, data: bytes, taken: bool) -> None:
+        """A message the world received: on `topic` if it took it, else on the topic's refused
+        channel (analysis reads what the run took, `swarm_msgs_py.topics.refused`)."""
+        if self.recorder is not None:
+            if taken:
+                self.recorder.write(topic, data)
+            else:
+                self.recorder.write_refused(topic, data)
 
     def publish(self, pub, data: bytes, topic: str, *, send: bool = True) -> None:
         """Publish `data` (unless not `send`) and record it."""

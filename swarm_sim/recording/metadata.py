@@ -96,6 +96,9 @@ class BagInfo:
     """First log time [ns, sim time]; 0 for an empty bag."""
     end_ns: int
     """Last log time [ns, sim time]; 0 for an empty bag."""
+    lost: tuple[str, ...] = ()
+    """What the bag lost, one line per damaged file: cut off mid-write, or fewer messages readable
+    than metadata.yaml lists (empty: every message written is there)."""
 
     @property
     def message_counts(self) -> dict[str, int]:

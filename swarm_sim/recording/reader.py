@@ -21,6 +21,7 @@ from swarm_sim.recording.mcap_file import _McapFile
 from swarm_sim.recording.metadata import (
     METADATA_FILE,
     BagError,
+    BagFileInfo,
     BagInfo,
     BagMessage,
     TopicInfo,
@@ -39,8 +40,12 @@ def _bag_files(path: Path) -> tuple[Path, list[Path], dict[str, Any] | None]:
             return path, [path], None
         else:
             raise BagError(f"{path}: not a bag (expected a rosbag2 directory or an .mcap file)")
-    meta = _load_metadata(path / METADATA_FILE) if (path / METADATA_FILE).exists() else None
+    meta_path = path / METADATA_FILE
+    meta = _load_metadata(meta_path) if meta_path.exists() or meta_path.is_symlink() else None
     found = sorted(path.glob("*.mcap"), key=_file_order)
+    odd = [p.name for p in found if not p.is_file()]
+    if odd:  # a FIFO would block the reader forever
+        raise BagError(f"{path}: {odd[0]} is not a regular file")
     if meta is None:
         if not found:
             raise BagError(f"{path}: not a bag (no {METADATA_FILE} and no .mcap files)")
@@ -53,12 +58,20 @@ def _bag_files(path: Path) -> tuple[Path, list[Path], dict[str, Any] | None]:
     return path, listed + [p for p in found if p not in listed], meta
 
 
+MAX_METADATA_BYTES = 64 << 20
+"""metadata.yaml larger than this is refused unread (a 1000-topic bag's is under 2 MB)."""
+
+
 def _file_order(p: Path) -> tuple[int, str]:
     m = re.search(r"_(\d+)\.mcap$", p.name)
     return (int(m.group(1)) if m else -1, p.name)
 
 
 def _load_metadata(path: Path) -> dict[str, Any]:
+    if not path.is_file():  # a FIFO would block the read forever; a directory, a dangling link
+        raise BagError(f"{path}: not a regular file")
+    if path.stat().st_size > MAX_METADATA_BYTES:
+        raise BagError(f"{path}: {path.stat().st_size} bytes is larger than a bag's metadata can be")
     try:
         doc = _load_yaml(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
@@ -146,6 +159,7 @@ def bag_info(path: Path | str) -> BagInfo:
             custom.update(f.custom_metadata())
     used = [i for i in infos if i.message_count]
     return BagInfo(
+        lost=_lost(files, infos, meta),
         path=root,
         topics={n: TopicInfo(n, t, c) for n, (t, c) in sorted(topics.items())},
         metadata=custom,
@@ -156,3 +170,21 @@ def bag_info(path: Path | str) -> BagInfo:
         end_ns=max((i.end_ns for i in used), default=0),
     )
 
+
+
+def _lost(files: list[_McapFile], infos: tuple[BagFileInfo, ...], meta: dict[str, Any] | None) -> tuple[str, ...]:
+    """What a bag lost, one line per file: cut off (no footer: the complete records before the cut
+    were read), or holding fewer messages than metadata.yaml says it was written with."""
+    listed: dict[str, int] = {}
+    for entry in (meta or {}).get("files") or []:
+        if isinstance(entry, dict) and isinstance(entry.get("message_count"), int):
+            listed[PurePath(str(entry.get("path", ""))).name] = entry["message_count"]
+    out = []
+    for f, info in zip(files, infos):
+        expected = listed.get(f.path.name)
+        if expected is not None and info.message_count < expected:
+            out.append(f"{f.path.name}: {info.message_count} of the {expected} messages metadata.yaml lists are readable"
+                       + (f" ({f.problem})" if f.problem else ""))
+        elif f.problem is not None:
+            out.append(f"{f.path.name}: {f.problem}")
+    return tuple(out)

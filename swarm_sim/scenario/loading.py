@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import sys
 import types
 import typing
 from collections.abc import Callable, Iterable
@@ -31,6 +32,11 @@ from swarm_sim.scenario.validation import validate
 
 MAX_FILE_BYTES = 1 << 20
 """A scenario file larger than this is refused (ours are ~1 KB)."""
+MAX_MAGNITUDE = 1e9
+"""The largest magnitude a scenario float may have: sizes [m], times [s], speeds, all far below
+(a 1e300 speed was accepted silently)."""
+MAX_INT = 2**63 - 1
+"""The largest magnitude of a scenario int (a seed, a count): what numpy and the codecs hold."""
 
 
 def _type_name(tp: Any) -> str:
@@ -38,6 +44,21 @@ def _type_name(tp: Any) -> str:
 
 
 _FLOAT_TEXT = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def _short(value: Any) -> str:
+    """`value` for an error line: its repr cut to 40 characters (an int's of up to 4300 digits)."""
+    text = repr(value) if not isinstance(value, int) or abs(value) < 10**40 else f"an integer of {len(str(value))} digits"
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _unreadable(exc: BaseException) -> str:
+    """Why PyYAML could not build a value (its constructors raise plain ValueErrors)."""
+    if isinstance(exc, RecursionError):
+        return "nested too deeply"
+    if "integer string conversion" in str(exc):
+        return f"an integer of more than {sys.get_int_max_str_digits()} digits"
+    return str(exc)[:80]
 
 
 def _convert(value: Any, tp: Any, key: str) -> Any:
@@ -80,12 +101,14 @@ def _convert(value: Any, tp: Any, key: str) -> Any:
             value = float(value)  # YAML 1.1 reads 1e30 (no dot) as a string
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ScenarioError(f"{key}: expected a number, got {value!r}")
-        if not math.isfinite(value):
-            raise ScenarioError(f"{key}: expected a finite number, got {value!r}")
+        if not math.isfinite(value) or abs(value) > MAX_MAGNITUDE:
+            raise ScenarioError(f"{key}: expected a finite number within +-{MAX_MAGNITUDE:g}, got {_short(value)}")
         return float(value)
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ScenarioError(f"{key}: expected int, got {value!r}")
+            raise ScenarioError(f"{key}: expected int, got {_short(value)}")
+        if abs(value) > MAX_INT:
+            raise ScenarioError(f"{key}: expected an integer within +-(2**63 - 1), got {_short(value)}")
         return value
     if tp is bool:
         if not isinstance(value, bool):
@@ -161,7 +184,9 @@ def parse_override(text: str) -> tuple[str, Any]:
     try:
         return key.strip(), yaml.safe_load(raw)
     except yaml.YAMLError as exc:
-        raise ScenarioError(f"--set {key}: cannot parse value {raw!r}: {exc}") from None
+        raise ScenarioError(f"--set {key}: cannot parse value {raw[:40]!r}: {' '.join(str(exc).split())}") from None
+    except (ValueError, RecursionError) as exc:  # an int of more than 4300 digits; nesting
+        raise ScenarioError(f"--set {key}: cannot parse value {raw[:40]!r}: {_unreadable(exc)}") from None
 
 
 def resolve_path(name_or_path: str) -> Path:
@@ -237,6 +262,8 @@ def read_yaml(path: Path) -> dict[str, Any]:
         raise ScenarioError(f"{path}: not valid YAML: {' '.join(str(exc).split())}") from None
     except RecursionError:
         raise ScenarioError(f"{path}: nested too deeply") from None
+    except ValueError as exc:  # an int of more than 4300 digits (Python's conversion limit)
+        raise ScenarioError(f"{path}: {_unreadable(exc)}") from None
     if data is None:
         raise ScenarioError(f"{path}: the file is empty")
     if not isinstance(data, dict):

@@ -9,6 +9,7 @@ on every scenario it builds.
 from __future__ import annotations
 
 import math
+import re
 
 from swarm_sim import registry
 from swarm_sim.scenario.schema import Scenario, ScenarioError
@@ -23,6 +24,15 @@ MIN_DT, MAX_DT = 1e-3, 10.0
 would make a one-second run a billion ticks), and a tick longer than 10 s is not control."""
 MAX_SUBSTEPS = 1000
 """pybullet steps per tick."""
+MAX_ROBOTS = 10_000
+MAX_RESOURCES = 1_000_000
+MAX_LINEAR_SPEED = 10.0
+"""[m/s]: the papers' robots drive 0.05-0.34 m/s; faster is a typo (a 1e300 speed was accepted)."""
+MAX_ANGULAR_SPEED = 100.0
+"""[rad/s]."""
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]{0,99}")
+"""A scenario's name: it names bag directories, so no path separators and no leading dot (a
+``name: ../../x`` put the bag outside ``--out``)."""
 
 
 def _require(condition: bool, message: str) -> None:
@@ -60,6 +70,8 @@ def check_world(s: Scenario) -> None:
     _require(s.sim.duration >= s.sim.dt, "sim.duration: must be at least one tick (sim.dt)")
     _require(s.sim.duration <= MAX_DURATION, f"sim.duration: at most {MAX_DURATION:g} s of sim time")
     _require(s.seed >= 0, "seed: must not be negative")
+    _require(s.name == "" or NAME.fullmatch(s.name) is not None,
+             f"name: {s.name[:40]!r} is not a plain name (letters, digits, _ . + -; it names the bag directory)")
     _require(s.arena.size > 0, "arena.size: must be positive")
     half = s.arena.size / 2
     _require(
@@ -67,10 +79,12 @@ def check_world(s: Scenario) -> None:
         f"depot: a disc of radius {s.depot.radius} m at {s.depot.center} is outside the arena",
     )
     r = s.robots
-    _require(r.count >= 1, "robots.count: need at least one robot")
+    _require(1 <= r.count <= MAX_ROBOTS, f"robots.count: need 1 to {MAX_ROBOTS} robots")
     _require(r.diameter > 0, "robots.diameter: must be positive")
-    _require(r.max_linear_speed > 0, "robots.max_linear_speed: must be positive")
-    _require(r.max_angular_speed > 0, "robots.max_angular_speed: must be positive")
+    _require(0 < r.max_linear_speed <= MAX_LINEAR_SPEED,
+             f"robots.max_linear_speed: must be positive and at most {MAX_LINEAR_SPEED:g} m/s")
+    _require(0 < r.max_angular_speed <= MAX_ANGULAR_SPEED,
+             f"robots.max_angular_speed: must be positive and at most {MAX_ANGULAR_SPEED:g} rad/s")
     _require(r.mass > 0, "robots.mass: must be positive")
     _require(
         r.start_spacing >= r.diameter,
@@ -121,7 +135,7 @@ def check_world(s: Scenario) -> None:
     _require(0 <= s.sensors.proximity_ring.ahead <= 180, "sensors.proximity_ring.ahead: must be in [0, 180] deg")
     _require(s.sensors.position_range > 0, "sensors.position_range: must be positive")
     res = s.resources
-    _require(res.count >= 0, "resources.count: must not be negative")
+    _require(0 <= res.count <= MAX_RESOURCES, f"resources.count: must be 0 to {MAX_RESOURCES}")
     _require(res.spacing > 0, "resources.spacing: must be positive")
     _require(res.margin >= 0, "resources.margin: must not be negative")
     if res.distribution == "clustered":

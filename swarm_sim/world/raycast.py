@@ -49,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from swarm_sim.scenario import ScanConfig, Scenario
-from swarm_sim.world.bullet import pybullet as p
+from swarm_sim.world.bullet import pybullet
 from swarm_sim.world.jit import inline, kernel
 from swarm_sim.world.pairs import RobotPairs, pairs_in_reach
 
@@ -473,7 +473,7 @@ def cast_scan_pybullet(
     ray_to = np.hstack([o + config.range_max * u, zs])
     fraction = np.empty(len(u))
     for lo in range(0, len(u), PYBULLET_BATCH):
-        hits = p.rayTestBatch(
+        hits = pybullet.rayTestBatch(
             ray_from[lo : lo + PYBULLET_BATCH].tolist(),
             ray_to[lo : lo + PYBULLET_BATCH].tolist(),
             numThreads=num_threads,

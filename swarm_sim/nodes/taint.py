@@ -1,0 +1,175 @@
+"""Who may publish on a run's topics, and the world's watch for anyone else (a foreign publisher).
+
+A run knows its own nodes from the start: the world, one controller per robot (node
+``controller`` in the robot's namespace), one node per registered server (`ServerSpec.node_name`).
+`run_topics` lists every topic of the run with its type (from our own types, whatever else a
+foreign publisher announces) and the nodes that publish it.
+
+Our own messages carry the run's tag (`swarm_msgs_py.auth`), so on those topics a foreign
+publisher's messages are refused and counted where they arrive. Observations, commands, ``/clock``
+and the task's state topics are standard types that cannot carry a tag: there only the graph can
+tell. `ForeignWatch` asks it (the world is the discovery server and sees every endpoint of the
+run): a publisher on a run's topic whose node is none of the topic's publishers, or one more than
+the topic has, is foreign. The world reports each at once (an error line, a ``foreign publisher``
+count on ``/diagnostics``) and the run is *tainted* (``foreign_publishers`` in the bag's metadata
+and the summary, `swarm-run` exit 6) when the topic carries no tag or the run has no key: what it
+sent may have reached a core. The run goes on to its end either way, so its bag holds everything.
+
+rclpy (Jazzy) hands a subscription no publisher GID with a message, so a message cannot be
+traced to its publisher; the graph names publishers (node, namespace, GID) but learns a node's
+name a little after its endpoints (``_NODE_NAME_UNKNOWN_`` meanwhile): such a publisher is
+judged by the count alone until its name is known.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from swarm_msgs_py import auth, topics
+from swarm_msgs_py.server_outputs import MARKER_ARRAY, outputs_of
+from swarm_sim import registry
+from swarm_sim.scenario import Scenario
+
+WORLD = ("/", "world")
+CONTROLLER = "controller"
+UNKNOWN = "_NODE_NAME_UNKNOWN_"
+"""The node name the graph gives an endpoint whose node it has not heard of yet."""
+
+
+@dataclass
+class RunTopic:
+    type_name: str
+    publishers: set[tuple[str, str]] = field(default_factory=set)
+    """(namespace, node name) of every node of the run that publishes it."""
+
+    @property
+    def tagged(self) -> bool:
+        """Whether its messages carry the run's tag (`swarm_msgs_py.auth`)."""
+        return self.type_name in auth.SIGNED_TYPES
+
+
+def run_topics(scenario: Scenario) -> dict[str, RunTopic]:
+    """Every topic of a run: its type and the run's nodes that publish it."""
+    out: dict[str, RunTopic] = {}
+
+    def add(topic: str, type_name: str, node: tuple[str, str]) -> None:
+        out.setdefault(topic, RunTopic(type_name)).publishers.add(node)
+
+    algorithm = registry.of(scenario)
+    task = registry.task(algorithm.task)
+    sensing = registry.resolve(task.sensing)
+    add(topics.CLOCK, topics.type_string(topics.CLOCK), WORLD)
+    for topic in (topics.WORLD_EVENTS, topics.WORLD_ROBOT_STATS, topics.WORLD_MARKERS, topics.DIAGNOSTICS):
+        add(topic, topics.type_string(topic), WORLD)
+    for st in registry.resolve(task.state) if task.state else ():
+        add(st.topic, st.type_name, WORLD)
+    observations = {topics.ODOM: topics.ROBOT_TOPIC_TYPES[topics.ODOM], topics.SCAN: topics.ROBOT_TOPIC_TYPES[topics.SCAN],
+                    **{t.name: t.type_name for t in sensing.topics}}
+    inbound, outbound = registry.robot_topics(algorithm)
+    for robot in scenario.robot_names:
+        controller = (f"/{robot}", CONTROLLER)
+        for name, type_name in observations.items():
+            add(topics.robot_topic(robot, name), type_name, WORLD)
+        for name in (topics.CMD_VEL, topics.STATUS):
+            add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], controller)
+        add(topics.DIAGNOSTICS, topics.type_string(topics.DIAGNOSTICS), controller)
+        for topic, family in outbound.items():
+            add(topic, family.type_name, controller)
+    for topic, family in registry.peer_topics(algorithm).items():
+        add(topics.heard(topic), family.type_name, WORLD)
+    for spec in algorithm.servers:
+        server = ("/", spec.node_name)
+        add(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK), server)
+        add(topics.DIAGNOSTICS, topics.type_string(topics.DIAGNOSTICS), server)
+        for topic, family in registry.server_topics(spec)[1].items():
+            add(topic, family.type_name, server)
+        outputs = outputs_of(spec)
+        for st in outputs.state:
+            add(st.topic, st.type_name, server)
+        if outputs.markers is not None:
+            add(outputs.markers.topic, MARKER_ARRAY, server)
+    return out
+
+
+@dataclass(frozen=True)
+class Foreign:
+    """A foreign publisher on a run's topic."""
+
+    topic: str
+    node: str
+    """Its node's full name as the graph gives it (``?`` while unknown)."""
+    gid: str
+    tainting: bool
+    """Whether what it sends can reach a core (the topic carries no tag, or the run has no key)."""
+
+    def __str__(self) -> str:
+        return f"{self.node} on {self.topic}"
+
+
+def _name(info) -> tuple[str, str]:
+    return info.node_namespace, info.node_name
+
+
+def _full(namespace: str, name: str) -> str:
+    return "?" if name == UNKNOWN else f"{namespace.rstrip('/')}/{name}"
+
+
+class ForeignWatch:
+    """The world's check of the graph for foreign publishers on the run's topics (see the module
+    docstring). `check` costs one publisher count per topic; a topic's publishers are looked at
+    only when their count changed since the last check."""
+
+    def __init__(self, scenario: Scenario, publishers_info: Callable[[str], list],
+                 count_publishers: Callable[[str], int]) -> None:
+        self.topics = run_topics(scenario)
+        self._info = publishers_info
+        self._count = count_publishers
+        self._counts: dict[str, int] = {}
+        self._known: set[tuple[str, str]] = set()
+        """(topic, GID) of every publisher judged so far (ours and foreign)."""
+        self._unnamed: set[str] = set()
+        """Topics that had a publisher of a node not named yet: looked at again next time."""
+        self.found: list[Foreign] = []
+
+    def check(self) -> list[Foreign]:
+        """The foreign publishers that appeared since the last check."""
+        new: list[Foreign] = []
+        for topic, spec in self.topics.items():
+            count = self._count(topic)
+            if count == self._counts.get(topic) and topic not in self._unnamed:
+                continue
+            self._counts[topic] = count
+            self._unnamed.discard(topic)
+            if count:
+                new += self._judge(topic, spec)
+        self.found += new
+        return new
+
+    def _judge(self, topic: str, spec: RunTopic) -> list[Foreign]:
+        infos = self._info(topic)
+        if any(i.node_name == UNKNOWN for i in infos):
+            self._unnamed.add(topic)
+        ours = [i for i in infos if _name(i) in spec.publishers]
+        strangers = [i for i in infos if _name(i) not in spec.publishers and i.node_name != UNKNOWN]
+        surplus = len(infos) - len(spec.publishers)
+        if surplus > len(strangers):  # more publishers than the run has, beyond those named strangers:
+            seen: set[tuple[str, str]] = set()  # a second publisher under one of our names, or unnamed
+            for i in ours + [i for i in infos if i.node_name == UNKNOWN]:
+                if _name(i) in seen or i.node_name == UNKNOWN:
+                    strangers.append(i)
+                seen.add(_name(i))
+        tainting = not spec.tagged or auth.key() is None
+        out = []
+        for i in strangers:
+            gid = bytes(i.endpoint_gid).hex()
+            if (topic, gid) in self._known:
+                continue
+            self._known.add((topic, gid))
+            out.append(Foreign(topic, _full(i.node_namespace, i.node_name), gid, tainting))
+        return out
+
+    def ready(self, topic: str) -> set[str]:
+        """The run's node names publishing `topic` now (the world starts when every server's
+        node has its ack publisher: counting publishers let a foreign one stand in)."""
+        return {name for ns, name in map(_name, self._info(topic)) if (ns, name) in self.topics[topic].publishers}

@@ -1,0 +1,278 @@
+"""A hostile neighbour on the run's bus (issue 25): a process that joins the run's discovery
+server and publishes on its topics. One test per class of attack; each runs swarm-run on this
+test's own domain (loopback only), joins it with a node of its own and asserts the run's exit
+code, the refused messages by reason, and that the run's bag analyses to the batch run of the
+seed. Bounded: each run is a few hundred ticks at ~10x real time; every process is stopped by
+process group at the end (`graph_helpers.launch`)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import rclpy
+import yaml
+from graph_helpers import REPO, launch, overrides  # noqa: F401 - launch: a fixture
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+
+from depot_manager.codec import DEPOT, RADIO
+from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKind
+from launch_py.dds import discovery_port
+from swarm_msgs_py import ack, clock, diagnostics, odometry, topics, twist
+from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.analysis.metrics import summarize
+from swarm_sim.analysis.replay import load_run
+from swarm_sim.types import BehaviourStatus, NodeDownEvent, Pose2D
+
+BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
+QUEUE = ("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", *overrides(BUSY_DEPOT))
+"""Long enough (~20 s wall) for a late joiner to be matched by every node before the run ends."""
+COMPARED = ("resources_delivered", "trips_by_robot", "oae_by_robot", "collision_time_s_by_robot",
+            "dropoff_times_s", "queue_length_max", "stale_ticks", "dead_nodes")
+
+
+def domain() -> int:
+    return int(os.environ["ROS_DOMAIN_ID"])
+
+
+def batch(*args: str) -> dict:
+    out = subprocess.run([sys.executable, "-m", "swarm_sim.batch", *args, "--json"], capture_output=True,
+                         text=True, timeout=300, cwd=REPO)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def assert_equals_batch(bag, args: tuple[str, ...]) -> None:
+    """The bag analyses (offline, from its bytes alone) to what the batch runner computes."""
+    analysed, expected = summarize(load_run(bag)), batch(*args)
+    for key in COMPARED:
+        assert analysed.get(key) == expected.get(key), key
+    assert analysed["resources_delivered"] > 0
+
+
+class Hostile(Node):
+    """A node in the run's domain, a client of its discovery server (as ``ros2`` would be)."""
+
+    def __init__(self, hear_clock: bool = True) -> None:
+        os.environ["ROS_DISCOVERY_SERVER"] = f"127.0.0.1:{discovery_port(domain())}"
+        self.ctx = rclpy.Context()
+        try:
+            rclpy.init(context=self.ctx)
+            super().__init__("hostile", context=self.ctx)  # the DDS participant is made here
+        finally:
+            del os.environ["ROS_DISCOVERY_SERVER"]
+        self.spinner = SingleThreadedExecutor(context=self.ctx)
+        self.spinner.add_node(self)
+        self.stamp = -1
+        if hear_clock:
+            self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK,
+                                     lambda d: setattr(self, "stamp", clock.decode_clock(d)), SENSOR_LOCKSTEP, raw=True)
+        self.pubs = {}
+
+    def publisher(self, topic: str, qos=EVENTS, msg_type=None):
+        base = topic[:-len(topics.HEARD) - 1] if topic.endswith("/" + topics.HEARD) else topic  # a relay's type
+        self.pubs[topic] = self.create_publisher(msg_type or topics.type_of(base), topic, qos)
+        return self.pubs[topic]
+
+    def spin(self, seconds: float, until=lambda: False) -> None:
+        end = time.monotonic() + seconds
+        while time.monotonic() < end and not until():
+            self.spinner.spin_once(timeout_sec=0.05)
+
+    def wait_matched(self, run, timeout: float = 90.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not (self.stamp > 0 and all(p.get_subscription_count() > 0 for p in self.pubs.values())):
+            assert time.monotonic() < deadline and run.proc.poll() is None, (
+                f"the run's topics never matched: clock {self.stamp}, "
+                f"{ {t: p.get_subscription_count() for t, p in self.pubs.items()} }")
+            self.spinner.spin_once(timeout_sec=0.1)
+
+    def close(self) -> None:
+        self.spinner.shutdown()
+        self.destroy_node()
+        self.ctx.try_shutdown()
+
+
+@pytest.fixture
+def hostile():
+    """Make a `Hostile` node once `run`'s world is up (before, its participant would hold the
+    domain the run is about to claim, and the run would refuse to start)."""
+    made: list[Hostile] = []
+
+    def make(run, hear_clock: bool = True) -> Hostile:
+        run.wait_until(lambda: (run.bag / "metadata.yaml").exists(), what="the world up")  # its bag is open
+        made.append(Hostile(hear_clock))
+        return made[-1]
+
+    yield make
+    for h in made:
+        h.close()
+
+
+def test_no_message_kills_or_stalls_a_node(launch, hostile):
+    """4-byte messages on every sense topic of a robot, an odometry at x = 1e308, a 19 MB array of
+    grants to robot_999 and a RadioQuery at x = 1e308: refused by reason, and the run is the
+    batch run. The sense topics carry no tag, so a foreign publisher there taints the run."""
+    run = launch("--domain-id", str(domain()), *QUEUE)
+    h = hostile(run)
+    senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
+              for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)]
+    grants, radio = h.publisher(topics.DEPOT_GRANTS), h.publisher(topics.heard(topics.RADIO))
+    h.wait_matched(run)
+    (huge,) = DEPOT.encode(0, [DepotGrant(0, "robot_999", "entry_line_0", k) for k in range(100_000)])
+    assert len(huge) > 19e6
+    for _ in range(3):
+        s = h.stamp
+        for pub in senses:
+            pub.publish(b"\x00\x01\x00\x00")
+        senses[0].publish(odometry.encode_odometry("robot_0", s + 10**8, Pose2D(1e308, 0.0, 0.0), 0.0, 0.0))
+        radio.publish(RADIO.encode(s, [RadioQuery(s, "robot_1", 1e308, 0.0)])[0])
+        grants.publish(huge)
+        h.spin(0.5)
+    code, summary, err = run.finish()
+    assert code == 6, err[-3000:]
+    assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0 and summary["run_ended"] == "complete"
+    rejected = summary["rejected_messages"]
+    for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER):
+        assert rejected[f"/robot_0/{name}"]["malformed"] >= 3
+    assert rejected["/robot_0/odom"]["out of bounds"] >= 3
+    assert rejected[topics.DEPOT_GRANTS]["too big"] >= 3 * 6  # by each robot, unread
+    assert rejected[topics.heard(topics.RADIO)]["unauthenticated"] >= 3
+    assert_equals_batch(run.bag, QUEUE)
+
+
+def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
+    """Reports, grants, radio, acks (one from the future), a node_down to the depot, a status
+    with 5000 OAEs and fake rejection counts, all as the run's nodes would send them but without
+    the run's tag: refused and counted, the foreign publishers reported; the run is the batch run
+    and exits 0 (nothing it sent could reach a core)."""
+    run = launch("--domain-id", str(domain()), *QUEUE)
+    h = hostile(run)
+    for topic in (topics.DEPOT_REPORTS, topics.DEPOT_GRANTS, topics.heard(topics.RADIO), topics.WORLD_EVENTS,
+                  "/robot_0/status"):
+        h.publisher(topic)
+    h.publisher(topics.DIAGNOSTICS, STATE_LATCHED)  # the recorder hears it transient-local
+    h.publisher(topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP)
+    h.wait_matched(run)
+    for _ in range(5):
+        s = h.stamp
+        h.pubs[topics.DEPOT_REPORTS].publish(DEPOT.encode(s, [DepotReport(s, "robot_1", ReportKind.JOIN,
+                                                                          "entry_line_0", 0)])[0])
+        h.pubs[topics.DEPOT_GRANTS].publish(DEPOT.encode(s, [DepotGrant(s, "robot_0", "entry_line_0", 0)])[0])
+        h.pubs[topics.heard(topics.RADIO)].publish(RADIO.encode(s, [RadioQuery(s, "robot_1", 0.0, 0.0)])[0])
+        h.pubs[topics.WORLD_EVENTS].publish(diagnostics.encode_events(s, [NodeDownEvent("robot_0", s, "robot", 3)]))
+        h.pubs["/robot_0/status"].publish(diagnostics.encode_status(BehaviourStatus("robot_0", s, "search", 5000, 0)))
+        h.pubs[topics.DIAGNOSTICS].publish(diagnostics.encode_rejections(s, "/robot_0/controller",
+                                                                         {("/radio", "malformed"): 999}))
+        h.pubs[topics.LOCKSTEP_ACK].publish(ack.encode_ack("depot", s + 10**13))
+        h.spin(0.3)
+    code, summary, err = run.finish()
+    assert code == 0, err[-3000:]
+    rejected = summary["rejected_messages"]
+    assert rejected[topics.DEPOT_REPORTS]["unauthenticated"] >= 5
+    assert rejected[topics.DEPOT_GRANTS]["unauthenticated"] >= 5 * 6
+    assert rejected[topics.WORLD_EVENTS]["unauthenticated"] >= 5
+    assert rejected[topics.LOCKSTEP_ACK]["unauthenticated"] >= 5
+    assert rejected[topics.DEPOT_REPORTS]["foreign publisher"] == 1  # reported, not tainting
+    assert summary["foreign_publishers"] == [] and summary["dead_nodes"] == []
+    assert "/radio" not in rejected and max(summary["oae_by_robot"].values()) < 5000
+    assert_equals_batch(run.bag, QUEUE)
+
+
+def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_taint(launch, hostile):
+    """/clock 10^4 s ahead (the depot once stopped acking and the run ended "server depot died"),
+    and a std_msgs/String publisher on /clock (its type hash once replaced Clock's in
+    metadata.yaml and rosbags refused the bag): the run is the batch run, tainted (exit 6)."""
+    from rosbags.highlevel import AnyReader
+    from std_msgs.msg import String
+
+    run = launch("--domain-id", str(domain()), *QUEUE)
+    h, other = hostile(run), hostile(run, hear_clock=False)  # a participant has one type per topic
+    forged = h.publisher(topics.CLOCK, SENSOR_LOCKSTEP)
+    strings = other.create_publisher(String, topics.CLOCK, 10)
+    h.wait_matched(run)
+    for _ in range(3):
+        forged.publish(clock.encode_clock(h.stamp + 10**13))
+        strings.publish(String(data="tick"))
+        h.spin(0.3)
+    code, summary, err = run.finish()
+    assert code == 6, err[-3000:]
+    assert any(f.endswith(f"on {topics.CLOCK}") for f in summary["foreign_publishers"])
+    assert summary["dead_nodes"] == [] and summary["run_ended"] == "complete"
+    assert summary["rejected_messages"][topics.CLOCK]["wrong tick"] >= 3  # by the depot manager
+    meta = yaml.safe_load((run.bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    (clock_topic,) = [t["topic_metadata"] for t in meta["topics_with_message_count"]
+                      if t["topic_metadata"]["name"] == topics.CLOCK]
+    assert clock_topic["type"] == "rosgraph_msgs/msg/Clock"
+    from swarm_sim.recording.metadata import _type_hash
+    assert clock_topic["type_description_hash"] == _type_hash("rosgraph_msgs/msg/Clock")
+    with AnyReader([run.bag]) as reader:  # it refused the bag with String's hash for /clock
+        (connection,) = [c for c in reader.connections if c.topic == topics.CLOCK]
+        assert connection.msgtype == "rosgraph_msgs/msg/Clock" and connection.msgcount > 1000
+    assert_equals_batch(run.bag, QUEUE)
+
+
+def test_a_forged_command_taints_the_run_and_the_analysis_says_so(launch, hostile):
+    """A foreign cmd_vel for robot_1, stamped for the tick under way: a standard type with no
+    room for a tag, so it may be applied; the run is reported tainted at once and at the end
+    (exit 6, the summary, the bag), and swarm-analyze says so too (exit 1)."""
+    run = launch("--domain-id", str(domain()), *QUEUE)
+    h = hostile(run)
+    pub = h.publisher("/robot_1/cmd_vel", SENSOR_LOCKSTEP)
+    h.wait_matched(run)
+    for _ in range(20):
+        pub.publish(twist.encode_twist("robot_1", h.stamp, 0.15, 1.0))
+        h.spin(0.05)
+    code, summary, err = run.finish()
+    assert code == 6 and "the run is tainted" in err, err[-3000:]
+    assert summary["foreign_publishers"] == ["/hostile on /robot_1/cmd_vel"]
+    assert summary["rejected_messages"]["/robot_1/cmd_vel"]["foreign publisher"] == 1
+    analysed = subprocess.run([sys.executable, "-m", "swarm_sim.analysis.cli", str(run.bag), "--no-plot", "--json"],
+                              capture_output=True, text=True, timeout=120, cwd=REPO)
+    assert analysed.returncode == 1 and "the run is tainted" in analysed.stderr
+    assert json.loads(analysed.stdout.strip().splitlines()[-1])["foreign_publishers"] == summary["foreign_publishers"]
+
+
+def test_an_ack_publisher_present_at_start_does_not_start_the_world_early(launch, hostile):
+    """Once, a foreign /lockstep/ack publisher made the world start before the nest was up and
+    declare it dead at 0.3 s; the world now waits for the nest's own node."""
+    args = ("--scenario", "drtm", "--robots", "4", "--duration", "60")
+    run = launch("--domain-id", str(domain()), *args)
+    h = hostile(run)
+    pub = h.publisher(topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP)
+    # a subscriber too: a client of the discovery server learns of the publishers it can match
+    h.create_subscription(topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, lambda d: None,
+                          SENSOR_LOCKSTEP, raw=True)
+    h.spin(10, until=lambda: pub.get_subscription_count() > 1)
+    staged = h.count_publishers(topics.LOCKSTEP_ACK) == 1  # ours alone: the nest is not up yet
+    if not staged:
+        pytest.skip("the nest's ack publisher was up before ours: the attack could not be staged")
+    h.spin(20, until=lambda: h.stamp >= 0)  # the world starts only with the nest
+    assert h.count_publishers(topics.LOCKSTEP_ACK) == 2, "the world started before the nest was up"
+    code, summary, err = run.finish()
+    assert code == 0, err[-3000:]
+    assert summary["dead_nodes"] == [] and summary["server_stale_ticks"] == 0
+    assert summary["rejected_messages"][topics.LOCKSTEP_ACK]["foreign publisher"] == 1
+    expected = batch(*args)
+    assert summary["nest_food_series"] == expected["nest_food_series"] and np.isfinite(summary["sim_seconds"])
+
+
+@pytest.mark.parametrize("discovery", ["server", "simple"])
+def test_a_second_run_on_a_domain_in_use_refuses_before_starting_anything(launch, discovery):
+    first = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE)
+    first.wait_until(lambda: first.sim_time() > 1.0, what="the first run under way")
+    second = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, bag="second")
+    code, summary, err = second.finish(timeout=60)
+    assert code == 2 and summary is None, err[-3000:]
+    (line,) = [x for x in err.splitlines() if x.strip()]
+    assert f"domain {domain()} is in use" in line and "--domain-id auto" in line
+    assert not second.bag.exists() and not second.children()
+    code, summary, err = first.finish()
+    assert code == 0, err[-3000:]
+    assert_equals_batch(first.bag, QUEUE)
