@@ -72,6 +72,18 @@ def check_world(s: Scenario) -> None:
     _require(r.max_linear_speed > 0, "robots.max_linear_speed: must be positive")
     _require(r.max_angular_speed > 0, "robots.max_angular_speed: must be positive")
     _require(r.mass > 0, "robots.mass: must be positive")
+    for name in ("diameter", "height", "mass", "max_linear_speed", "max_angular_speed"):
+        value = getattr(r.platform, name)
+        _require(value is None or value > 0, f"robots.platform.{name}: must be positive")
+    stg = r.stop_turn_go
+    _require(stg.angle_tolerance > 0, "robots.stop_turn_go.angle_tolerance: must be positive")
+    _require(stg.distance_tolerance > 0, "robots.stop_turn_go.distance_tolerance: must be positive")
+    _require(stg.collision_step >= 0, "robots.stop_turn_go.collision_step: must not be negative")
+    wt = r.wheel_turning
+    _require(0 <= wt.no_turn_angle <= wt.soft_turn_angle <= wt.hard_turn_angle <= 180,
+             "robots.wheel_turning: need 0 <= no_turn_angle <= soft_turn_angle <= hard_turn_angle <= 180 deg")
+    _require(0 <= wt.go_straight_angle <= 180, "robots.wheel_turning.go_straight_angle: must be in [0, 180] deg")
+    _require(wt.delta >= 0, "robots.wheel_turning.delta: must not be negative")
     _require(
         r.start_spacing >= r.diameter,
         f"robots.start_spacing: {r.start_spacing} m is less than the robot diameter {r.diameter} m",
