@@ -12,6 +12,7 @@ HEADLINE = (Measure("resources_collected_pct", "%"), Measure("collision_time_per
 
 register(Algorithm(
     name="cpfa",
+    authors_robot="footbot_cpfa",  # CPFA-ARGoS's BaseController on the foot-bot (the queue paper's baseline)
     paper="Hecker & Moses 2015 (Beyond pheromones); the queue paper's baseline (queue_depot_traffic.md sec. VII)",
     behaviour="swarm_controllers.cpfa.behaviour:CpfaBehaviour",
     config=(SECTION,),

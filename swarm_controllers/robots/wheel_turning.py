@@ -108,7 +108,7 @@ class WheelTurning:
             self.active = True
             if not self._collided:
                 self.events += 1
-            self._override = Command(*self._wheels(-self._max * x / length, -self._max * y / length, inf))
+            self._override = Command(*self.twist_from_vector(-self._max * x / length, -self._max * y / length, inf))
             self._next = (self._next[0], True)
         return self._override
 
@@ -123,10 +123,11 @@ class WheelTurning:
         if self._override is not None:  # avoiding this tick: its turn stands
             return self._override.linear, self._override.angular
         m = self._max
-        return self._wheels(m + m * cos(error), m * sin(error), cap)
+        return self.twist_from_vector(m + m * cos(error), m * sin(error), cap)
 
-    def _wheels(self, vx: float, vy: float, cap: float) -> tuple[float, float]:
-        """(linear [m/s], angular [rad/s]) for heading vector (vx, vy) [body frame]."""
+    def twist_from_vector(self, vx: float, vy: float, cap: float = inf) -> tuple[float, float]:
+        """``SetWheelSpeedsFromVector``: (linear [m/s], angular [rad/s]) for heading vector (vx, vy)
+        [m/s, body frame], the base speed at most `cap` [m/s]. Advances the turning mechanism."""
         angle = atan2(vy, vx)
         a = abs(angle)
         base = min(hypot(vx, vy), self._max, cap)

@@ -89,6 +89,11 @@ class RunTrace:
     messages: list[Any] = field(default_factory=list)
     """The robots' peer messages, in delivery order, for algorithms that ask
     (`swarm_sim.registry.Algorithm.trace_peers`; the caging paper's types 0-4)."""
+    rule_collision_s: dict[RobotId, float] | None = None
+    """Per robot, collision time [s] by the algorithm's state-dependent rule
+    (`swarm_sim.registry.Algorithm.collision_rule`; None without one)."""
+    status_log: dict[RobotId, list[BehaviourStatus]] = field(default_factory=dict)
+    """Per robot, every status it published, in order (`swarm_sim.registry.Algorithm.trace_status`)."""
 
 
 def resources_delivered(trace: RunTrace) -> int:

@@ -154,6 +154,9 @@ def apply_model(scenario: Any) -> Any:
     r = scenario.robots
     model = robot_model(r.model)
     overrides = {f: getattr(r.platform, f) for f in BODY_FIELDS if getattr(r.platform, f) is not None}
+    for key, value in overrides.items():
+        if not value > 0:
+            raise ValueError(f"robots.platform.{key}: must be positive")
     planar = model.planar if r.planar is None else r.planar
     if model.name == GENERIC:
         if overrides:

@@ -72,9 +72,6 @@ def check_world(s: Scenario) -> None:
     _require(r.max_linear_speed > 0, "robots.max_linear_speed: must be positive")
     _require(r.max_angular_speed > 0, "robots.max_angular_speed: must be positive")
     _require(r.mass > 0, "robots.mass: must be positive")
-    for name in ("diameter", "height", "mass", "max_linear_speed", "max_angular_speed"):
-        value = getattr(r.platform, name)
-        _require(value is None or value > 0, f"robots.platform.{name}: must be positive")
     stg = r.stop_turn_go
     _require(stg.angle_tolerance > 0, "robots.stop_turn_go.angle_tolerance: must be positive")
     _require(stg.distance_tolerance > 0, "robots.stop_turn_go.distance_tolerance: must be positive")
