@@ -122,7 +122,10 @@ class StopTurnGo:
         return self._tick()
 
     def hold(self, heading_error: float, ahead: float = inf) -> tuple[float, float]:
-        self._request = (heading_error, ahead if ahead < inf else self._step, False)
+        """Turn to the heading, then drive `ahead` [m] (``SearchStepSize`` when infinite), at least
+        the distance tolerance: the authors' robots count a target nearer than that as reached,
+        and a behaviour that still asks to go on (its leg not quite walked) gets there."""
+        self._request = (heading_error, max(ahead if ahead < inf else self._step, self._dist_tol), False)
         return self._tick()
 
     def avoidance(self, escape_distance: float = 0.0, *, keep_right: bool = False) -> StopTurnGo:

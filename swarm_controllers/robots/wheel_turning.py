@@ -90,7 +90,9 @@ class WheelTurning:
         return self._goal(remainder(atan2(dy, dx) - yaw, _TWO_PI), d / self._dt)
 
     def hold(self, heading_error: float, ahead: float = inf) -> tuple[float, float]:
-        return self._goal(heading_error, ahead / self._dt)
+        """Along a heading, at the speed ``SetWheelSpeedsFromVector`` gives (`ahead` is not read:
+        the example steers by vectors, not legs)."""
+        return self._goal(heading_error, inf)
 
     def avoidance(self, escape_distance: float = 0.0, *, keep_right: bool = False) -> WheelTurning:
         """Itself: ``diffusion`` (no escape run: the example steers by the readings every tick)."""
