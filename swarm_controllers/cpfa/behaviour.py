@@ -70,6 +70,12 @@ is 0.2 Hz (the early iAnt controller drew every 16 Hz step; CPFA-ROS per 0.5 m w
 keep the same hazard per second but spread it over every tick of dt seconds:
 p' = 1 - (1 - p) ** (draw_rate * dt), so no 5 s clock is shared by all robots.
 
+Motion goes through the robot model's motion layer (`swarm_controllers.motion.drive_for`): the
+behaviour names targets (sites, the nest, a dock) and walk-leg headings, the model decides how the
+robot drives there (the generic robot steers continuously; ``footbot_cpfa`` moves in the ARGoS
+CPFA's own stop-turn-go steps). The avoidance described next is the generic robot's; a platform
+model brings its authors' own (`swarm_controllers.robots`).
+
 Obstacle avoidance has priority over every state's motion; the state machine still runs (and
 draws) on avoidance ticks, as in ARGoS where the CPFA step and the collision-avoiding move are
 separate. When an avoidance episode ends the robot first drives straight ahead for one

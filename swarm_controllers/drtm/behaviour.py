@@ -21,9 +21,11 @@ One state machine for both (Fig. 1, Table 1); they differ only in the threshold 
   is ahead within the avoidance distance or it is within half the nest radius of the centre
   (the ARGoS foraging example's robots likewise look for a place in the nest for 50 ticks). It
   consumes no energy meanwhile: only S_S and S_R do (Sec. 3.1).
-* **Obstacle avoidance** (Sec. 2.2) has priority over the ASM in S_S and S_R: the scan-based
-  avoidance of `swarm_controllers.avoidance` (turn away, then a straight escape run of one body
-  length). Each episode is one OAE; the robot counts it and reports it to the nest (AVOIDED).
+* **Obstacle avoidance** (Sec. 2.2) has priority over the ASM in S_S and S_R: the robot model's
+  (`swarm_controllers.motion.Drive.avoidance`; the generic robot's is the scan-based avoidance of
+  `swarm_controllers.avoidance`: turn away, then a straight escape run of one body length; the
+  ``footbot_foraging`` model's the ARGoS foraging example's ``diffusion``). Steering to a token or
+  the light goes through the model's motion layer too. Each episode is one OAE; the robot counts it and reports it to the nest (AVOIDED).
   Waiting robots do not move, so they neither avoid nor count.
 """
 

@@ -39,6 +39,8 @@ class RingSensor:
         range. `ranges`: the scan [m from the centre]; NaN and inf read nothing."""
         values = ranges.tolist() if isinstance(ranges, np.ndarray) else list(ranges)
         reach, body, rng = self._reach, self._body, self._range
+        if min(values, default=math.inf) > reach:  # nothing near (min skips a NaN unless it is first,
+            return 0.0, 0.0                        # and a NaN min goes on to the full check below)
         hits = [i for i, v in enumerate(values) if v <= reach and v - body <= rng]
         if not hits:
             return 0.0, 0.0

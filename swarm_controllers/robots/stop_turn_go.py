@@ -35,7 +35,8 @@ left out. The angle and distance tolerances and ``SearchStepSize`` are the scena
 
 A tick's motion is worked out once, from the state at its start, the collision seen in it and the
 behaviour's last request in it (as ARGoS's ``Move`` sees the last ``SetTarget`` of the step), so
-the order in which a behaviour asks for avoidance and motion does not matter.
+the order in which a behaviour asks for avoidance and motion does not matter; on a tick the
+behaviour drives the wheels itself (standing at a dock, a queue's brake) the moves wait.
 """
 
 from __future__ import annotations
@@ -69,7 +70,7 @@ class StopTurnGo:
     """One robot's ``BaseController`` (see the module docstring); a `swarm_controllers.motion.Drive`."""
 
     __slots__ = (
-        "_angle_tol", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle", "_looked",
+        "_angle_tol", "_collided", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle", "_looked",
         "_next", "_request", "_ring", "_rng", "_stamp", "_state", "_step", "_v", "_w", "_wheel_cm",
         "active", "events",
     )
@@ -89,9 +90,13 @@ class StopTurnGo:
         self._cos_ahead = math.cos(math.radians(scenario.sensors.proximity_ring.ahead))
         self._rng = (rng if rng is not None else np.random.default_rng(0)).spawn(1)[0]
         """The collision delays' own stream: the behaviour's draws stay as they are."""
-        self._state: tuple = (_EMPTY, 0.0, False, False)
-        """At the tick's start: (moves, delay left [s], collided last tick, moves are a collision's)."""
+        self._state: tuple = (_EMPTY, 0.0, False)
+        """At the tick's start: (moves, delay left [s], the moves are a collision's)."""
         self._next = self._state
+        """The state after this tick's motion; the same as `_state` while the tick has driven nothing
+        (a behaviour that sets its own twist leaves the motion where it was)."""
+        self._collided = False
+        """A collision on the last tick (an episode goes on)."""
         self._stamp = -1
         self._hit: float | None = None
         """This tick's collision: the readings' angle [deg], None if none (or not looked yet)."""
@@ -110,6 +115,7 @@ class StopTurnGo:
         if stamp_ns != self._stamp:
             self._stamp = stamp_ns
             self._state = self._next
+            self._collided = self.active
             self._hit = None
             self._looked = False
             self._request = None
@@ -138,8 +144,9 @@ class StopTurnGo:
     def update(self, ranges: np.ndarray) -> Command | None:
         """On a collision, the turn it starts; while the turn and its step run, their motion; else None."""
         self._detect(ranges)
-        twist = self._tick()
-        return Command(*twist) if self._hit is not None or self._state[3] else None
+        if self._hit is None and not self._state[2]:
+            return None
+        return Command(*self._tick())
 
     def turn_only(self, ranges: np.ndarray) -> Command | None:
         self._idle = True
@@ -148,8 +155,7 @@ class StopTurnGo:
         return Command(*twist) if self._hit is not None else None
 
     def reset(self) -> None:
-        moves, delay, _, seq = self._next
-        self._next = (moves, delay, False, seq)
+        self.active = False
 
     # ------------------------------------------------------------------ the tick
 
@@ -163,12 +169,12 @@ class StopTurnGo:
             self._hit = math.degrees(atan2(y, x))
             self._delay_draw = float(self._rng.uniform(*COLLISION_DELAY))
             self.active = True
-            if not self._state[2]:
+            if not self._collided:
                 self.events += 1
 
     def _tick(self) -> tuple[float, float]:
         """This tick's twist from the state at its start; sets the state for the next tick."""
-        moves, delay, _, seq = self._state
+        moves, delay, seq = self._state
         hit = self._hit
         if hit is not None:
             turn = ((_TURN, TURN_CM_PER_DEGREE * abs(hit) / self._wheel_cm, -1.0),) if hit else ()
@@ -197,7 +203,7 @@ class StopTurnGo:
                 out[0] = (kind, duration, sign)
         if self._idle:
             out = []
-        self._next = (tuple(out), max(delay - self._dt, 0.0), hit is not None, seq and bool(out))
+        self._next = (tuple(out), max(delay - self._dt, 0.0), seq and bool(out))
         return lin / self._dt, ang / self._dt
 
     def _plan(self, error: float, distance: float, to_target: bool) -> tuple:
