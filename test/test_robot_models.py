@@ -331,3 +331,16 @@ def test_every_algorithm_names_its_authors_robot_and_the_comparisons_can_run_on_
     with pytest.raises(SystemExit):
         parser.parse_args(["all", "--robot-model", "roomba"])
     assert parser.parse_args(["all", "--robot-model", "authors"]).robot_model == "authors"
+
+
+def test_the_foot_bot_ring_is_cast_as_a_full_circle_with_the_same_hits(monkeypatch):
+    import swarm_sim.world.raycast as raycast
+
+    s = load_scenario("queue_qmt", ["robots.model=footbot_cpfa", "robots.count=200"])
+    assert raycast.evenly_round(24, s.sensors.scan.fov) and not raycast.evenly_round(5, math.pi)
+    scene = raycast.StaticScene.from_scenario(s)
+    rng = np.random.default_rng(4)
+    pos, yaw = rng.uniform(-4, 4, (200, 2)), rng.uniform(-math.pi, math.pi, 200)
+    fast = raycast.nearest_hits(pos, yaw, 0.085, scene, 24, s.sensors.scan.fov, 3.5)
+    monkeypatch.setattr(raycast, "evenly_round", lambda rays, fov: False)
+    assert np.array_equal(fast, raycast.nearest_hits(pos, yaw, 0.085, scene, 24, s.sensors.scan.fov, 3.5))
