@@ -22,7 +22,7 @@ from swarm_sim.scenario import Scenario
 class RingSensor:
     """One robot's proximity ring, read from its scan."""
 
-    __slots__ = ("_body", "_cos", "_range", "_reach", "_reading", "_sin", "rays")
+    __slots__ = ("_body", "_cos", "_range", "_reach", "_sin", "_value", "rays")
 
     def __init__(self, scenario: Scenario) -> None:
         angles = ray_angles(scenario.sensors.scan)
@@ -32,7 +32,7 @@ class RingSensor:
         self._body = scenario.robots.diameter / 2.0
         self._range = scenario.sensors.proximity_ring.range
         self._reach = self._body + self._range + 1e-9
-        self._reading = model_of(scenario).ring_reading
+        self._value = model_of(scenario).ring_value
 
     def vector(self, ranges: np.ndarray | Sequence[float]) -> tuple[float, float]:
         """The sum of the readings as vectors [body frame, x ahead]; (0, 0) when nothing is within
@@ -41,12 +41,11 @@ class RingSensor:
         reach, body, rng = self._reach, self._body, self._range
         if min(values, default=math.inf) > reach:  # nothing near (min skips a NaN unless it is first,
             return 0.0, 0.0                        # and a NaN min goes on to the full check below)
-        hits = [i for i, v in enumerate(values) if v <= reach and v - body <= rng]
-        if not hits:
-            return 0.0, 0.0
-        readings = self._reading(np.array([values[i] - body for i in hits])).tolist()
+        reading, cos, sin = self._value, self._cos, self._sin
         x = y = 0.0
-        for i, value in zip(hits, readings):
-            x += value * self._cos[i]
-            y += value * self._sin[i]
+        for i, v in enumerate(values):
+            if v <= reach and v - body <= rng:
+                value = reading(v - body)
+                x += value * cos[i]
+                y += value * sin[i]
         return x, y

@@ -47,6 +47,11 @@ def exp_reading(d: np.ndarray) -> np.ndarray:
     return np.exp(-np.maximum(d, 0.0))
 
 
+def exp_value(d: float) -> float:
+    """`exp_reading` of one hit, in plain floats."""
+    return math.exp(-max(d, 0.0))
+
+
 @dataclass(frozen=True)
 class RobotModel:
     """One platform. None: the scenario's own value (the generic robot)."""
@@ -76,7 +81,9 @@ class RobotModel:
     ring_range: float | None = None
     """[m] beyond the body (``sensors.proximity_ring.range``)."""
     ring_reading: Callable[[np.ndarray], np.ndarray] = exp_reading
-    """A ring sensor's reading of a hit d [m] from the body (numpy, elementwise)."""
+    """A ring sensor's reading of a hit d [m] from the body (numpy, elementwise: the world's)."""
+    ring_value: Callable[[float], float] = exp_value
+    """The same for one hit, in plain floats (a controller's)."""
     light_everywhere: bool = False
     """The light sensor has no range (``sensors.light_range`` becomes the arena's diagonal)."""
     ground_food: bool = False
@@ -103,7 +110,7 @@ MODELS: dict[str, RobotModel] = {m.name: m for m in (
         diameter=2 * footbot.BODY_RADIUS, height=footbot.BODY_HEIGHT, mass=footbot.MASS,
         max_linear_speed=0.16, max_angular_speed=footbot.wheel_speed_to_turn_rate(0.08),
         ring_rays=footbot.RING_SENSORS, ring_fov=footbot.RING_FOV, ring_range=footbot.RING_RANGE,
-        ring_reading=footbot.ring_reading,
+        ring_reading=footbot.ring_reading, ring_value=footbot.ring_value,
     ),
     RobotModel(
         name="footbot_foraging",
@@ -114,7 +121,8 @@ MODELS: dict[str, RobotModel] = {m.name: m for m in (
         diameter=2 * footbot.BODY_RADIUS, height=footbot.BODY_HEIGHT, mass=footbot.MASS,
         max_linear_speed=0.1, max_angular_speed=footbot.wheel_speed_to_turn_rate(0.1),
         ring_rays=footbot.RING_SENSORS, ring_fov=footbot.RING_FOV, ring_range=footbot.RING_RANGE,
-        ring_reading=footbot.ring_reading, light_everywhere=True, ground_food=True,
+        ring_reading=footbot.ring_reading, ring_value=footbot.ring_value, light_everywhere=True,
+        ground_food=True,
     ),
     RobotModel(
         name="khepera3",

@@ -54,6 +54,12 @@ def ring_reading(d: np.ndarray) -> np.ndarray:
         return np.where(d < _NEAR, 1.0, _A / (np.maximum(d, 0.0) + _B))
 
 
+def ring_value(d: float) -> float:
+    """`ring_reading` of one hit [m from the sensor], in plain floats (a controller reads its own
+    ring every tick: numpy's per-call cost would be most of it)."""
+    return 1.0 if d < _NEAR else _A / (max(d, 0.0) + _B)
+
+
 def wheel_speed_to_turn_rate(wheel: float) -> float:
     """[rad/s] of a foot-bot turning in place with its wheels at +-`wheel` [m/s]."""
     return 2.0 * wheel / INTERWHEEL_DISTANCE

@@ -84,5 +84,11 @@ class ProximityRing:
         so a row gives the same floats whichever rows it is stacked with: the batch runner's
         whole-swarm array and a bag replay's rows of a few robots agree bit for bit (`ahead`'s
         matrix product may order its sums by the array's shape)."""
-        value = np.ascontiguousarray(self._values(ranges))
-        return (value * self._cos).sum(axis=1), (value * self._sin).sum(axis=1)
+        value = self._values(ranges)
+        x, y = np.zeros(len(value)), np.zeros(len(value))
+        rows = np.flatnonzero(value.any(axis=1))  # most robots read nothing
+        if len(rows):
+            near = np.ascontiguousarray(value[rows])
+            x[rows] = (near * self._cos).sum(axis=1)
+            y[rows] = (near * self._sin).sum(axis=1)
+        return x, y
