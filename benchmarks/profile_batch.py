@@ -3,6 +3,7 @@
     python benchmarks/profile_batch.py --robots 112 1000 --scenario cpfa queue_qmt
     python benchmarks/profile_batch.py --robots 112 --scenario cpfa --duration 60 --repeat 3
     python benchmarks/profile_batch.py --robots 1000 --warmup 60   # robots spread out first
+    python benchmarks/profile_batch.py --scenario queue_qmt --set robots.model=footbot_cpfa   # a robot model
 
 Each (scenario, robots) pair is run with the same seed plain (only the tick window is marked:
 the real-time factor) and instrumented, alternated ``--repeat`` times; the table is the
@@ -46,14 +47,17 @@ from typing import Any
 import swarm_sim.batch as batch
 import swarm_sim.world.core as world_core
 from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance
+from swarm_controllers.robots.stop_turn_go import StopTurnGo
+from swarm_controllers.robots.wheel_turning import WheelTurning
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.scenario import Scenario, load_scenario
 
 GROUPS = ("world", "behaviours", "routing", "servers", "bookkeeping", "gc")
 """Phase names start with one of these (then ':'); the table prints a subtotal per group."""
 
-AVOIDANCE = (ObstacleAvoidance, AvoidThenEscape)
-"""The behaviours' shared obstacle avoidance (the scan's consumer): its ``update`` is a phase."""
+AVOIDANCE = (ObstacleAvoidance, AvoidThenEscape, StopTurnGo, WheelTurning)
+"""The behaviours' obstacle avoidance (the scan's consumer; the robot models' own for the
+foot-bots): its ``update`` is a phase."""
 
 
 class _TimedPybullet:
@@ -124,7 +128,7 @@ class TickWindow:
     calls: dict[str, int] = field(default_factory=dict)
 
     def mark(self, timers: Timers | None) -> None:
-        """A tick boundary (`PerimeterLog.update` entry): opens the window or extends it."""
+        """A tick boundary (a probe's ``update``, `TickMarker`): opens the window or extends it."""
         self.end = time.perf_counter()
         self.marks += 1
         if self.marks == self.skip + 1:
@@ -202,7 +206,7 @@ def profile_run(
     after the first `warmup_ticks`."""
     timers = Timers() if instrument else None
     window = TickWindow(warmup_ticks)
-    world_cls, probes_of, router_cls = batch.World, batch.make_probes, batch.Router
+    world_cls, probes_of, router_cls, rule_cls = batch.World, batch.make_probes, batch.Router, batch.RuleLog
     wrap = timers.wrap if timers else (lambda _name, fn: fn)
 
     def make_world(s: Scenario, *args: Any) -> Any:
@@ -241,6 +245,11 @@ def profile_run(
             probe.update = wrap("bookkeeping: probes (perimeter log)", probe.update)
         return {"tick marker": TickMarker(window, timers), **probes}
 
+    def make_rule_log(*args: Any) -> Any:
+        log = rule_cls(*args)
+        log.update = wrap("bookkeeping: state rules (ring vectors, statuses)", log.update)
+        return log
+
     batch_make_servers = batch.make_servers
     targets: list[tuple[Any, str, Any]] = [(batch, "World", make_world), (batch, "make_probes", make_probes)]
     if timers is not None:
@@ -254,6 +263,7 @@ def profile_run(
             (batch, "with_messages", wrap("routing: inbox into observations", batch.with_messages)),
             (batch, "_collect_events", wrap("bookkeeping: events + trace", batch._collect_events)),
             (batch, "_record_state", wrap("bookkeeping: events + trace", batch._record_state)),
+            (batch, "RuleLog", make_rule_log),
             (world_core, "p", _TimedPybullet(world_core.p, timers)),
             (world_core, "cast_scan", wrap("world: ray casting (scan)", world_core.cast_scan)),
             (world_core, "cast_scan_pybullet", wrap("world: ray casting (scan)", world_core.cast_scan_pybullet)),
@@ -323,7 +333,8 @@ def timer_overhead_s() -> float:
 def print_profile(prof: Profile, plains: list[Profile], overhead_s: float) -> None:
     s = prof.scenario
     n = s.robots.count
-    print(f"\n== {s.name}, {n} robots, {s.arena.size:g} x {s.arena.size:g} m, {s.resources.count} resources, "
+    print(f"\n== {s.name}, {n} robots ({s.robots.model}{', planar' if s.robots.planar else ''}), "
+          f"{s.arena.size:g} x {s.arena.size:g} m, {s.resources.count} resources, "
           f"ticks {s.ticks - prof.ticks}-{s.ticks - 1} of {s.sim.dt:g} s, seed {s.seed}")
     ms = sorted(p.ms_per_tick for p in plains)
     plain = sorted(plains, key=lambda p: p.ms_per_tick)[len(plains) // 2]
@@ -374,6 +385,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--warmup", type=float, default=0.0, help="sim seconds run before the measured ticks")
     parser.add_argument("--repeat", type=int, default=1, help="plain and instrumented runs, alternated")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="any scenario field, e.g. robots.model=footbot_cpfa or robots.planar=true")
     args = parser.parse_args(argv)
     overhead = timer_overhead_s()
     print(f"timer cost {1e9 * overhead:.0f} ns per timed call", flush=True)
@@ -381,7 +394,8 @@ def main(argv: list[str] | None = None) -> int:
         for n in sorted(args.robots):
             duration = args.duration or (60.0 if n < 500 else 10.0)
             fields = scaled_fields(name, n, dict(args.arena).get(n))
-            scenario = load_scenario(name, **fields, sim__duration=args.warmup + duration, seed=args.seed)
+            scenario = load_scenario(name, args.overrides, **fields, sim__duration=args.warmup + duration,
+                                     seed=args.seed)
             warmup = round(args.warmup / scenario.sim.dt)
             plains, profs = [], []
             for _ in range(max(1, args.repeat)):

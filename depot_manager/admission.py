@@ -219,6 +219,12 @@ class DepotAdmission:
         """Entry lines, inner queues, exit lines."""
         return self._m.lines
 
+    def dock_slots(self) -> frozenset[tuple[str, int]]:
+        """Every (line, cell) that is a dock's stop (a line may reach a dock at one of its cells)."""
+        m = self._m
+        docks = {int(d) for d in m.dock_ids}
+        return frozenset((line, i) for line in m.lines for i, c in enumerate(m.line_ids[line].tolist()) if c in docks)
+
     def keep_clear(self, line: str, cell: int) -> bool:
         """The cell is an intersection cell: no grant ends there (sec. IV-D)."""
         return bool(self._m.intersection[self._id(line, cell)])

@@ -1,4 +1,6 @@
-"""Reactive obstacle avoidance from the laser scan.
+"""Reactive obstacle avoidance from the laser scan: the generic robot's (the platform robot models
+bring their authors' own, `swarm_controllers.robots`; every behaviour gets its robot's from
+`swarm_controllers.motion.Drive.avoidance`).
 
 The scan sees walls, obstacles and other robots alike, so one rule covers all three: when a
 ray in the front sector reads closer than `AvoidanceConfig.distance`, the robot stops driving

@@ -1,4 +1,22 @@
-"""Steering for a differential-drive robot: turn in place, or drive with a proportional turn.
+"""The motion layer between a behaviour and the wheels, and the generic robot's steering.
+
+Behaviours decide where to go; the robot model (``robots.model``, `swarm_sim.robots`) decides how
+the robot moves there, as the authors' ``BaseController`` does for their behaviours. Every
+behaviour gets its robot's `Drive` from `drive_for` and asks it for
+
+- ``to_point(x, y, yaw, tx, ty)``: the twist toward a target point [m, world frame];
+- ``hold(heading_error, ahead)``: the twist along a heading (`ahead` [m]: how far the behaviour
+  means to go that way; models that move in whole legs drive that far);
+- ``avoidance(escape_distance, keep_right=...)``: the robot's collision avoidance, with priority
+  over the behaviour's motion (`swarm_controllers.avoidance.AvoidThenEscape`'s interface);
+- ``begin(stamp_ns)``, once at the start of every tick (models with a state of their own advance
+  it once a tick, whatever the behaviour asks in between).
+
+The models' drives: `ContinuousDrive` (the generic robot and the Khepera III: steered continuously,
+re-aimed every tick, `steer`), `swarm_controllers.robots.stop_turn_go.StopTurnGo` (the CPFA
+lineage's foot-bot) and `swarm_controllers.robots.wheel_turning.WheelTurning` (the ARGoS foraging
+example's foot-bot). A behaviour's own twist (standing still, a random walk's turn) goes to the
+wheels as it is.
 
 Plain `math` on purpose: these run for every robot every tick, and numpy's per-call overhead
 on scalars costs more than the arithmetic (its functions imported by name: a module attribute
@@ -10,8 +28,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from math import atan2, cos, hypot, inf, remainder
+from typing import Protocol
 
+import numpy as np
+
+from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_sim.geometry import wrap_angle
+from swarm_sim.registry import resolve
+from swarm_sim.robots import model_of
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import Command, Pose2D
 
@@ -88,3 +112,72 @@ def hold_heading(pose: Pose2D, heading: float, limits: DriveLimits) -> Command:
         return Command()
     linear, angular = steer(wrap_angle(error), inf, limits)
     return Command(linear, angular)
+
+
+class Avoidance(Protocol):
+    """A robot's collision avoidance (`AvoidThenEscape` and the robot models' own)."""
+
+    @property
+    def events(self) -> int:
+        """Avoidance episodes so far."""
+        ...
+
+    @property
+    def active(self) -> bool:
+        """True while the last `update` found something to avoid."""
+        ...
+
+    def update(self, ranges: np.ndarray) -> Command | None:
+        """The command overriding the behaviour this tick, or None."""
+        ...
+
+    def turn_only(self, ranges: np.ndarray) -> Command | None:
+        """The avoidance of a robot that stands still: turns in place only."""
+        ...
+
+    def reset(self) -> None:
+        """Forget the current episode (the robot stopped moving)."""
+        ...
+
+
+class Drive(Protocol):
+    """A robot model's motion layer (see the module docstring)."""
+
+    def begin(self, stamp_ns: int) -> None: ...
+
+    def to_point(self, x: float, y: float, yaw: float, tx: float, ty: float) -> tuple[float, float]: ...
+
+    def hold(self, heading_error: float, ahead: float = inf) -> tuple[float, float]: ...
+
+    def avoidance(self, escape_distance: float, *, keep_right: bool = False) -> Avoidance: ...
+
+
+class ContinuousDrive:
+    """The generic robot's motion (and the Khepera III's): `go_to_point_twist` and `steer` within
+    the scenario's speed limits, re-aimed every tick; avoidance by `AvoidThenEscape`. Stateless,
+    so `begin` does nothing and `hold` drives on whatever `ahead` says."""
+
+    __slots__ = ("limits", "scenario")
+
+    def __init__(self, scenario: Scenario, rng: np.random.Generator | None = None) -> None:
+        self.scenario = scenario
+        self.limits = DriveLimits.from_scenario(scenario)
+
+    def begin(self, stamp_ns: int) -> None:
+        pass
+
+    def to_point(self, x: float, y: float, yaw: float, tx: float, ty: float) -> tuple[float, float]:
+        return go_to_point_twist(x, y, yaw, tx, ty, self.limits)
+
+    def hold(self, heading_error: float, ahead: float = inf) -> tuple[float, float]:
+        return steer(heading_error, inf, self.limits)
+
+    def avoidance(self, escape_distance: float, *, keep_right: bool = False) -> AvoidThenEscape:
+        return AvoidThenEscape(self.scenario, escape_distance, keep_right=keep_right)
+
+
+def drive_for(scenario: Scenario, rng: np.random.Generator | None = None) -> Drive:
+    """The motion layer of the scenario's robot model (`swarm_sim.robots.RobotModel.motion`), for
+    one robot; `rng`: the robot's behaviour generator (a model that draws spawns its own stream
+    from it, so the behaviour's draws stay as they are)."""
+    return resolve(model_of(scenario).motion)(scenario, rng)

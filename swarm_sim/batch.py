@@ -29,6 +29,7 @@ import numpy as np
 
 from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.analysis.metrics import RunTrace, summarize
+from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.analysis.text import summary_line
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
@@ -106,6 +107,11 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
     series = SeriesLog(algorithm.servers, trace.series)
     # The servers whose published state a series reads: asked for their state every tick.
     watched = {s.channel: StateWatch(outputs_of(s).state) for s in algorithm.servers if s.channel in series.reads_state}
+    # State-dependent metrics (`swarm_sim.analysis.state_rules`): only for algorithms that declare them.
+    robot_list = list(behaviours.values())
+    rule_log = RuleLog(robots, resolve(algorithm.collision_rule)(scenario), scenario.sim.dt) \
+        if algorithm.collision_rule else None
+    status_log = StatusLog(robots) if algorithm.trace_status else None
     try:
         obs = world.reset()
         _record_state(world, state_topics, trace)
@@ -119,6 +125,11 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             inbox = router.take_before(ROBOTS, world.t_ns)
             seen = obs.values() if not inbox else [with_messages(o, inbox) for o in obs.values()]
             answers = list(map(call, steps, seen))  # the world's dict is in robot order
+            if rule_log is not None:
+                t_ns = world.t_ns
+                rule_log.update(*world.ring.vectors(world.scan_ranges), lambda i: robot_list[i].status(t_ns))
+            if status_log is not None:
+                status_log.update(b.status(world.t_ns) for b in robot_list)
             sent = list(chain.from_iterable(map(_MESSAGES, answers)))
             for message in sent:
                 router.post(message)
@@ -151,6 +162,10 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
         trace.status = status
         trace.probes = {name: observer.result() for name, observer in probes.items()}
         trace.messages.sort(key=delivery_order)
+        if rule_log is not None:
+            trace.rule_collision_s = rule_log.seconds()
+        if status_log is not None:
+            trace.status_log = status_log.log
     finally:
         world.close()
     trace.wall_seconds = time.monotonic() - wall0

@@ -210,6 +210,19 @@ class Algorithm:
     states: tuple[str, ...] = ()
     """Every state its robots' statuses can report (``BehaviourStatus.state``), in the order a
     replay video's legend lists them, each with its own colour from the first frame."""
+    authors_robot: str = "generic"
+    """The robot model its authors' experiments ran on (``robots.model``, `swarm_sim.robots`):
+    what ``swarm-compare --robot-model authors`` runs it on. Its shipped scenarios keep their own
+    ``robots.model`` (the committed results were made with ``generic``)."""
+    collision_rule: str | None = None
+    """``module:function`` ``(scenario) -> rule``; ``rule(status: BehaviourStatus) -> float | None``:
+    the half-angle [deg] about the heading within which the proximity ring's reading counts as
+    collision time in the state the robot reports, None where it does not count (its authors
+    count collision time in the controller, by state). Batch runs and bag replays then keep each
+    robot's time by that rule in ``RunTrace.rule_collision_s`` (`swarm_sim.analysis.state_rules`)."""
+    trace_status: bool = False
+    """Keep every status its robots publish (``RunTrace.status_log``: batch runs ask every behaviour
+    each tick, bag replays read ``/<robot>/status``), for metrics counted by state."""
 
 
 _ALGORITHMS: dict[str, Algorithm] = {}

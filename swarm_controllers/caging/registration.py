@@ -40,6 +40,7 @@ _PANELS = (
 
 register(Algorithm(
     name="caging",
+    authors_robot="khepera3",  # the paper's CoppeliaSim Khepera III
     paper="caging_transport.md (Cardoso, Nedjah & Mourelle): Algs. 1-6, eqs. (1), (2), (5)",
     behaviour="swarm_controllers.caging.behaviour:CagingBehaviour",
     task="transport",

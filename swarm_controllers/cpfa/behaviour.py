@@ -70,6 +70,12 @@ is 0.2 Hz (the early iAnt controller drew every 16 Hz step; CPFA-ROS per 0.5 m w
 keep the same hazard per second but spread it over every tick of dt seconds:
 p' = 1 - (1 - p) ** (draw_rate * dt), so no 5 s clock is shared by all robots.
 
+Motion goes through the robot model's motion layer (`swarm_controllers.motion.drive_for`): the
+behaviour names targets (sites, the nest, a dock) and walk-leg headings, the model decides how the
+robot drives there (the generic robot steers continuously; ``footbot_cpfa`` moves in the ARGoS
+CPFA's own stop-turn-go steps). The avoidance described next is the generic robot's; a platform
+model brings its authors' own (`swarm_controllers.robots`).
+
 Obstacle avoidance has priority over every state's motion; the state machine still runs (and
 draws) on avoidance ticks, as in ARGoS where the CPFA step and the collision-avoiding move are
 separate. When an avoidance episode ends the robot first drives straight ahead for one
@@ -82,15 +88,14 @@ from __future__ import annotations
 
 import math
 from enum import Enum
-from math import inf, remainder
+from math import remainder
 
 import numpy as np
 
 from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.api import new_command, uniform_draws
-from swarm_controllers.avoidance import AvoidThenEscape
 from swarm_controllers.cpfa.config import CpfaConfig
-from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
+from swarm_controllers.motion import Avoidance, Drive, drive_for
 from swarm_sim.messaging import per_inbox
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
@@ -183,9 +188,9 @@ class CpfaBehaviour:
     # (1000 robots, ticks 600-800, alternated runs: Q_MT 16.6 -> 14.7 ms a tick; CPFA and 112
     # robots within noise; issue 14).
     __slots__ = (
-        "_arrival2", "_avoidance", "_blocked2", "_bound", "_carrying", "_dock_r2", "_docks",
-        "_heading", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
-        "_leg_x", "_leg_y", "_limits", "_mode", "_nest", "_nest_r2", "_omega",
+        "_arrival2", "_avoidance", "_blocked2", "_bound", "_carrying", "_dock_r2", "_docks", "_drive",
+        "_heading", "_hold", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
+        "_leg_x", "_leg_y", "_mode", "_nest", "_nest_r2", "_omega", "_to_point",
         "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
         "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
         "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
@@ -194,19 +199,23 @@ class CpfaBehaviour:
 
     def __init__(
         self, scenario: Scenario, robot: RobotId, rng: np.random.Generator,
-        *, keep_out: float | None = None,
+        *, keep_out: float | None = None, drive: Drive | None = None,
     ) -> None:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
-        give-up return ends at its edge. None: the depot disc (the plain CPFA)."""
+        give-up return ends at its edge. None: the depot disc (the plain CPFA). drive: the robot's
+        motion layer when another behaviour owns it (the queue strategies'; default: the robot
+        model's, `swarm_controllers.motion.drive_for`)."""
         cfg = CpfaConfig.of(scenario)
         dt = scenario.sim.dt
         self.robot = robot
         self._rng = rng
         self._random = uniform_draws(rng)
         """``rng.random`` (the same numbers, cheaper)."""
-        self._limits = DriveLimits.from_scenario(scenario)
-        self._avoidance = AvoidThenEscape(scenario, escape_distance=cfg.search_step)
+        self._drive = drive_for(scenario, rng) if drive is None else drive
+        self._to_point = self._drive.to_point
+        self._hold = self._drive.hold
+        self._avoidance = self._drive.avoidance(cfg.search_step)
         self._update_avoidance = self._avoidance.update
         self._p_switch = per_tick_probability(
             cfg.probability_of_switching_to_searching, cfg.draw_rate, dt
@@ -304,6 +313,11 @@ class CpfaBehaviour:
         return self._avoidance.events
 
     @property
+    def avoidance(self) -> Avoidance:
+        """The robot's collision avoidance (its motion layer's)."""
+        return self._avoidance
+
+    @property
     def switch_probability(self) -> float:
         """p_s per tick of our dt."""
         return self._p_switch
@@ -327,6 +341,7 @@ class CpfaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
+        self._drive.begin(obs.stamp_ns)
         if obs.messages:
             pheromones = _pheromones(obs.messages)
             if pheromones:
@@ -373,7 +388,7 @@ class CpfaBehaviour:
                 return self._start_search(obs, steering)
         elif d2 < self._arrival2 or (self._avoidance.active and d2 < self._blocked2):
             return self._start_search(obs, steering)
-        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits) if steering else _IDLE
+        return self._to_point(x, y, pose.yaw, tx, ty) if steering else _IDLE
 
     def _start_search(self, obs: Observation, steering: bool = True) -> tuple[float, float]:
         self._state = CpfaState.SEARCHING
@@ -388,13 +403,16 @@ class CpfaBehaviour:
             self._state = CpfaState.RETURNING
             return self._returning(obs, steering)
         pose = obs.pose
-        if (pose.x - self._leg_x) ** 2 + (pose.y - self._leg_y) ** 2 >= self._step2:
+        done2 = (pose.x - self._leg_x) ** 2 + (pose.y - self._leg_y) ** 2
+        if done2 >= self._step2:
             self._new_leg(obs)
-        return self._walk(obs) if steering else _IDLE
+            done2 = 0.0
+        return self._walk(obs, done2) if steering else _IDLE
 
-    def _walk(self, obs: Observation) -> tuple[float, float]:
-        """Along the current leg's heading."""
-        return steer(remainder(self._heading - obs.pose.yaw, _TWO_PI), inf, self._limits)
+    def _walk(self, obs: Observation, done2: float = 0.0) -> tuple[float, float]:
+        """Along the current leg's heading, for what is left of the leg (`done2`: the squared
+        distance walked so far [m^2])."""
+        return self._hold(remainder(self._heading - obs.pose.yaw, _TWO_PI), self._search_step - math.sqrt(done2))
 
     def _new_leg(self, obs: Observation) -> None:
         """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
@@ -435,7 +453,7 @@ class CpfaBehaviour:
             if not steering:
                 return _IDLE
             (tx, ty), _ = self._nearest_dock(obs)
-            return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+            return self._to_point(x, y, pose.yaw, tx, ty)
         nx, ny = self._nest
         d2 = (nx - x) ** 2 + (ny - y) ** 2
         if not self._carrying and d2 < self._nest_r2:
@@ -443,7 +461,7 @@ class CpfaBehaviour:
             return self._departing(obs, steering)
         if d2 < self._arrival2 or not steering:
             return _IDLE  # at the centre, waiting for the drop (or the avoidance drives)
-        return go_to_point_twist(x, y, pose.yaw, nx, ny, self._limits)
+        return self._to_point(x, y, pose.yaw, nx, ny)
 
     # ------------------------------------------------------------------ events
 

@@ -17,6 +17,7 @@ STATES = ("DEPARTING", "SEARCHING", "RETURNING")
 
 register(Algorithm(
     name="cpfa",
+    authors_robot="footbot_cpfa",  # CPFA-ARGoS's BaseController on the foot-bot (the queue paper's baseline)
     paper="Hecker & Moses 2015 (Beyond pheromones); the queue paper's baseline (queue_depot_traffic.md sec. VII)",
     behaviour="swarm_controllers.cpfa.behaviour:CpfaBehaviour",
     config=(SECTION,),

@@ -21,9 +21,11 @@ One state machine for both (Fig. 1, Table 1); they differ only in the threshold 
   is ahead within the avoidance distance or it is within half the nest radius of the centre
   (the ARGoS foraging example's robots likewise look for a place in the nest for 50 ticks). It
   consumes no energy meanwhile: only S_S and S_R do (Sec. 3.1).
-* **Obstacle avoidance** (Sec. 2.2) has priority over the ASM in S_S and S_R: the scan-based
-  avoidance of `swarm_controllers.avoidance` (turn away, then a straight escape run of one body
-  length). Each episode is one OAE; the robot counts it and reports it to the nest (AVOIDED).
+* **Obstacle avoidance** (Sec. 2.2) has priority over the ASM in S_S and S_R: the robot model's
+  (`swarm_controllers.motion.Drive.avoidance`; the generic robot's is the scan-based avoidance of
+  `swarm_controllers.avoidance`: turn away, then a straight escape run of one body length; the
+  ``footbot_foraging`` model's the ARGoS foraging example's ``diffusion``). Steering to a token or
+  the light goes through the model's motion layer too. Each episode is one OAE; the robot counts it and reports it to the nest (AVOIDED).
   Waiting robots do not move, so they neither avoid nor count.
 """
 
@@ -34,8 +36,8 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import AvoidThenEscape, ray_window
-from swarm_controllers.motion import DriveLimits, go_to_point_twist, steer
+from swarm_controllers.avoidance import ray_angles, ray_window
+from swarm_controllers.motion import drive_for
 from swarm_controllers.drtm.config import NestConfig, ThresholdConfig
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_controllers.drtm.response_threshold import (
@@ -76,11 +78,13 @@ class ThresholdForager:
         self._robots = scenario.robots.count
         self._side = scenario.arena.size
         self._desired = NestConfig.of(scenario).desired_food
-        self._limits = DriveLimits.from_scenario(scenario)
+        self._drive = drive_for(scenario, rng)
         self._speed = scenario.robots.max_linear_speed
         self._max_turn = scenario.robots.max_angular_speed
-        self._avoid = AvoidThenEscape(scenario, escape_distance=scenario.robots.diameter)
-        self._front = ray_window(self._avoid.avoidance.front_rays)
+        self._avoid = self._drive.avoidance(scenario.robots.diameter)
+        half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
+        self._front = ray_window(i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= half_front)
+        """The front sector's rays (the generic avoidance's), watched while settling into the nest."""
         self._stop_distance = scenario.controller.avoidance.distance
         self._nest_xy = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._settled_r2 = (scenario.depot.radius / 2.0) ** 2
@@ -119,6 +123,7 @@ class ThresholdForager:
 
     def step(self, obs: Observation) -> Command:
         self._stamp = obs.stamp_ns
+        self._drive.begin(obs.stamp_ns)
         for m in obs.messages:
             if type(m) is NestState and (self.nest is None or m.stamp_ns >= self.nest.stamp_ns):
                 self.nest = m
@@ -163,7 +168,7 @@ class ThresholdForager:
         if sense.resources:  # A(t) = 1: the nearest token is the attractor
             x, y = sense.resources[0]
             pose = obs.pose
-            return go_to_point_twist(pose.x, pose.y, pose.yaw, x, y, self._limits)
+            return self._drive.to_point(pose.x, pose.y, pose.yaw, x, y)
         return self._walk()
 
     def _returning(self, obs: Observation, reports: list[NestEvent]) -> tuple[float, float]:
@@ -181,7 +186,7 @@ class ThresholdForager:
             return avoiding
         x, y = sense.light
         if x or y:  # A(t) = 1: the light is the attractor
-            return steer(math.atan2(y, x), math.inf, self._limits)
+            return self._drive.hold(math.atan2(y, x))
         return self._walk()
 
     # ------------------------------------------------------------------ motion
@@ -205,7 +210,7 @@ class ThresholdForager:
         if not (x or y) or dx * dx + dy * dy <= self._settled_r2 or self._blocked(obs.ranges):
             self._settle = 0
             return 0.0, 0.0
-        return steer(math.atan2(y, x), math.inf, self._limits)
+        return self._drive.hold(math.atan2(y, x))
 
     def _blocked(self, ranges: np.ndarray) -> bool:
         return bool(np.min(ranges[self._front]) < self._stop_distance)

@@ -11,7 +11,9 @@ from __future__ import annotations
 import bisect
 from typing import Any
 
+from swarm_controllers.drtm.behaviour import ForagerState
 from swarm_controllers.drtm.config import NestConfig
+from swarm_sim.analysis.state_rules import events_by_state
 
 SERIES_PERIOD = 5.0
 """The time series fields hold one value every this many seconds of sim time [s]."""
@@ -52,6 +54,21 @@ def energy_efficiency(trace: Any) -> float | None:
 def oae_total(trace: Any) -> int:
     """M_T: obstacle-avoidance events of all robots (M_v = M_T / N_r is ``oae_per_robot``)."""
     return sum(s.obstacle_avoidance_events for s in trace.status.values())
+
+
+def oae_by_state(trace: Any) -> dict[str, int] | None:
+    """OAEs by the state (S_S ``searching``, S_R ``returning``) the robot was in when it counted
+    them, from the statuses the robots published (`swarm_sim.analysis.state_rules`; None without
+    them). Their sum is M_T."""
+    return events_by_state(trace.status_log) if trace.status_log else None
+
+
+def oae_returning_total(trace: Any) -> int | None:
+    """The OAEs of robots in state S_R over the run: what the paper's M_T2 counts ("the number
+    of OAEs due to robots within state S_R", Sec. 2.2, eq. (5)), over the whole run instead of
+    the last T_2."""
+    by_state = oae_by_state(trace)
+    return None if by_state is None else by_state.get(ForagerState.RETURNING.value, 0)
 
 
 def _sampled(points: list[tuple[float, float]], end: float) -> list[list[float]]:

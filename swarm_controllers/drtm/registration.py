@@ -22,7 +22,7 @@ _SERVER = ServerSpec(
 _METRICS = tuple(
     Metric(name, f"swarm_controllers.drtm.metrics:{name}", None)
     for name in ("food_deviation", "energy_efficiency", "oae_total", "food_collected", "nest_food_final",
-                 "nest_food_series", "active_robots_series", "oae_series")
+                 "nest_food_series", "active_robots_series", "oae_series", "oae_by_state", "oae_returning_total")
 )
 
 _HEADLINE = (Measure("food_deviation", "tokens", "V_f"), Measure("energy_efficiency", "%", "E_e", scale=100.0),
@@ -42,6 +42,7 @@ for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
                              ("artm", "ArtmBehaviour", "ARTM (Castello et al.), the baseline")):
     register(Algorithm(
         name=_name,
+        authors_robot="footbot_foraging",  # the ARGoS foraging example's set-up (see swarm_sim.robots)
         paper=f"drtm_task_allocation.md (Pang et al. 2023) secs. 2-4: {_what}",
         behaviour=f"swarm_controllers.drtm.behaviour:{_class}",
         task="nest",
@@ -53,4 +54,5 @@ for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
         headline=_HEADLINE,
         panels=_PANELS,
         states=("waiting", "searching", "returning"),
+        trace_status=True,
     ))

@@ -33,6 +33,7 @@ register_probe(Probe(
 
 register(Algorithm(
     name="queue",
+    authors_robot="footbot_cpfa",  # Tameem786/ and Artglz/Collision_Free_CPFA
     paper="queue_depot_traffic.md secs. III-V: Q_SE, Q_ST, Q_ME, Q_MT",
     behaviour="swarm_controllers.queue.behaviour:QueueBehaviour",
     config=(CPFA_SECTION, ("queue", "depot_manager.config:QueueConfig")),
@@ -46,7 +47,12 @@ register(Algorithm(
     metrics=(
         Metric("queue_length_mean", "depot_manager.metrics:queue_length_mean", 0.0),
         Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
+        Metric("authors_collision_time_per_robot_s",
+               "swarm_controllers.queue.authors_count:authors_collision_time_per_robot_s", None),
+        Metric("authors_collision_time_total_min",
+               "swarm_controllers.queue.authors_count:authors_collision_time_total_min", None),
     ),
+    collision_rule="swarm_controllers.queue.authors_count:collision_rule",
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
     headline=(*HEADLINE, Measure("perimeter_delay_mean_s", "s", "time delay"),
               Measure("queue_length_mean", "robots"), Measure("queue_length_max", "robots")),

@@ -88,9 +88,9 @@ from enum import Enum
 
 import numpy as np
 
-from swarm_controllers.avoidance import AvoidThenEscape, ray_angles
+from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.spiral.config import SpiralConfig
-from swarm_controllers.motion import DriveLimits, go_to_point_twist
+from swarm_controllers.motion import Drive, drive_for
 from swarm_controllers.spiral.geometry import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import (
@@ -122,13 +122,15 @@ class LaneAvoidance:
     ends, so its state never goes stale between calls.
     """
 
-    def __init__(self, scenario: Scenario, *, lookahead: float | None = None,
+    def __init__(self, scenario: Scenario, drive: Drive | None = None, *, lookahead: float | None = None,
                  yield_timeout: float = LANE_YIELD_TIMEOUT) -> None:
-        """lookahead [m from the robot's centre]: default one robot diameter (it must stay
+        """drive: the robot's motion layer, whose avoidance is the general one (default: the robot
+        model's). lookahead [m from the robot's centre]: default one robot diameter (it must stay
         below ``controller.spiral.arena_margin`` so the wall beyond a lane's end does not
         block the lane). yield_timeout [s, sim time]."""
         r = scenario.robots
-        self.general = AvoidThenEscape(scenario, escape_distance=r.diameter, keep_right=True)
+        drive = drive_for(scenario) if drive is None else drive
+        self.general = drive.avoidance(r.diameter, keep_right=True)
         self.lookahead = r.diameter if lookahead is None else float(lookahead)
         self.approach_radius = scenario.controller.avoidance.distance + r.diameter / 2.0
         """A robot this close to a point of its lane [m] drives onto it in lane mode: the general
@@ -230,8 +232,9 @@ class DdsaBehaviour:
         """This robot's spiral [m, world frame]."""
         self._wp = [(float(x), float(y)) for x, y in self.path.waypoints]
         self._cum = [float(c) for c in self.path.cumulative]
-        self._limits = DriveLimits.from_scenario(scenario)
-        self._avoidance = LaneAvoidance(scenario)
+        self._drive = drive_for(scenario, rng)
+        self._to_point = self._drive.to_point
+        self._avoidance = LaneAvoidance(scenario, self._drive)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
         self._carrot = sp.gap
@@ -291,6 +294,7 @@ class DdsaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
+        self._drive.begin(obs.stamp_ns)
         carrying = bool(obs.sensed.carrying)
         if carrying != self._carrying:
             self._carrying = carrying
@@ -341,9 +345,9 @@ class DdsaBehaviour:
         self._update_progress(x, y)
         if obs.sensed.resources and not self._carrying:
             rx, ry = obs.sensed.resources[0]
-            return go_to_point_twist(x, y, pose.yaw, float(rx), float(ry), self._limits)
+            return self._to_point(x, y, pose.yaw, float(rx), float(ry))
         tx, ty = self._lane_target()
-        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+        return self._to_point(x, y, pose.yaw, tx, ty)
 
     def _lane_target(self) -> tuple[float, float]:
         """The point one gap ahead of the progress on the current leg (the leg's end when
@@ -393,7 +397,7 @@ class DdsaBehaviour:
             self._next = max(self.path.next_waypoint_index(s), 0)
             self._state = DdsaState.SEARCHING
             return self._searching(obs)
-        return go_to_point_twist(pose.x, pose.y, pose.yaw, tx, ty, self._limits)
+        return self._to_point(pose.x, pose.y, pose.yaw, tx, ty)
 
     def _to_depot(self, obs: Observation) -> tuple[float, float]:
         """RETURNING: to the centre (the world drops the resource in the depot disc)."""
@@ -403,7 +407,7 @@ class DdsaBehaviour:
         d2 = (cx - x) ** 2 + (cy - y) ** 2
         if d2 < self._arrival2:
             return 0.0, 0.0
-        return go_to_point_twist(x, y, pose.yaw, cx, cy, self._limits)
+        return self._to_point(x, y, pose.yaw, cx, cy)
 
 
 def planned_paths(scenario: Scenario) -> list[np.ndarray]:

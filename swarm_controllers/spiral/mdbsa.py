@@ -82,7 +82,7 @@ from swarm_controllers.spiral.center import region_paths
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.ddsa import LaneAvoidance
-from swarm_controllers.motion import DriveLimits, go_to_point_twist
+from swarm_controllers.motion import drive_for
 from swarm_controllers.spiral.geometry import SpiralPath
 from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.scenario import Scenario
@@ -165,8 +165,9 @@ class MdbsaBehaviour:
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
         self._idle_r2 = float(RegionConfig.of(scenario).center_radius) ** 2
-        self._limits = DriveLimits.from_scenario(scenario)
-        self._avoidance = LaneAvoidance(scenario)
+        self._drive = drive_for(scenario, rng)
+        self._to_point = self._drive.to_point
+        self._avoidance = LaneAvoidance(scenario, self._drive)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
         self._arrival2 = scenario.controller.arrival_tolerance**2
@@ -237,6 +238,7 @@ class MdbsaBehaviour:
 
     def step(self, obs: Observation) -> Command:
         self._stamp_ns = obs.stamp_ns
+        self._drive.begin(obs.stamp_ns)
         self._outbox = []
         for m in obs.messages:
             if isinstance(m, RegionAssignment) and m.robot == self.robot:
@@ -257,8 +259,7 @@ class MdbsaBehaviour:
             linear, angular = self._delivering(obs)
         elif state is MdbsaState.IDLE:
             assert self._idle_at is not None
-            linear, angular = go_to_point_twist(obs.pose.x, obs.pose.y, obs.pose.yaw,
-                                                *self._idle_at, self._limits)
+            linear, angular = self._to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._idle_at)
         else:
             linear, angular = self._to_center(obs)
         if self._state is MdbsaState.WAITING:  # just reported; stand from now on
@@ -386,7 +387,7 @@ class MdbsaBehaviour:
             self._ask(obs)
             return 0.0, 0.0
         pose = obs.pose
-        return go_to_point_twist(pose.x, pose.y, pose.yaw, *self._center, self._limits)
+        return self._to_point(pose.x, pose.y, pose.yaw, *self._center)
 
     def _walk_over(self, obs: Observation) -> tuple[float, float]:
         self._state = MdbsaState.TO_CENTER
@@ -411,9 +412,9 @@ class MdbsaBehaviour:
             return self._walk_over(obs)
         if obs.sensed.resources and not self._carrying:
             rx, ry = obs.sensed.resources[0]
-            return go_to_point_twist(x, y, pose.yaw, float(rx), float(ry), self._limits)
+            return self._to_point(x, y, pose.yaw, float(rx), float(ry))
         tx, ty = self._lane_target(w)
-        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+        return self._to_point(x, y, pose.yaw, tx, ty)
 
     @staticmethod
     def _project(w: _Walk, x: float, y: float) -> None:
@@ -456,7 +457,7 @@ class MdbsaBehaviour:
             w.next = max(w.path.next_waypoint_index(w.u), 1)
             self._state = MdbsaState.SEARCHING
             return self._searching(obs)
-        return go_to_point_twist(pose.x, pose.y, pose.yaw, tx, ty, self._limits)
+        return self._to_point(pose.x, pose.y, pose.yaw, tx, ty)
 
     def _delivering(self, obs: Observation) -> tuple[float, float]:
         pose = obs.pose
@@ -474,4 +475,4 @@ class MdbsaBehaviour:
             tx, ty = min(self._drops, key=lambda c: (c[0] - x) ** 2 + (c[1] - y) ** 2)
         if (tx - x) ** 2 + (ty - y) ** 2 < self._arrival2:
             return 0.0, 0.0  # inside the zone: the world drops it this tick or the next
-        return go_to_point_twist(x, y, pose.yaw, tx, ty, self._limits)
+        return self._to_point(x, y, pose.yaw, tx, ty)

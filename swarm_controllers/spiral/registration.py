@@ -30,8 +30,12 @@ register_delivery(DeliveryKind(
     resources_inside=True,
 ))
 
+_AUTHORS_ROBOT = "footbot_cpfa"
+"""MARSLab-UTRGV's spiral code drives the foot-bot with the CPFA lineage's BaseController."""
+
 register(Algorithm(
     name="ddsa",
+    authors_robot=_AUTHORS_ROBOT,
     paper="mdbsa_spiral_search.md sec. III (Lu & Luna 2023): DDSA",
     behaviour="swarm_controllers.spiral.ddsa:DdsaBehaviour",
     config=(_SECTION,),
@@ -47,6 +51,7 @@ register(Algorithm(
 for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
     register(Algorithm(
         name=_name,
+        authors_robot=_AUTHORS_ROBOT,
         paper=f"mdbsa_spiral_search.md sec. IV (Lu & Luna 2023): MDBSA-{_name[-1].upper()}",
         behaviour="swarm_controllers.spiral.mdbsa:MdbsaBehaviour",
         config=(_SECTION,),

@@ -63,6 +63,11 @@ class RunTrace:
     foreign: list[str] = field(default_factory=list)
     """Publishers seen on the run's topics that were none of its nodes (`swarm_sim.nodes.taint`):
     the run is tainted, its results may hold what they sent."""
+    rule_collision_s: dict[RobotId, float] | None = None
+    """Per robot, collision time [s] by the algorithm's state-dependent rule
+    (`swarm_sim.registry.Algorithm.collision_rule`; None without one)."""
+    status_log: dict[RobotId, list[BehaviourStatus]] = field(default_factory=dict)
+    """Per robot, every status it published, in order (`swarm_sim.registry.Algorithm.trace_status`)."""
 
 
 def resources_delivered(trace: RunTrace) -> int:

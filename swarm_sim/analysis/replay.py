@@ -22,10 +22,11 @@ from typing import Any
 import numpy as np
 
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py import diagnostics, odometry, topics
+from swarm_msgs_py import diagnostics, odometry, scan, topics
 from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
+from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.inbound import Bounds, Inbound, Rejections
 from swarm_sim.messaging import delivery_order
 from swarm_sim.recording import BagError, bag_info, read_bag
@@ -63,6 +64,8 @@ def load_run(path: Path | str) -> RunTrace:
         peers.update(dict.fromkeys(family.topics.values(), family))
     index = {r: i for i, r in enumerate(trace.robots)}
     positions: dict[int, np.ndarray] = {}  # stamp -> (robots, 2) odometry positions
+    statuses = StatusLog(trace.robots)
+    rings = _Rings(scenario) if algorithm.collision_rule else None  # the scans whose ring reads something
     last_clock = 0
     gate = Inbound(trace.robots, scenario.dt_ns, Rejections(), lambda line: None, Bounds.of(scenario))
     families = {t: registry.resolve(spec.family) for spec in algorithm.servers
@@ -106,6 +109,11 @@ def load_run(path: Path | str) -> RunTrace:
                     raise ValueError(f"counts beyond one a tick ({status.obstacle_avoidance_events} OAE, "
                                      f"{status.trips} trips in {scenario.ticks} ticks)")
                 trace.status[status.robot] = status
+                statuses.published(status)
+            elif rings is not None and m.topic.endswith("/" + topics.SCAN):
+                robot = m.topic[1:].partition("/")[0]
+                if robot in index:
+                    rings.add(index[robot], *scan.decode_scan(m.data))
             elif m.topic in state:
                 st = state[m.topic]
                 stamp, value = st.decode(m.data)
@@ -129,6 +137,12 @@ def load_run(path: Path | str) -> RunTrace:
     trace.lost = list(info.lost)
     if trace.lost and trace.ended == "complete":  # what is missing may be anything: never "complete"
         trace.ended = "incomplete bag"
+    if algorithm.trace_status:
+        trace.status_log = statuses.log
+    if rings is not None:
+        log = RuleLog(trace.robots, registry.resolve(algorithm.collision_rule)(scenario), scenario.sim.dt)
+        rings.replay(log, statuses)
+        trace.rule_collision_s = log.seconds()
     return trace
 
 
@@ -147,6 +161,34 @@ def _strings(path: Path, key: str, text: str) -> list[str]:
         pass
     warnings.warn(f"{path}: ignoring malformed {key} metadata {text[:80]!r}", MalformedMessageWarning, stacklevel=3)
     return []
+
+
+
+class _Rings:
+    """The recorded scans on which a robot's proximity ring reads something, for the state rules
+    (`swarm_sim.analysis.state_rules`): its vectors computed as the batch runner computes them."""
+
+    def __init__(self, scenario) -> None:
+        from swarm_sim.world.proximity import (
+            ProximityRing,  # lazy: loads the world (pybullet); only state-rule replays need it
+        )
+
+        self._ring = ProximityRing(scenario)
+        self._reach = scenario.robots.diameter / 2 + scenario.sensors.proximity_ring.range
+        self._rows: list[tuple[int, int, np.ndarray]] = []  # (stamp, robot index, ranges)
+
+    def add(self, i: int, stamp_ns: int, ranges: np.ndarray) -> None:
+        if ranges.size and float(ranges.min()) - self._reach <= 1e-9:
+            self._rows.append((stamp_ns, i, ranges))
+
+    def replay(self, log: RuleLog, statuses: StatusLog) -> None:
+        if not self._rows:
+            return
+        self._rows.sort(key=lambda row: row[:2])
+        x, y = self._ring.vectors(np.stack([r for _, _, r in self._rows]))
+        robots = log.robots
+        for (stamp, i, _), xi, yi in zip(self._rows, x.tolist(), y.tolist()):
+            log.add(i, xi, yi, statuses.at(robots[i], stamp))
 
 
 def _server_stale(path: Path, text: str) -> dict[str, int]:

@@ -4,17 +4,22 @@ single-comparison subcommands and ``all`` (`swarm_sim.compare.reproduce`) share.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from swarm_sim import compare
+from swarm_sim import compare, registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import note_cut_runs
-from swarm_sim.compare.sweep import FAILED, RESULTS, ResultsFileError, RunFunction, run_sweep
+from swarm_sim.compare.sweep import FAILED, RESULTS, ResultsFileError, RunFunction, RunPlan, run_sweep
 from swarm_sim.executors import Executor, add_executor_arguments
+from swarm_sim.robots import known_models
 from swarm_sim.scenario import ScenarioError, load_scenario
+
+AUTHORS = "authors"
+"""``--robot-model authors``: each run on its algorithm's authors' robot (`registry.Algorithm.authors_robot`)."""
 
 
 def strategies_of(text: Sequence[str] | None, known: Sequence[str], parser: argparse.ArgumentParser) -> list[str]:
@@ -38,6 +43,9 @@ def common_arguments(p: argparse.ArgumentParser, out: str, *, strategies: bool =
                    help="sim seconds (sim.duration), overrides the paper's")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override any scenario field for every run")
+    p.add_argument("--robot-model", choices=(*known_models(), AUTHORS), metavar="NAME",
+                   help=f"the robot model of every run ({', '.join(known_models())}; {AUTHORS}: each "
+                        "algorithm's authors' robot); default: each scenario's own (generic)")
     if strategies:
         p.add_argument("--strategies", nargs="+", metavar="NAME", help="a subset of the strategies")
     mode = p.add_mutually_exclusive_group()
@@ -60,10 +68,28 @@ def build_parser(comparisons: Mapping[str, Comparison]) -> argparse.ArgumentPars
     return parser
 
 
+def plans_of(comparison: Comparison, args: argparse.Namespace, strategies: list[str]) -> list[RunPlan]:
+    """The comparison's runs, on the robot model ``--robot-model`` asks for (``robots.model`` set
+    before the user's ``--set``s, which still win)."""
+    plans = comparison.plans(args, strategies)
+    model = getattr(args, "robot_model", None)
+    if not model:
+        return plans
+    out = []
+    for plan in plans:
+        name = model
+        if model == AUTHORS:
+            scenario = load_scenario(plan.strategy, plan.overrides, **dict(plan.fields))
+            name = registry.of(scenario).authors_robot
+        given = tuple(o for o in plan.overrides if o not in args.overrides)
+        out.append(dataclasses.replace(plan, overrides=(*given, f"robots.model={name}", *args.overrides)))
+    return out
+
+
 def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies: list[str], *,
                    run: RunFunction | None, executor: Executor) -> tuple[int, list[Path]]:
     """One comparison's sweep then its report: (exit status, files written)."""
-    plans = comparison.plans(args, strategies)
+    plans = plans_of(comparison, args, strategies)
     out = comparison.out_dir(args)
     if run is None:
         for plan in plans:

@@ -20,7 +20,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.commands import build_parser, run_comparison
+from swarm_sim.compare.commands import build_parser, plans_of, run_comparison
 from swarm_sim.compare.report import md_table
 from swarm_sim.compare.sweep import RESULTS, RunFunction, read_results
 from swarm_sim.executors import Executor, executor_from_args
@@ -49,6 +49,8 @@ def sweep_argv(name: str, options: Sequence[str], args: argparse.Namespace, out:
         argv += ["--duration", repr(args.duration)]
     for text in args.overrides:
         argv += ["--set", text]
+    if getattr(args, "robot_model", None):
+        argv += ["--robot-model", args.robot_model]
     if args.resume:
         argv.append("--resume")
     if args.overwrite:
@@ -97,7 +99,7 @@ def reproduce_all(args: argparse.Namespace, comparisons: Mapping[str, Comparison
 
 def _rows(out: Path, comparison: Comparison, args: argparse.Namespace, strategies: list[str]) -> list[dict]:
     """This sweep's rows from its results file (the plans' strategies and settings only)."""
-    keys = {(p.strategy, p.settings) for p in comparison.plans(args, strategies)}
+    keys = {(p.strategy, p.settings) for p in plans_of(comparison, args, strategies)}
     return [r for r in read_results(out / RESULTS) if (r.get("strategy"), r.get("settings")) in keys]
 
 
@@ -117,6 +119,8 @@ def write_report(reports: Sequence[SweepReport], args: argparse.Namespace) -> Pa
     if args.duration is not None:
         command += f" --duration {args.duration:g}"
     command += "".join(f" --set {s}" for s in args.overrides)
+    if getattr(args, "robot_model", None):
+        command += f" --robot-model {args.robot_model}"
     lines = ["# The papers' results, reproduced", "",
              f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, seeds "
              f"0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held: each "

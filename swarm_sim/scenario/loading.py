@@ -27,6 +27,7 @@ from typing import Any, Literal, get_args, get_origin
 import yaml
 
 from swarm_sim import registry
+from swarm_sim.robots import apply_model
 from swarm_sim.scenario.schema import ControllerConfig, Scenario, ScenarioError
 from swarm_sim.scenario.validation import validate
 
@@ -223,7 +224,15 @@ def load_scenario(
     for key, value in fields.items():
         if value is not None:
             _set_path(data, key.replace("__", "."), value)
-    scenario = _build(Scenario, data, "")
+    return _finish(_build(Scenario, data, ""))
+
+
+def _finish(scenario: Scenario) -> Scenario:
+    """The robot model's values written in (`swarm_sim.robots.apply_model`), then validated."""
+    try:
+        scenario = apply_model(scenario)
+    except ValueError as exc:
+        raise ScenarioError(str(exc)) from None
     validate(scenario)
     return scenario
 
@@ -290,6 +299,4 @@ def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
 
 def scenario_from_dict(data: dict[str, Any]) -> Scenario:
     """The scenario `scenario_to_dict` wrote (bag metadata), built and validated again."""
-    scenario = _build(Scenario, data, "")
-    validate(scenario)
-    return scenario
+    return _finish(_build(Scenario, data, ""))

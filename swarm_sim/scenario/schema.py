@@ -65,10 +65,74 @@ class NoiseConfig:
 
 
 @dataclass(frozen=True)
+class PlatformConfig:
+    """Single values of a platform robot model overridden (to vary one factor at a time); None
+    keeps the model's. The generic robot takes these from ``robots`` itself and refuses them here."""
+
+    diameter: float | None = None
+    """[m]"""
+    height: float | None = None
+    """[m]"""
+    mass: float | None = None
+    """[kg]"""
+    max_linear_speed: float | None = None
+    """[m/s]"""
+    max_angular_speed: float | None = None
+    """[rad/s]"""
+
+
+@dataclass(frozen=True)
+class StopTurnGoConfig:
+    """The CPFA lineage's ``BaseController`` settings, read by the ``footbot_cpfa`` model's motion
+    (`swarm_controllers.robots.stop_turn_go`). Defaults: the queue paper's authors' experiment files
+    (Tameem786/Collision_Free_CPFA, ``experiments/*.xml``, ``<settings>``); the spiral paper's
+    authors use 0.05 rad and 0.01 m (MARSLab-UTRGV, branch luki-dev, ``Distributed/experiments``)."""
+
+    angle_tolerance: float = 0.1
+    """``TargetAngleTolerance`` [rad]: a larger heading error is turned out on the spot first."""
+    distance_tolerance: float = 0.05
+    """``TargetDistanceTolerance`` [m]: a target this close is reached (the robot stops)."""
+    collision_step: float = 0.08
+    """``SearchStepSize`` [m]: the blind step pushed after a collision turn."""
+
+
+@dataclass(frozen=True)
+class WheelTurningConfig:
+    """The ARGoS foraging example's ``wheel_turning`` and ``diffusion`` parameters
+    (ilpincy/argos3-examples, ``experiments/foraging.argos``), read by the ``footbot_foraging``
+    model's motion (`swarm_controllers.robots.wheel_turning`)."""
+
+    hard_turn_angle: float = 90.0
+    """``hard_turn_angle_threshold`` [deg]: above it the robot turns in place."""
+    soft_turn_angle: float = 70.0
+    """``soft_turn_angle_threshold`` [deg]: a hard turn becomes soft at or below it."""
+    no_turn_angle: float = 10.0
+    """``no_turn_angle_threshold`` [deg]: at or below it the robot drives straight."""
+    go_straight_angle: float = 5.0
+    """``go_straight_angle_range`` = -5:5 [deg]: the proximity vector within it, and shorter
+    than `delta`, is ignored."""
+    delta: float = 0.1
+    """``delta``: the longest proximity vector (sum of the 24 readings) ignored."""
+
+
+@dataclass(frozen=True)
 class RobotConfig:
+    model: str = "generic"
+    """The robot model (`swarm_sim.robots`): ``generic`` (this section's values as they are),
+    ``footbot_cpfa`` (the ARGoS foot-bot with the CPFA lineage's stop-turn-go motion: the queue and
+    spiral papers' authors'), ``footbot_foraging`` (the foot-bot with the ARGoS foraging example's
+    motion and sensors: the DRTM paper's), ``khepera3`` (the caging paper's). A platform model
+    fixes diameter, height, mass and both speed limits (`platform` overrides single ones), its
+    sensors and its motion layer."""
+    planar: bool | None = None
+    """The world keeps the robots exactly upright; None: the model's choice (every platform
+    model yes, the generic robot no)."""
+    platform: PlatformConfig = field(default_factory=PlatformConfig)
+    stop_turn_go: StopTurnGoConfig = field(default_factory=StopTurnGoConfig)
+    wheel_turning: WheelTurningConfig = field(default_factory=WheelTurningConfig)
     count: int = 16
     diameter: float = 0.17
-    """Foot-bot-like cylinder diameter [m]."""
+    """Foot-bot-like cylinder diameter [m] (a platform `model` sets its own)."""
     height: float = 0.1
     """[m]; only matters for pybullet's collision shapes."""
     max_linear_speed: float = 0.16

@@ -86,6 +86,15 @@ def check_world(s: Scenario) -> None:
     _require(0 < r.max_angular_speed <= MAX_ANGULAR_SPEED,
              f"robots.max_angular_speed: must be positive and at most {MAX_ANGULAR_SPEED:g} rad/s")
     _require(r.mass > 0, "robots.mass: must be positive")
+    stg = r.stop_turn_go
+    _require(stg.angle_tolerance > 0, "robots.stop_turn_go.angle_tolerance: must be positive")
+    _require(stg.distance_tolerance > 0, "robots.stop_turn_go.distance_tolerance: must be positive")
+    _require(stg.collision_step >= 0, "robots.stop_turn_go.collision_step: must not be negative")
+    wt = r.wheel_turning
+    _require(0 <= wt.no_turn_angle <= wt.soft_turn_angle <= wt.hard_turn_angle <= 180,
+             "robots.wheel_turning: need 0 <= no_turn_angle <= soft_turn_angle <= hard_turn_angle <= 180 deg")
+    _require(0 <= wt.go_straight_angle <= 180, "robots.wheel_turning.go_straight_angle: must be in [0, 180] deg")
+    _require(wt.delta >= 0, "robots.wheel_turning.delta: must not be negative")
     _require(
         r.start_spacing >= r.diameter,
         f"robots.start_spacing: {r.start_spacing} m is less than the robot diameter {r.diameter} m",

@@ -11,8 +11,8 @@ control. Every physics substep sets each robot's base velocity to (v cos yaw, v 
 (0, 0, w) (unless pybullet already holds exactly that: `World._set_velocities`) and lets
 pybullet resolve contacts, so robots push each other and stop at walls.
 Tipping is prevented by a huge roll/pitch inertia and zero friction/damping (measured: tilt
-below 1e-9); contact normals are horizontal, so yaw changes only by the commanded turn rate,
-which is why later substeps predict the heading (yaw + w * j * dt_sub) instead of reading it
+below 1e-9; a planar robot's, `PLANAR_TILT_INERTIA`, keeps it below 1e-30); contact normals
+are horizontal, so yaw changes only by the commanded turn rate, which is why later substeps predict the heading (yaw + w * j * dt_sub) instead of reading it
 back. Contact solving leaves a tiny z drift (measured: ~5e-6 m over 100 s of a crowded
 16-robot run, ~5e-5 m for 112 robots pushing into each other); the first substep of each tick
 adds the vz that returns the body to z = height/2. Robot-robot contact is counted every substep
@@ -63,7 +63,17 @@ from swarm_sim.world.start import start_positions
 from swarm_sim.world.tasks import TaskFactory, WorldTask
 
 TILT_INERTIA = 1e6
-"""Roll and pitch inertia [kg m^2]: large enough that contacts never tip a robot."""
+"""Roll and pitch inertia [kg m^2] of a robot that is not planar (``robots.planar``; the generic
+robot): large enough that contacts never tip it, though they leave tilts below 1e-9 (and turning
+while so tilted adds ~1e-12 rad/s to its angular velocity). A planar robot's is
+`PLANAR_TILT_INERTIA`, as no authors' platform tilts robots (ARGoS's dynamics2d is planar)."""
+PLANAR_TILT_INERTIA = 1e30
+"""Roll and pitch inertia [kg m^2] of a planar robot (``robots.planar``; every platform model): its
+tilt stays below 1e-30 rad (measured, 112 robots crowding in Q_MT: 8.5e-31), so it never tilts in
+any sense a float can tell from its heading, and a robot that touches nothing keeps the velocity it
+was given bit for bit while it turns (measured: 64,234 checks, none off), so its velocity is only
+re-set after contacts (`World._velocities_kept`). Not infinite: Bullet's multibody then computes
+NaN; not 1e300: its products underflow to subnormal floats, which tripled the physics' time."""
 CONTACT_TOLERANCE = 1e-3
 """Two robots whose pybullet contact distance is at most this [m] are in contact (pybullet also
 reports points a few mm apart that it merely watches)."""
@@ -170,6 +180,7 @@ class World:
         rc = scenario.robots
         self._radius = rc.diameter / 2
         self._z0 = rc.height / 2
+        self._planar = bool(rc.planar)
         self._vmax = rc.max_linear_speed
         self._wmax = rc.max_angular_speed
         noise = rc.odometry_noise
@@ -215,6 +226,7 @@ class World:
         )
         mass = s.robots.mass
         izz = 0.5 * mass * self._radius**2
+        tilt = PLANAR_TILT_INERTIA if s.robots.planar else TILT_INERTIA
         self._bodies: list[int] = []
         for i, (x, y) in enumerate(starts):
             body = p.createMultiBody(
@@ -224,7 +236,7 @@ class World:
             p.changeDynamics(
                 body, -1, lateralFriction=0.0, spinningFriction=0.0, rollingFriction=0.0,
                 restitution=0.0, linearDamping=0.0, angularDamping=0.0,
-                localInertiaDiagonal=[TILT_INERTIA, TILT_INERTIA, izz],
+                localInertiaDiagonal=[tilt, tilt, izz],
                 activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING,
                 collisionMargin=min(ROBOT_COLLISION_MARGIN, self._radius / 2), physicsClientId=cid,
             )
@@ -338,6 +350,19 @@ class World:
     def headings(self) -> np.ndarray:
         """(n,) true robot yaws [rad, world frame] in robot order (read-only view for tasks)."""
         return self._yaw
+
+    @property
+    def scan_ranges(self) -> np.ndarray:
+        """(n, rays) the current tick's scan ranges [m, float32, from the robots' centres], in
+        robot order (read-only: the rows the observations hold)."""
+        if self._obs_cache is None:
+            self.observe()
+        return self._ranges
+
+    @property
+    def ring(self) -> ProximityRing:
+        """The proximity ring the world counts collision time with (`swarm_sim.world.proximity`)."""
+        return self._ring
 
     @property
     def dt_ns(self) -> int:
@@ -476,7 +501,10 @@ class World:
         ARTM runs: every robot this selects (42-100 % of them) read back bit for bit the velocity
         set. Skipping a call also moves the update of the body's bounding box from the call into
         stepSimulation, which can leave pybullet's broadphase with other far-apart pairs (that
-        carry no contact points) for a while; the runs stay bit for bit the same (test_world)."""
+        carry no contact points) for a while; the runs stay bit for bit the same (test_world).
+        A planar robot (`PLANAR_TILT_INERTIA`) keeps its velocity while it turns, tilted or not."""
+        if self._planar:
+            return ~touching
         return (~turning | self._upright) & ~touching
 
     def _odometry(self, pos0: np.ndarray, yaw0: np.ndarray) -> None:
@@ -525,6 +553,7 @@ class World:
                 self._pairs,
             )
         ranges.flags.writeable = False
+        self._ranges = ranges
         self._ring_ahead = self._ring.ahead(ranges)
         sensed = self.task.sense()
         obs = observations(self.robots, self.t_ns, self._odo, self._meas_v, self._meas_w, ranges, sensed)

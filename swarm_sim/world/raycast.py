@@ -67,6 +67,15 @@ def is_full_circle(fov: float) -> bool:
     return fov >= TWO_PI - 1e-9
 
 
+def evenly_round(rays: int, fov: float) -> bool:
+    """The rays are evenly spaced all the way round: a full circle, or a partial fov whose rays'
+    spacing closes the circle (24 rays over 345 deg: the foot-bot's ring, 15 deg apart from
+    -172.5 deg). The analytic scan then wraps its windows and tests a far robot on one ray."""
+    if is_full_circle(fov):
+        return True
+    return rays > 1 and abs(fov / (rays - 1) * rays - TWO_PI) < 1e-9
+
+
 def scan_angles(rays: int, fov: float) -> tuple[float, float]:
     """(angle_min, angle_increment) [rad, relative to the heading], as the codec sends them.
 
@@ -393,7 +402,7 @@ def nearest_hits(
     headings = np.ascontiguousarray(headings, dtype=float)
     n = len(origins)
     angle_min, inc = scan_angles(rays, fov)
-    full = is_full_circle(fov)
+    full = evenly_round(rays, fov)
     range_max = float(range_max)
     ox, oy = origins[:, 0].copy(), origins[:, 1].copy()
     # Ray directions and bearings by numpy: its cos, sin and arctan2 differ from libm's in the

@@ -20,7 +20,8 @@ DURATION = 40.0
 BUSY = ["resources.count=60"]
 """More food than the paper's 20 so that robots deliver within 40 s."""
 NEST_FIELDS = ("food_deviation", "energy_efficiency", "oae_total", "food_collected", "nest_food_final",
-               "nest_food_series", "active_robots_series", "oae_series", "oae_by_robot", "trips_by_robot")
+               "nest_food_series", "active_robots_series", "oae_series", "oae_by_robot", "trips_by_robot",
+               "oae_by_state", "oae_returning_total")
 
 
 def test_drtm_graph_run_publishes_the_nest_state_every_tick(tmp_path):

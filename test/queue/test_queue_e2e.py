@@ -49,6 +49,7 @@ def test_qmt_graph_run_delivers_at_docks_only(tmp_path):
 
     # the same seed in process gives the same run
     batch = summarize(run_batch(load_scenario("queue_qmt", [f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])).trace)
+    assert summary["authors_collision_time_per_robot_s"] is not None
     for key in ("resources_delivered", "collision_time_per_robot_s", "dropoff_times_s", "perimeter_delay_mean_s",
-                "queue_length_max"):
+                "queue_length_max", "authors_collision_time_per_robot_s", "authors_collision_time_total_min"):
         assert batch[key] == summary[key], key
