@@ -19,7 +19,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioRep
 from depot_manager.server import MARKER_PERIOD, draw
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
-from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState, Series
+from swarm_msgs_py.server_outputs import LivePlot, ServerMarkers, ServerOutputs, ServerState, Series
 from depot_manager.state import DepotView, decode_depot_state, encode_depot_state
 
 DEPOT_REPORTS = "/depot/reports"
@@ -36,8 +36,32 @@ def _queue_lengths(depot: DepotView) -> dict[str, tuple[int, ...]]:
     return {"queue_lengths": tuple(n for _, n in depot.queues)}
 
 
+_QUEUES_SCRIPT = """\
+// /depot/state: the status named "queues" holds each entry line's queue length -> numbers.
+import {{ Input }} from "./types";
+
+type Output = {{ total: number; longest: number; lines: number }};
+
+export const inputs = ["/depot/state"];
+export const output = "{prefix}depot_queues";
+
+export default function script(event: Input<"/depot/state">): Output | undefined {{
+  const queues = event.message.status.find((s) => s.name === "queues");
+  if (queues === undefined) return undefined;
+  const lengths = queues.values.map((kv) => Number(kv.value));
+  return {{
+    total: lengths.reduce((a, b) => a + b, 0),
+    longest: lengths.length ? Math.max(...lengths) : 0,
+    lines: lengths.length,
+  }};
+}}
+"""
+
+
 OUTPUTS = ServerOutputs(
     state=(ServerState(DEPOT_STATE, TYPE_NAME, "depot", encode_depot_state, decode_depot_state),),
     markers=ServerMarkers(DEPOT_MARKERS, draw, MARKER_PERIOD),
     series=(Series(DEPOT_STATE, _queue_lengths, on_change=True),),
+    live=(LivePlot("depot_queues", "depot queues", "depot queue lengths [robots]", _QUEUES_SCRIPT,
+                   (("total", "robots queued (all entry lines)"), ("longest", "longest entry line"))),),
 )

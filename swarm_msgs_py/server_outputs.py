@@ -82,10 +82,29 @@ class Series:
 
 
 @dataclass(frozen=True)
+class LivePlot:
+    """A plot of what a server publishes, in the shipped live layouts
+    (`swarm_sim.nodes.foxglove_layout`): Foxglove's plots read no numbers from strings, so a user
+    script (TypeScript, run inside Foxglove or Lichtblick) turns the server's state into numbers."""
+
+    key: str
+    """The script's key, and the last part of its output topic."""
+    name: str
+    title: str
+    """The plot's title, with its unit."""
+    script: str
+    """The TypeScript source; ``{prefix}`` stands for where its output topic must start
+    (Foxglove's and Lichtblick's differ), literal braces are doubled."""
+    series: tuple[tuple[str, str], ...]
+    """(field of the script's output, legend label) per line."""
+
+
+@dataclass(frozen=True)
 class ServerOutputs:
     state: tuple[ServerState, ...] = ()
     markers: ServerMarkers | None = None
     series: tuple[Series, ...] = ()
+    live: tuple[LivePlot, ...] = ()
 
 
 NO_OUTPUTS = ServerOutputs()

@@ -237,7 +237,7 @@ def test_the_shipped_layouts_are_the_ones_the_code_builds():
     from swarm_sim.nodes.foxglove_layout import (
         LAYOUT_FILE,
         LICHTBLICK_FILE,
-        QUEUES,
+        FOXGLOVE_SCRIPTS,
         STUDIO_SCRIPTS,
         TOTALS,
         build_layout,
@@ -252,7 +252,7 @@ def test_the_shipped_layouts_are_the_ones_the_code_builds():
     assert scene["config"]["topics"]["/depot/markers"]["visible"] and scene["config"]["topics"]["/center/markers"]
     plots = [item["content"] for item in layout["content"]["items"][1]["content"]["items"]]
     paths = {p["value"] for plot in plots for p in plot["config"]["paths"]}
-    assert f"{TOTALS}.deliveries" in paths and f"{QUEUES}.total" in paths
+    assert f"{TOTALS}.deliveries" in paths and f"{FOXGLOVE_SCRIPTS}depot_queues.total" in paths  # the depot's LivePlot
     scripts = {s["name"]: s["sourceCode"] for s in layout["userScripts"].values()}
     assert f'export const output = "{TOTALS}"' in scripts["swarm totals"]
     assert 'inputs = ["/depot/state"]' in scripts["depot queues"]

@@ -169,9 +169,8 @@ class _Rings:
     (`swarm_sim.analysis.state_rules`): its vectors computed as the batch runner computes them."""
 
     def __init__(self, scenario) -> None:
-        from swarm_sim.world.proximity import (
-            ProximityRing,  # lazy: loads the world (pybullet); only state-rule replays need it
-        )
+        # lazy: loads the world (pybullet); only state-rule replays need it
+        from swarm_sim.world.proximity import ProximityRing
 
         self._ring = ProximityRing(scenario)
         self._reach = scenario.robots.diameter / 2 + scenario.sensors.proximity_ring.range

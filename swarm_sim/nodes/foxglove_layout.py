@@ -7,13 +7,13 @@ Two files of one layout: `LAYOUT_FILE` for the current Foxglove app, built with
 swarm_sim.nodes.foxglove_layout`` rewrites both (the tests check them against this code). Left: a
 top-down 3D panel with the world's markers and every registered server's (`ServerOutputs.markers`:
 the depot's, the center's) and every robot's odometry in the ``world`` frame. Right: plots of the
-swarm's deliveries and pick-ups, the depot's queue lengths and the mean collision time over sim
-time.
+swarm's deliveries and pick-ups, every registered server's live plots (`ServerOutputs.live`: the
+depot's queue lengths) and the mean collision time over sim time.
 
 Our state topics are diagnostic_msgs/DiagnosticArray with numbers as strings, which Foxglove's
-plots do not read, so the layout carries two small user scripts (TypeScript, run inside Foxglove)
-that turn ``/world/robot_stats`` and ``/depot/state`` into numbers; they work the same on a live
-connection and on a bag.
+plots do not read, so the layout carries small user scripts (TypeScript, run inside Foxglove)
+that turn ``/world/robot_stats`` and each server's state into numbers; they work the same on a
+live connection and on a bag.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 
 from swarm_msgs_py import topics
+from swarm_msgs_py.server_outputs import LivePlot, outputs_of
 from swarm_sim import registry
 
 LAYOUT_FILE = Path(__file__).resolve().parents[2] / "launch_py" / "foxglove_layout.json"
@@ -31,15 +32,12 @@ FOXGLOVE_SCRIPTS = "/foxglove_script/"
 STUDIO_SCRIPTS = "/studio_script/"
 """Where a user script's output topic must start: in Foxglove, and in Lichtblick (Studio's name)."""
 TOTALS = FOXGLOVE_SCRIPTS + "swarm_totals"
-QUEUES = FOXGLOVE_SCRIPTS + "depot_queues"
 ODOMETRY_ROBOTS = 128
 """Robots whose odometry the 3D panel shows as poses (every tick; the world's robot markers come
 every 5 s of sim time): robot_0 ... robot_127."""
 
 def marker_topics() -> tuple[str, ...]:
     """The world's markers, then every registered server's, in registry order."""
-    from swarm_msgs_py.server_outputs import outputs_of  # lazy: the registry loads every paper's record
-
     servers = {s.channel: s for a in registry.algorithms() for s in a.servers}
     drawn = [outputs_of(s).markers for s in servers.values()]
     return (topics.WORLD_MARKERS, *dict.fromkeys(m.topic for m in drawn if m is not None))
@@ -70,37 +68,27 @@ export default function script(event: Input<"/world/robot_stats">): Output {{
 }}
 """
 
-_QUEUES_SCRIPT = """\
-// /depot/state: the status named "queues" holds each entry line's queue length -> numbers.
-import {{ Input }} from "./types";
-
-type Output = {{ total: number; longest: number; lines: number }};
-
-export const inputs = ["/depot/state"];
-export const output = "{prefix}depot_queues";
-
-export default function script(event: Input<"/depot/state">): Output | undefined {{
-  const queues = event.message.status.find((s) => s.name === "queues");
-  if (queues === undefined) return undefined;
-  const lengths = queues.values.map((kv) => Number(kv.value));
-  return {{
-    total: lengths.reduce((a, b) => a + b, 0),
-    longest: lengths.length ? Math.max(...lengths) : 0,
-    lines: lengths.length,
-  }};
-}}
-"""
+def _live_plots() -> tuple[LivePlot, ...]:
+    """Every registered server's live plots, in registry order."""
+    servers = {s.channel: s for a in registry.algorithms() for s in a.servers}
+    return tuple(plot for s in servers.values() for plot in outputs_of(s).live)
 
 
-PLOTS = (
-    ("deliveries", "deliveries and pick-ups", (("swarm_totals.deliveries", "resources delivered"),
-                                               ("swarm_totals.pickups", "pick-ups"))),
-    ("queues", "depot queue lengths [robots]", (("depot_queues.total", "robots queued (all entry lines)"),
-                                                ("depot_queues.longest", "longest entry line"))),
-    ("collisions", "collision time per robot [s]", (("swarm_totals.collision_time_s_mean", "mean over robots"),)),
-)
-"""(id, title, [(script output.field, label)]): the plots on the right, top to bottom."""
-SCRIPTS = (("swarm_totals", "swarm totals", _TOTALS_SCRIPT), ("depot_queues", "depot queues", _QUEUES_SCRIPT))
+def plot_specs() -> tuple[tuple[str, str, tuple[tuple[str, str], ...]], ...]:
+    """(id, title, [(script output.field, label)]): the plots on the right, top to bottom: the
+    swarm's deliveries, every server's live plots, the collision time."""
+    return (
+        ("deliveries", "deliveries and pick-ups", (("swarm_totals.deliveries", "resources delivered"),
+                                                   ("swarm_totals.pickups", "pick-ups"))),
+        *((p.key.rpartition("_")[2], p.title, tuple((f"{p.key}.{field}", label) for field, label in p.series))
+          for p in _live_plots()),
+        ("collisions", "collision time per robot [s]", (("swarm_totals.collision_time_s_mean", "mean over robots"),)),
+    )
+
+
+def script_specs() -> tuple[tuple[str, str, str], ...]:
+    """(key, name, TypeScript source with ``{prefix}``): the swarm totals, then the servers'."""
+    return (("swarm_totals", "swarm totals", _TOTALS_SCRIPT), *((p.key, p.name, p.script) for p in _live_plots()))
 SCENE_TITLE = "swarm (markers)"
 CAMERA = {"perspective": False, "distance": 18.0, "phi": 0.0, "thetaOffset": 0.0, "target": (0.0, 0.0, 0.0)}
 """Top-down over the arena's centre."""
@@ -129,7 +117,7 @@ def build_layout() -> str:
     plots = [fl.PlotPanel(title=title, config=fl.PlotConfig(
         paths=[fl.PlotSeries(value=FOXGLOVE_SCRIPTS + path, label=label, enabled=True) for path, label in series],
         show_legend=True, x_axis_val="timestamp",
-    )) for _, title, series in PLOTS]
+    )) for _, title, series in plot_specs()]
     layout = fl.Layout(
         content=fl.SplitContainer(direction="row", items=[
             fl.SplitItem(proportion=3, content=scene),
@@ -137,7 +125,7 @@ def build_layout() -> str:
                 fl.SplitItem(content=plot) for plot in plots])),
         ]),
         user_scripts={key: fl.UserScript(name=name, source_code=code.format(prefix=FOXGLOVE_SCRIPTS))
-                      for key, name, code in SCRIPTS},
+                      for key, name, code in script_specs()},
     )
     return layout.to_json()
 
@@ -167,12 +155,12 @@ def build_lichtblick_layout() -> str:
                   for path, label in series],
         "showLegend": True, "legendDisplay": "floating", "showXAxisLabels": True, "showYAxisLabels": True,
         "xAxisVal": "timestamp", "isSynced": True,
-    }) for key, title, series in PLOTS}
+    }) for key, title, series in plot_specs()}
     layout = {
         "configById": {"3D!swarm": scene, **plots},
         "globalVariables": {},
         "userNodes": {key: {"name": name, "sourceCode": code.format(prefix=STUDIO_SCRIPTS)}
-                      for key, name, code in SCRIPTS},
+                      for key, name, code in script_specs()},
         "playbackConfig": {"speed": 1},
         "layout": {"direction": "row", "first": "3D!swarm", "second": _column(list(plots)), "splitPercentage": 60},
     }
