@@ -17,15 +17,14 @@ import numpy as np
 import pytest
 import rclpy
 import yaml
-from graph_helpers import REPO, launch, overrides  # noqa: F401 - launch: a fixture
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
-from depot_manager.codec import DEPOT, RADIO
+from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_REPORTS, RADIO, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKind
+from graph_helpers import REPO, launch, overrides  # noqa: F401 - launch: a fixture
 from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, odometry, topics, twist
-from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
@@ -77,7 +76,9 @@ class Hostile(Node):
 
     def publisher(self, topic: str, qos=EVENTS, msg_type=None):
         base = topic[:-len(topics.HEARD) - 1] if topic.endswith("/" + topics.HEARD) else topic  # a relay's type
-        self.pubs[topic] = self.create_publisher(msg_type or topics.type_of(base), topic, qos)
+        family_types = {DEPOT_GRANTS: DEPOT.type_name, DEPOT_REPORTS: DEPOT.type_name, RADIO_TOPIC: RADIO.type_name}
+        msg_type = msg_type or (topics.import_type(family_types[base]) if base in family_types else topics.type_of(base))
+        self.pubs[topic] = self.create_publisher(msg_type, topic, qos)
         return self.pubs[topic]
 
     def spin(self, seconds: float, until=lambda: False) -> None:
@@ -123,7 +124,7 @@ def test_no_message_kills_or_stalls_a_node(launch, hostile):
     h = hostile(run)
     senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
               for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)]
-    grants, radio = h.publisher(topics.DEPOT_GRANTS), h.publisher(topics.heard(topics.RADIO))
+    grants, radio = h.publisher(DEPOT_GRANTS), h.publisher(topics.heard(RADIO_TOPIC))
     h.wait_matched(run)
     (huge,) = DEPOT.encode(0, [DepotGrant(0, "robot_999", "entry_line_0", k) for k in range(100_000)])
     assert len(huge) > 19e6
@@ -142,8 +143,8 @@ def test_no_message_kills_or_stalls_a_node(launch, hostile):
     for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER):
         assert rejected[f"/robot_0/{name}"]["malformed"] >= 3
     assert rejected["/robot_0/odom"]["out of bounds"] >= 3
-    assert rejected[topics.DEPOT_GRANTS]["too big"] >= 3 * 6  # by each robot, unread
-    assert rejected[topics.heard(topics.RADIO)]["unauthenticated"] >= 3
+    assert rejected[DEPOT_GRANTS]["too big"] >= 3 * 6  # by each robot, unread
+    assert rejected[topics.heard(RADIO_TOPIC)]["unauthenticated"] >= 3
     assert_equals_batch(run.bag, QUEUE)
 
 
@@ -154,7 +155,7 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     and exits 0 (nothing it sent could reach a core)."""
     run = launch("--domain-id", str(domain()), *QUEUE)
     h = hostile(run)
-    for topic in (topics.DEPOT_REPORTS, topics.DEPOT_GRANTS, topics.heard(topics.RADIO), topics.WORLD_EVENTS,
+    for topic in (DEPOT_REPORTS, DEPOT_GRANTS, topics.heard(RADIO_TOPIC), topics.WORLD_EVENTS,
                   "/robot_0/status"):
         h.publisher(topic)
     h.publisher(topics.DIAGNOSTICS, STATE_LATCHED)  # the recorder hears it transient-local
@@ -162,10 +163,10 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     h.wait_matched(run)
     for _ in range(5):
         s = h.stamp
-        h.pubs[topics.DEPOT_REPORTS].publish(DEPOT.encode(s, [DepotReport(s, "robot_1", ReportKind.JOIN,
+        h.pubs[DEPOT_REPORTS].publish(DEPOT.encode(s, [DepotReport(s, "robot_1", ReportKind.JOIN,
                                                                           "entry_line_0", 0)])[0])
-        h.pubs[topics.DEPOT_GRANTS].publish(DEPOT.encode(s, [DepotGrant(s, "robot_0", "entry_line_0", 0)])[0])
-        h.pubs[topics.heard(topics.RADIO)].publish(RADIO.encode(s, [RadioQuery(s, "robot_1", 0.0, 0.0)])[0])
+        h.pubs[DEPOT_GRANTS].publish(DEPOT.encode(s, [DepotGrant(s, "robot_0", "entry_line_0", 0)])[0])
+        h.pubs[topics.heard(RADIO_TOPIC)].publish(RADIO.encode(s, [RadioQuery(s, "robot_1", 0.0, 0.0)])[0])
         h.pubs[topics.WORLD_EVENTS].publish(diagnostics.encode_events(s, [NodeDownEvent("robot_0", s, "robot", 3)]))
         h.pubs["/robot_0/status"].publish(diagnostics.encode_status(BehaviourStatus("robot_0", s, "search", 5000, 0)))
         h.pubs[topics.DIAGNOSTICS].publish(diagnostics.encode_rejections(s, "/robot_0/controller",
@@ -175,11 +176,11 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     code, summary, err = run.finish()
     assert code == 0, err[-3000:]
     rejected = summary["rejected_messages"]
-    assert rejected[topics.DEPOT_REPORTS]["unauthenticated"] >= 5
-    assert rejected[topics.DEPOT_GRANTS]["unauthenticated"] >= 5 * 6
+    assert rejected[DEPOT_REPORTS]["unauthenticated"] >= 5
+    assert rejected[DEPOT_GRANTS]["unauthenticated"] >= 5 * 6
     assert rejected[topics.WORLD_EVENTS]["unauthenticated"] >= 5
     assert rejected[topics.LOCKSTEP_ACK]["unauthenticated"] >= 5
-    assert rejected[topics.DEPOT_REPORTS]["foreign publisher"] == 1  # reported, not tainting
+    assert rejected[DEPOT_REPORTS]["foreign publisher"] == 1  # reported, not tainting
     assert summary["foreign_publishers"] == [] and summary["dead_nodes"] == []
     assert "/radio" not in rejected and max(summary["oae_by_robot"].values()) < 5000
     assert_equals_batch(run.bag, QUEUE)

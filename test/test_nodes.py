@@ -279,8 +279,8 @@ def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
                              lambda d: reports.append(diagnostics.decode_rejections(d)[1]), EVENTS, raw=True)
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
             for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
-    laid = peer.create_publisher(topics.type_of(topics.PHEROMONES), topics.heard(topics.PHEROMONES), EVENTS)
-    peer.create_subscription(topics.type_of(topics.PHEROMONES), topics.PHEROMONES, lambda d: None, EVENTS, raw=True)
+    laid = peer.create_publisher(topics.import_type(PHEROMONES.type_name), topics.heard(PHEROMONES_TOPIC), EVENTS)
+    peer.create_subscription(topics.import_type(PHEROMONES.type_name), PHEROMONES_TOPIC, lambda d: None, EVENTS, raw=True)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     executor.add_node(peer)
@@ -314,7 +314,7 @@ def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
         for name in pubs:
             assert counts[(f"/robot_0/{name}", "malformed")] == 3
         assert counts[("/robot_0/odom", "out of bounds")] == 3 and counts[("/robot_0/scan", "out of bounds")] == 3
-        assert counts[(topics.heard(topics.PHEROMONES), "too big")] == 3
+        assert counts[(topics.heard(PHEROMONES_TOPIC), "too big")] == 3
     finally:
         executor.shutdown()
         node.destroy_node()

@@ -18,6 +18,7 @@ import pytest
 from swarm_controllers.motion import ContinuousDrive, drive_for
 from swarm_controllers.robots.stop_turn_go import PLAN_TIME, StopTurnGo
 from swarm_controllers.robots.wheel_turning import WheelTurning
+from swarm_sim.registry import task_factory
 from swarm_sim.robots import footbot
 from swarm_sim.scenario import ScenarioError, load_scenario, scenario_from_dict, scenario_to_dict
 from swarm_sim.types import Command, Pose2D
@@ -236,7 +237,7 @@ def test_the_khepera_iii_cannot_go_faster_than_k_teams_regulated_limit():
     assert (s.robots.max_linear_speed, s.robots.diameter, s.robots.mass) == (0.298, 0.13, 0.69)
     assert s.robots.max_angular_speed == pytest.approx(2 * 0.298 / 0.0885)
     s = _scenario("khepera3", "resources.count=0", "resources.distribution=uniform")
-    with World(s) as world:
+    with World(s, task_factory(s)) as world:
         world.reset()
         world.teleport({"robot_0": Pose2D(-1.0, 0.0, 0.0)})
         for _ in range(10):
@@ -251,10 +252,10 @@ def test_planar_robots_stay_upright_in_a_crowd():
 
     for model, bound in (("footbot_cpfa", 1e-25), ("generic", 1e-6)):
         s = load_scenario("queue_qmt", [f"robots.model={model}", "robots.count=24", "sim.duration=30"])
+        from swarm_sim.behaviour import behaviour_rng
         from swarm_sim.registry import make_behaviour
-        from swarm_controllers.api import behaviour_rng
 
-        with World(s) as world:
+        with World(s, task_factory(s)) as world:
             robots = {r: make_behaviour(s, r, behaviour_rng(s.seed, r)) for r in world.robots}
             obs = world.reset()
             tilts = []
@@ -270,7 +271,7 @@ def test_planar_robots_stay_upright_in_a_crowd():
 def test_a_stop_turn_go_leg_in_the_world_ends_at_its_target():
     s = _scenario("footbot_cpfa", "resources.count=0", "resources.distribution=uniform")
     drive = drive_for(s, np.random.default_rng(2))
-    with World(s) as world:
+    with World(s, task_factory(s)) as world:
         obs = world.reset()
         world.teleport({"robot_0": Pose2D(1.0, 1.0, 0.0)})
         obs = world.observe()

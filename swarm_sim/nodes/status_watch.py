@@ -44,18 +44,24 @@ class StatusWatch:
                                      lambda data, r=robot, t=topic: self._on_status(r, t, data), EVENTS, raw=True)
 
     def _on_status(self, robot: RobotId, topic: str, data: bytes) -> None:
-        self._recording.write(topic, data)
+        """Check a status as the world checks any bus message; record it where analysis reads
+        what the run took, or on the topic's refused channel."""
+        self._recording.write_taken(topic, data, self._take(robot, topic, data))
+
+    def _take(self, robot: RobotId, topic: str, data: bytes) -> bool:
         try:
             status = diagnostics.decode_status(data)
         except ValueError as exc:
             self._inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
-            return
+            return False
         if status.robot != robot:
             self._inbound.reject(topic, Reason.UNKNOWN_ROBOT, f"status of {status.robot[:40]!r} on {topic}")
-        elif not 0 <= status.stamp_ns <= self._inbound.now_ns or status.stamp_ns % self._dt_ns:
+            return False
+        if not 0 <= status.stamp_ns <= self._inbound.now_ns or status.stamp_ns % self._dt_ns:
             self._inbound.reject(topic, Reason.WRONG_TICK, f"stamped {status.stamp_ns} ns at tick {self._inbound.now_ns} ns")
-        else:
-            self.statuses[robot] = status
+            return False
+        self.statuses[robot] = status
+        return True
 
     def settle(self, executor: Executor, spins: int = 8) -> None:
         """Take what has already arrived (statuses sent just before the commands of this tick)."""
