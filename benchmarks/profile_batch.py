@@ -123,6 +123,10 @@ class TickWindow:
     skip: int = 0
     start: float = math.nan
     end: float = math.nan
+    cpu_start: float = math.nan
+    cpu_end: float = math.nan
+    """The same window on the process's CPU clock (`time.process_time`): on a shared machine
+    other processes stretch the wall time, not this."""
     marks: int = 0
     seconds: dict[str, float] = field(default_factory=dict)
     calls: dict[str, int] = field(default_factory=dict)
@@ -130,9 +134,11 @@ class TickWindow:
     def mark(self, timers: Timers | None) -> None:
         """A tick boundary (a probe's ``update``, `TickMarker`): opens the window or extends it."""
         self.end = time.perf_counter()
+        self.cpu_end = time.process_time()
         self.marks += 1
         if self.marks == self.skip + 1:
             self.start = self.end
+            self.cpu_start = self.cpu_end
             if timers is not None:
                 timers.reset()
         elif timers is not None:
@@ -156,10 +162,16 @@ class Profile:
     """Exclusive wall time per phase over the window [s]; "other" is the rest."""
     calls: dict[str, int]
     run: batch.BatchRun
+    window_cpu_s: float = math.nan
+    """CPU time of the ticks [s] (`TickWindow.cpu_start`)."""
 
     @property
     def ms_per_tick(self) -> float:
         return 1e3 * self.window_s / self.ticks
+
+    @property
+    def cpu_ms_per_tick(self) -> float:
+        return 1e3 * self.window_cpu_s / self.ticks
 
     @property
     def real_time_factor(self) -> float:
@@ -283,7 +295,8 @@ def profile_run(
     window_s = window.end - window.start
     phases = dict(window.seconds)
     phases["other (run_batch loop, timers)"] = window_s - sum(phases.values())
-    return Profile(scenario, window.ticks, window_s, run_s, phases, dict(window.calls), run)
+    return Profile(scenario, window.ticks, window_s, run_s, phases, dict(window.calls), run,
+                   window.cpu_end - window.cpu_start)
 
 
 def scaled_fields(scenario: str, robots: int, arena: float | None) -> dict[str, Any]:
@@ -342,6 +355,9 @@ def print_profile(prof: Profile, plains: list[Profile], overhead_s: float) -> No
     print(f"plain run:        {plain.ms_per_tick:7.2f} ms/tick{spread}, "
           f"real-time factor {plain.real_time_factor:6.1f}x, "
           f"delivered {len(plain.run.trace.drops)}")
+    cpu = sorted(p.cpu_ms_per_tick for p in plains)
+    print(f"plain run, CPU:   {cpu[len(cpu) // 2]:7.2f} ms/tick of CPU time (range {cpu[0]:.2f}-{cpu[-1]:.2f}; "
+          f"what other processes on the machine do not stretch)")
     calls = sum(prof.calls.values())
     print(f"instrumented run: {prof.ms_per_tick:7.2f} ms/tick, real-time factor {prof.real_time_factor:6.1f}x, "
           f"delivered {len(prof.run.trace.drops)}; {calls / prof.ticks:.0f} timed calls/tick, "
