@@ -168,16 +168,20 @@ class WorldNode(Node):
                 topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
+            self.watch.hear(topic, self._cmd_subs[robot].get_publisher_count)
         if self.servers:
             self.recording.add(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK))
             self._ack_sub = self.create_subscription(
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
+            self.watch.hear(topics.LOCKSTEP_ACK, self._ack_sub.get_publisher_count)
         self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning,
                                Bounds.of(self.scenario))
         """The world's guard: commands, acks and robots' messages decode through it."""
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
+        for topic, sub in self.relay.subscriptions.items():
+            self.watch.hear(topic, sub.get_publisher_count)
         self.loop = WorldLoop(self)
 
     stop_requested = False
@@ -301,11 +305,11 @@ class WorldNode(Node):
         self.recording.discover(self._warn_unknown_commands)
         self.check_foreign()
 
-    def check_foreign(self) -> None:
+    def check_foreign(self, full: bool = False) -> None:
         """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
         line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
-        (an untagged topic) taints the run."""
-        for f in self.watch.check():
+        (an untagged topic) taints the run. `full`: every topic now (else a slice of them)."""
+        for f in self.watch.check(full):
             self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
             if f.tainting:
                 self.foreign.append(str(f))
