@@ -222,32 +222,31 @@ class WorldNode(Node):
         return not spec.tagged or auth.verify(data) is not None
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        refused = self.rejections.total
-        self._take_cmd(robot, data)
         topic = self._topic_of_cmd[robot]
-        self.recording.write_taken(topic, data, self.rejections.total == refused)
+        self.recording.write_taken(topic, data, self._take_cmd(robot, topic, data))
 
-    def _take_cmd(self, robot: RobotId, data: bytes) -> None:
-        topic = self._topic_of_cmd[robot]
+    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool:
+        """Take a command (True), or refuse and count it (False: recorded apart)."""
         decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
-            return
+            return False
         stamp_ns, linear, angular = decoded
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
-            return
+            return False
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
             if self.barrier.has_answered(robot, stamp_ns):
-                return  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
+                return True  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
                 self.barrier.heard(robot)  # slow, not dead
             self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
-            return
+            return False
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
+        return True
 
     def _on_ack(self, data: bytes) -> None:
         refused = self.rejections.total
