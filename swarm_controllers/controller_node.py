@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import gc
 import os
 import signal
@@ -97,19 +98,14 @@ class ControllerNode(Node):
             **{t.name: (t.type_name, t.decode, "value") for t in self.sensing.topics},
         }
         self._expected = len(observations)
+        refused = lambda: self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)  # noqa: E731
         for name, (type_name, decode, kind) in observations.items():
-            guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind)
-
-            def on_message(data: bytes, name: str = name, guarded=guarded) -> None:
-                # The guard first (size, decode, numbers, tick): nothing from the bus raises in
-                # this callback or reaches the behaviour unchecked.
-                decoded = guarded(data)
-                if decoded is not None:
-                    self._on_observation(name, decoded)
-                else:  # counted: say so now, the robot may not tick again soon
-                    self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)
-
-            self.create_subscription(topics.import_type(type_name), name, on_message, SENSOR_LOCKSTEP, raw=True)
+            # The guard is the callback (size, decode, numbers, tick): nothing from the bus raises
+            # in it or reaches the behaviour unchecked; a refusal is reported at once (the robot
+            # may not tick again soon).
+            deliver = functools.partial(self._on_observation, name)
+            guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind, deliver, refused)
+            self.create_subscription(topics.import_type(type_name), name, guarded, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)

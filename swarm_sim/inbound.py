@@ -254,18 +254,25 @@ class Inbound:
             self.reject(where, getattr(exc, "reason", Reason.MALFORMED), str(exc)[:200])
             return None
 
-    def sense_guard(self, where: str, decode: Callable[[bytes], Any], kind: str = "value") -> Callable[[bytes], Any]:
-        """One observation topic's whole guard as one function, bytes -> decoded (stamp, value,
-        ...) or None (counted): within `Bounds.sense_bytes`, decodable, its numbers finite and
-        within bounds (`kind`: ``odometry``: the pose within the arena, speeds within the robot's
-        limits; ``scan``: one range per ray, none NaN or negative but -inf, REP 117's too close;
-        ``value``: every float within the coordinate bound, `within`), stamped on a tick of the
-        run. All inlined: every robot runs it on every observation (450 times a tick in a
-        112-robot controller process)."""
+    def sense_guard(self, where: str, decode: Callable[[bytes], Any], kind: str,
+                    deliver: Callable[[Any], None], refused: Callable[[], None] = lambda: None,
+                    ) -> Callable[[bytes], None]:
+        """One observation topic's whole guard as one subscription callback: `deliver(decoded)`
+        (stamp, value, ...) if the message is within `Bounds.sense_bytes`, decodable, its numbers
+        finite and within bounds (`kind`: ``odometry``: the pose within the arena, speeds within
+        the robot's limits, stamped on a tick of the run; ``scan``: one range per ray, none NaN or
+        negative but -inf, REP 117's too close; ``value``: every float within the coordinate
+        bound, `within`), else count it and call `refused()`. Only odometry's stamp is checked: a
+        controller steps when all its topics carry one stamp, so that one is the tick's. All
+        inlined, one closure per kind: every robot runs it on every observation (450 times a tick
+        in a 112-robot controller process), and every comparison fails for NaN."""
         b = self.bounds
-        if b is None:
-            return decode
         reject = self.reject
+        if b is None:
+            def unchecked(data: bytes) -> None:
+                deliver(decode(data))
+
+            return unchecked
         cap, c, end, dt = b.sense_bytes, b.coordinate, b.end_ns, b.dt_ns
         speed, turn, rays = b.speed, b.turn_rate, b.rays
         too_big, malformed, out, wrong = Reason.TOO_BIG, Reason.MALFORMED, Reason.OUT_OF_BOUNDS, Reason.WRONG_TICK
@@ -273,18 +280,17 @@ class Inbound:
         def failed(data: bytes, exc: Exception | None = None) -> None:
             if exc is None:
                 reject(where, too_big, f"{len(data)} bytes (at most {cap})")
-            else:
+            else:  # a decoder may raise anything: the node lives
                 reject(where, getattr(exc, "reason", malformed), str(exc)[:200])
+            refused()
 
-        def refused(reason: Reason, stamp: int) -> None:
+        def bad(reason: Reason, stamp: int) -> None:
             reject(where, reason, f"stamped {stamp} ns: no tick of this run" if reason is wrong
                    else "a number not finite, or beyond the arena or the robot's limits")
+            refused()
 
-        # One closure per kind, the size test and the decoding inlined in each (no call or dispatch
-        # to spare per message); every comparison fails for NaN. A decoder may raise anything: the
-        # node lives.
         if kind == "odometry":
-            def guarded(data: bytes) -> Any:
+            def guarded(data: bytes) -> None:
                 if len(data) > cap:
                     return failed(data)
                 try:
@@ -294,40 +300,36 @@ class Inbound:
                 stamp, pose, v, w = d
                 if not (-c <= pose.x <= c and -c <= pose.y <= c and -4.0 <= pose.yaw <= 4.0
                         and -speed <= v <= speed and -turn <= w <= turn):
-                    return refused(out, stamp)
+                    return bad(out, stamp)
                 if not (0 <= stamp <= end and stamp % dt == 0):
-                    return refused(wrong, stamp)
-                return d
+                    return bad(wrong, stamp)
+                deliver(d)
         elif kind == "scan":
             neg_inf, smallest = -np.inf, np.minimum.reduce
 
-            def guarded(data: bytes) -> Any:
+            def guarded(data: bytes) -> None:
                 if len(data) > cap:
                     return failed(data)
                 try:
                     d = decode(data)
                 except Exception as exc:  # noqa: BLE001
                     return failed(data, exc)
-                stamp, ranges = d
+                ranges = d[1]
                 if len(ranges) != rays or not (smallest(ranges) >= 0.0 or ((ranges >= 0.0) | (ranges == neg_inf)).all()):
-                    return refused(out, stamp)
-                if not (0 <= stamp <= end and stamp % dt == 0):
-                    return refused(wrong, stamp)
-                return d
+                    return bad(out, d[0])
+                deliver(d)
         else:
-            def guarded(data: bytes) -> Any:
+            def guarded(data: bytes) -> None:
                 if len(data) > cap:
                     return failed(data)
                 try:
                     d = decode(data)
                 except Exception as exc:  # noqa: BLE001
                     return failed(data, exc)
-                stamp, value = d
+                value = d[1]
                 if type(value) is not bool and not within(value, c):
-                    return refused(out, stamp)
-                if not (0 <= stamp <= end and stamp % dt == 0):
-                    return refused(wrong, stamp)
-                return d
+                    return bad(out, d[0])
+                deliver(d)
 
         return guarded
 

@@ -177,20 +177,26 @@ def test_observations_are_checked_for_their_tick_and_their_numbers():
     gate, scenario, _ = _guarded()
     dt, b = scenario.dt_ns, gate.bounds
     as_is = lambda d: d  # noqa: E731 - the guard's decoder: the "bytes" are the decoded tuple here
-    odom = gate.sense_guard("/r/odom", as_is, "odometry")
+
+    def guard(where, kind):
+        got = []
+        check = gate.sense_guard(where, as_is, kind, got.append)
+        return lambda d: (check(d), got.pop() if got else None)[1]
+
+    odom = guard("/r/odom", "odometry")
     assert odom((dt, Pose2D(1.0, -1.0, 3.0), 0.1, -1.0))
     for stamp, x, v, w in ((dt, float("nan"), 0.0, 0.0), (dt, 1e308, 0.0, 0.0), (dt, 0.0, b.speed * 1.01, 0.0),
                            (dt, 0.0, 0.0, -b.turn_rate * 1.01)):
         assert odom((stamp, Pose2D(x, 0.0, 0.0), v, w)) is None
     for stamp in (dt + 1, -dt, b.end_ns + dt):
         assert odom((stamp, Pose2D(0.0, 0.0, 0.0), 0.0, 0.0)) is None
-    ranges = gate.sense_guard("/r/scan", as_is, "scan")
+    ranges = guard("/r/scan", "scan")
     rays = b.rays
     assert ranges((dt, np.array([np.inf, -np.inf, 0.5] + [1.0] * (rays - 3), np.float32)))
     assert ranges((dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))) is None
     assert ranges((dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))) is None
     assert ranges((dt, np.ones(rays + 1, np.float32))) is None
-    seen = gate.sense_guard("/r/resources", as_is)
+    seen = guard("/r/resources", "value")
     assert seen((dt, ((1.0, 2.0), (-2.0, 0.5))))
     assert seen((dt, ((1.0, 2.0), (float("inf"), 0.5)))) is None
     assert seen((dt, ((1e9, 2.0),))) is None
@@ -204,22 +210,33 @@ def test_the_sense_guard_decodes_and_checks_in_one_call():
 
     gate, scenario, _ = _guarded()
     dt, sc = scenario.dt_ns, scenario.sensors.scan
-    odom = gate.sense_guard("/r/odom", odometry.decode_odometry, "odometry")
-    ranges = gate.sense_guard("/r/scan", scan.decode_scan, "scan")
-    seen = gate.sense_guard("/r/resources", resources.decode_resources)
-    grip = gate.sense_guard("/r/gripper", gripper.decode_gripper)
-    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))[0] == dt
-    assert odom(odometry.encode_odometry("robot_0", dt, Pose2D(1e308, 2.0, 0.5), 0.1, 0.0)) is None
-    assert odom(odometry.encode_odometry("robot_0", dt + 1, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0)) is None
-    assert odom(b"\x00\x01\x00\x00") is None and odom(bytes(gate.bounds.sense_bytes + 1)) is None
+    got, refusals = [], []
+
+    def guard(where, decode, kind="value"):
+        return gate.sense_guard(where, decode, kind, got.append, lambda: refusals.append(where))
+
+    odom = guard("/r/odom", odometry.decode_odometry, "odometry")
+    ranges = guard("/r/scan", scan.decode_scan, "scan")
+    seen = guard("/r/resources", resources.decode_resources)
+    grip = guard("/r/gripper", gripper.decode_gripper)
+    odom(odometry.encode_odometry("robot_0", dt, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))
+    assert got.pop()[0] == dt
+    odom(odometry.encode_odometry("robot_0", dt, Pose2D(1e308, 2.0, 0.5), 0.1, 0.0))
+    odom(odometry.encode_odometry("robot_0", dt + 1, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))
+    odom(b"\x00\x01\x00\x00")
+    odom(bytes(gate.bounds.sense_bytes + 1))
     good = np.full(sc.rays, np.inf, np.float32)
     good[0] = -np.inf
-    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is not None
+    ranges(scan.encode_scan("robot_0", dt, good, sc))
+    assert got.pop()[0] == dt
     good[1] = np.nan
-    assert ranges(scan.encode_scan("robot_0", dt, good, sc)) is None
-    assert seen(resources.encode_resources(dt, [(1.0, 1.0)])) is not None
-    assert seen(resources.encode_resources(dt, [(1.0, float("nan"))])) is None
-    assert grip(gripper.encode_gripper(dt, True)) == (dt, True)
+    ranges(scan.encode_scan("robot_0", dt, good, sc))
+    seen(resources.encode_resources(dt, [(1.0, 1.0)]))
+    assert got.pop()[0] == dt
+    seen(resources.encode_resources(dt, [(1.0, float("nan"))]))
+    grip(gripper.encode_gripper(dt, True))
+    assert got.pop() == (dt, True) and got == []
+    assert refusals == ["/r/odom"] * 4 + ["/r/scan", "/r/resources"]
     assert gate.rejections.counts == {("/r/odom", "out of bounds"): 1, ("/r/odom", "wrong tick"): 1,
                                       ("/r/odom", "malformed"): 1, ("/r/odom", "too big"): 1,
                                       ("/r/scan", "out of bounds"): 1, ("/r/resources", "out of bounds"): 1}

@@ -30,13 +30,15 @@ class PeerRelay:
         """Peer topic -> publisher on ``heard(topic)``."""
         self._relayed: list[tuple[str, bytes]] = []
         """What arrived since the last tick went out, in order."""
+        self.subscriptions = {}
+        """Peer topic -> the world's subscription to it."""
         for topic, family in registry.peer_topics(algorithm).items():
             msg_type = topics.import_type(family.type_name)
             recording.add(topic, family.type_name)
             recording.skip(topics.heard(topic))  # the relay's copies: recorded once, as sent
             self._relays[topic] = node.create_publisher(msg_type, topics.heard(topic), EVENTS)
-            node.create_subscription(msg_type, topic, lambda data, t=topic, f=family: self._on_peer(t, f, data),
-                                     EVENTS, raw=True)
+            self.subscriptions[topic] = node.create_subscription(
+                msg_type, topic, lambda data, t=topic, f=family: self._on_peer(t, f, data), EVENTS, raw=True)
 
     def _on_peer(self, topic: str, family, data: bytes) -> None:
         taken = self._take(topic, family, data)

@@ -37,11 +37,13 @@ class StatusWatch:
         self._dt_ns = dt_ns
         self.statuses: dict[RobotId, BehaviourStatus] = {}
         """Each robot's last admitted status."""
+        self.subscriptions = {}
+        """Topic -> the world's subscription to it (for the foreign-publisher watch)."""
         for robot in robots:
             topic = topics.robot_topic(robot, topics.STATUS)
             recording.add(topic, topics.type_string(topic))
-            node.create_subscription(topics.type_of(topic), topic,
-                                     lambda data, r=robot, t=topic: self._on_status(r, t, data), EVENTS, raw=True)
+            self.subscriptions[topic] = node.create_subscription(topics.type_of(topic), topic,
+                lambda data, r=robot, t=topic: self._on_status(r, t, data), EVENTS, raw=True)
 
     def _on_status(self, robot: RobotId, topic: str, data: bytes) -> None:
         """Check a status as the world checks any bus message; record it where analysis reads

@@ -50,6 +50,7 @@ class WorldLoop:
         cfg, sim, world = node.config, node.scenario.sim, node.world
         node.discover()
         self.wait_for_controllers(executor)
+        node.check_foreign(full=True)
         node.outputs.start_live_view(node.discover)
         obs = world.reset()
         wall0 = last_progress = time.monotonic()
@@ -95,7 +96,7 @@ class WorldLoop:
             self.spin(executor, 0.1)
             if time.monotonic() - checked >= 1.0:
                 checked = time.monotonic()
-                node.check_foreign()
+                node.check_foreign(full=True)  # before the first tick: every topic, every second
             missing = node.unconnected()
             if missing and time.monotonic() - said >= node.config.progress_period:
                 said = time.monotonic()

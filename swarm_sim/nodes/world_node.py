@@ -173,17 +173,23 @@ class WorldNode(Node):
                 topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
+            self.watch.hear(topic, self._cmd_subs[robot].get_publisher_count)
         if self.servers:
             self.recording.add(topics.LOCKSTEP_ACK, topics.type_string(topics.LOCKSTEP_ACK))
             self._ack_sub = self.create_subscription(
                 topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, self._on_ack,
                 SENSOR_LOCKSTEP, raw=True,
             )
+            self.watch.hear(topics.LOCKSTEP_ACK, self._ack_sub.get_publisher_count)
         self.inbound = Inbound(self.robots, self.scenario.dt_ns, self.rejections, self.get_logger().warning,
                                Bounds.of(self.scenario))
         """The world's guard: commands, acks and robots' messages decode through it."""
         self.relay = PeerRelay(self, algorithm, self.inbound, self.recording)
+        for topic, sub in self.relay.subscriptions.items():
+            self.watch.hear(topic, sub.get_publisher_count)
         self.statuses = StatusWatch(self, self.robots, self.inbound, self.recording, self.scenario.dt_ns)
+        for topic, sub in self.statuses.subscriptions.items():
+            self.watch.hear(topic, sub.get_publisher_count)
         self._progress = registry.resolve(algorithm.progress) if algorithm.progress else None
         self.loop = WorldLoop(self)
 
@@ -225,32 +231,31 @@ class WorldNode(Node):
         return not spec.tagged or auth.verify(data) is not None
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
-        refused = self.rejections.total
-        self._take_cmd(robot, data)
         topic = self._topic_of_cmd[robot]
-        self.recording.write_taken(topic, data, self.rejections.total == refused)
+        self.recording.write_taken(topic, data, self._take_cmd(robot, topic, data))
 
-    def _take_cmd(self, robot: RobotId, data: bytes) -> None:
-        topic = self._topic_of_cmd[robot]
+    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool:
+        """Take a command (True), or refuse and count it (False: recorded apart)."""
         decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
-            return
+            return False
         stamp_ns, linear, angular = decoded
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
-            return
+            return False
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
             if self.barrier.has_answered(robot, stamp_ns):
-                return  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
+                return True  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
                 self.barrier.heard(robot)  # slow, not dead
             self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
-            return
+            return False
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
+        return True
 
     def _on_ack(self, data: bytes) -> None:
         refused = self.rejections.total
@@ -325,11 +330,11 @@ class WorldNode(Node):
         self.recording.discover(self._warn_unknown_commands)
         self.check_foreign()
 
-    def check_foreign(self) -> None:
+    def check_foreign(self, full: bool = False) -> None:
         """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
         line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
-        (an untagged topic) taints the run."""
-        for f in self.watch.check():
+        (an untagged topic) taints the run. `full`: every topic now (else a slice of them)."""
+        for f in self.watch.check(full):
             self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
             if f.tainting:
                 self.foreign.append(str(f))
