@@ -151,6 +151,8 @@ class WorldNode(Node):
             for r in self.robots
         }
         self._commands: dict[RobotId, Command] = {}
+        self._taken_cmd: dict[RobotId, bytes] = {}
+        """Each robot's last command taken, as received (its repeats are not recorded again)."""
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
@@ -232,10 +234,15 @@ class WorldNode(Node):
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
         topic = self._topic_of_cmd[robot]
-        self.recording.write_taken(topic, data, self._take_cmd(robot, topic, data))
+        taken = self._take_cmd(robot, topic, data)
+        if taken is not None:
+            self.recording.write_taken(topic, data, taken)
 
-    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool:
-        """Take a command (True), or refuse and count it (False: recorded apart)."""
+    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool | None:
+        """Take a command (True), or refuse and count it (False: recorded apart); None for a robot's
+        answer again to a tick it has answered (the world re-sent the tick, `resend_period`, and
+        the controller repeats its answer for each re-sent topic): the bag keeps one command per
+        robot and tick, as the run used."""
         decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
             return False
@@ -243,9 +250,12 @@ class WorldNode(Node):
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return False
+        if self.config.mode == "lockstep" and self.barrier.has_answered(robot, stamp_ns):
+            if data == self._taken_cmd.get(robot):
+                return None  # its answer again, to a tick the world re-sent (`resend_period`)
+            self.inbound.reject(topic, Reason.REFUSED, f"a second, different command for tick {stamp_ns} ns")
+            return False
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
-            if self.barrier.has_answered(robot, stamp_ns):
-                return True  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
@@ -254,6 +264,7 @@ class WorldNode(Node):
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
             return False
         self._commands[robot] = Command(linear, angular)
+        self._taken_cmd[robot] = data
         self.barrier.answered(robot, stamp_ns)
         return True
 
