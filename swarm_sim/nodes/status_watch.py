@@ -28,7 +28,6 @@ from swarm_sim.inbound import Inbound, Reason
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.types import BehaviourStatus, RobotId
 
-
 _DECODE_STATUS = auth.verified(diagnostics.decode_status)
 """A status must carry the run's tag: a forged `finished` would end the run early."""
 

@@ -38,9 +38,8 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
-from swarm_msgs_py import auth
+from swarm_msgs_py import auth, odometry, scan, topics, twist
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py import odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import SENSOR_LOCKSTEP
@@ -58,7 +57,6 @@ from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
-
 
 COMMAND_BYTES = 512
 """Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""

@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from depot_manager.admission import DepotAdmission
+from depot_manager.codec import OUTPUTS
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import (
     DepotGeometryConfig,
@@ -33,7 +34,6 @@ from depot_manager.geometry import (
     make_layout,
 )
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
-from depot_manager.codec import OUTPUTS
 from depot_manager.server import DepotServer
 from swarm_controllers.spiral.protocol import ProgressReport
 from swarm_msgs_py.server_outputs import StateWatch
