@@ -12,7 +12,7 @@ seconds to the first after ``--warmup + --window``):
 - CPU per tick of every process of the run, thread by thread (``/proc/PID/task/TID/stat``): the
   Python main thread (which also serialises and sends: publication is synchronous), Fast DDS's
   receive threads (``dds.udp.*``: socket reads, deserialisation into the readers' histories,
-  the executor's wake-up) and its other threads (``dds.ev``, ``dds.ds_ev``: timers, heartbeats,
+  the executor's wake-up; ``dds.shm.*`` with shared memory) and its other threads (``dds.ev``, ``dds.ds_ev``: timers, heartbeats,
   discovery);
 - ``--perf``: ``perf record`` of the world and one controller process over the window, samples
   by library: Fast DDS, the ROS layers (rmw, rcl, rclpy), the Python interpreter (our code),
@@ -136,8 +136,8 @@ def tree(root: int) -> dict[int, str]:
 def thread_group(comm: str, main: bool) -> str:
     if main:
         return "main thread (Python, publish, take)"
-    if comm.startswith("dds.udp"):
-        return "DDS receive threads (dds.udp)"
+    if comm.startswith(("dds.udp", "dds.shm")):
+        return "DDS receive threads (dds.udp, dds.shm)"
     if comm.startswith("dds."):
         return "DDS event/discovery threads"
     return "other threads"

@@ -28,6 +28,10 @@ _IMPORTED = time.monotonic()
 """When the world node's imports were done (start-up lines count from here)."""
 
 
+POLL_PERIOD = 0.05
+"""Wall seconds between the lockstep wait's polls of the bag (it flushes every second)."""
+
+
 class Interrupted(Exception):
     """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
@@ -109,27 +113,35 @@ class WorldLoop:
             )
 
     def await_commands(self, executor: Executor) -> None:
-        """Lockstep barrier: spin until every live controller and server answered this tick."""
+        """Lockstep barrier: spin until every live controller and server answered this tick.
+        One wake-up dispatches one message (the EventsExecutor), so the loop does as little as
+        it can per wake-up: the barrier keeps the set of those outstanding, the stop flag is a
+        read, and the bag is polled every `POLL_PERIOD`."""
         node = self.node
         stamp = node.world.t_ns
-        waiting = node.barrier.live()
+        barrier = node.barrier
+        barrier.open_tick(stamp)
+        outstanding = barrier.outstanding
         now = time.monotonic()
         deadline, resend = now + node.config.tick_timeout, now + node.config.resend_period
-        while True:
-            waiting = node.barrier.waiting(stamp, waiting)
+        next_poll = now + POLL_PERIOD
+        while outstanding:
+            if node.stop_requested:
+                raise Interrupted
             now = time.monotonic()
-            if not waiting:
-                break
             if now >= deadline:  # take what has already arrived before calling anyone stale
-                for _ in range(4 * len(waiting)):
+                for _ in range(4 * len(outstanding)):
                     executor.spin_once(timeout_sec=0.0)
                 break
             if now >= resend:  # a sample lost (e.g. while discovery settles): ask again
                 resend = now + node.config.resend_period
-                node.resend(waiting, stamp)
-            bag_time = self.spin(executor, min(0.05, max(0.0, deadline - now)))
-            deadline += bag_time
-            resend += bag_time
+                node.resend([p for p in barrier.live() if p in outstanding], stamp)
+            executor.spin_once(timeout_sec=min(0.05, deadline - now))
+            if now >= next_poll:
+                bag_time = node.recording.poll()  # flushing the bag is not the controllers' time
+                deadline += bag_time
+                resend += bag_time
+                next_poll = now + POLL_PERIOD
         node.close_tick(stamp)
 
     def await_wall(self, executor: Executor, until: float) -> None:
