@@ -100,7 +100,7 @@ class WorldLoop:
             self.spin(executor, 0.1)
             if time.monotonic() - checked >= 1.0:
                 checked = time.monotonic()
-                node.check_foreign(full=True)  # before the first tick: every topic, every second
+                node.check_foreign()  # foreign nodes by name, counts within the budget
             missing = node.unconnected()
             if missing and time.monotonic() - said >= node.config.progress_period:
                 said = time.monotonic()

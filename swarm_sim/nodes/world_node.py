@@ -116,7 +116,8 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers)
+        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers,
+                                  self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node)
         """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
         self.foreign: list[str] = []
         """The foreign publishers found whose messages may have reached a core: the run is tainted."""
