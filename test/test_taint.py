@@ -4,6 +4,7 @@ and keeps to its time budget however big the graph."""
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from types import SimpleNamespace
 
@@ -53,7 +54,7 @@ def run_graph(robots: int) -> tuple[Graph, ForeignWatch]:
 
 def test_a_foreign_node_is_found_at_the_next_check_whatever_the_budget():
     graph, watch = run_graph(16)
-    assert watch.check(full=True) == []
+    assert watch.check(budget=math.inf) == []
     graph.add("/", "hostile", "/robot_3/odom")
     found = watch.check(budget=0.0)
     assert [(f.topic, f.node, f.tainting) for f in found] == [("/robot_3/odom", "/hostile", True)]
@@ -62,7 +63,7 @@ def test_a_foreign_node_is_found_at_the_next_check_whatever_the_budget():
 
 def test_a_second_publisher_under_a_run_name_is_found_within_a_rotation():
     graph, watch = run_graph(16)
-    watch.check(full=True)
+    watch.check(budget=math.inf)
     graph.add("/", "world", "/robot_5/scan")  # our world's name, twice on one topic
     found = []
     for _ in range(len(watch.topics)):  # each check counts at least one topic
@@ -75,7 +76,7 @@ def test_a_second_publisher_under_a_run_name_is_found_within_a_rotation():
 def test_a_check_keeps_to_its_budget_a_full_one_covers_every_topic():
     graph, watch = run_graph(112)
     graph.queries = 0
-    watch.check(full=True)
+    watch.check(budget=math.inf)
     full = graph.queries
     assert full >= len(watch.topics) - len(watch.heard)
     graph.queries = 0

@@ -166,12 +166,12 @@ class ForeignWatch:
             self.heard[topic] = matched
             self._sweep = [t for t in self._sweep if t != topic]
 
-    def check(self, full: bool = False, budget: float = SWEEP_BUDGET) -> list[Foreign]:
+    def check(self, budget: float = SWEEP_BUDGET) -> list[Foreign]:
         """The foreign publishers that appeared since the last check: every publisher of a node
         that is none of the run's (or that shares the name of one of them), and, within `budget`
         wall seconds, on the topics the world hears whose count changed, on the next of the others,
-        and on the topics whose publishers' nodes were not all named yet (`full`: all of them,
-        whatever it takes)."""
+        and on the topics whose publishers' nodes were not all named yet (``math.inf``: all of
+        them, once)."""
         new = self._by_node()
         for topic, matched in self.heard.items():
             self._recount(topic, matched())
@@ -181,14 +181,14 @@ class ForeignWatch:
         self._unnamed = set()
         stop = time.perf_counter() + budget  # past it, one more of each (so each check moves on)
         judged = 0
-        while self._due and (full or not judged or time.perf_counter() < stop):
+        while self._due and (not judged or time.perf_counter() < stop):
             topic = next(iter(self._due))
             del self._due[topic]
             new += self._judge(topic, self.topics[topic])
             judged += 1
         n = len(self._sweep)
         for k in range(n):
-            if not full and k and time.perf_counter() >= stop:
+            if k and time.perf_counter() >= stop:
                 break
             topic = self._sweep[self._cursor]
             self._cursor = (self._cursor + 1) % n

@@ -331,11 +331,11 @@ class WorldNode(Node):
         self.recording.discover(self._warn_unknown_commands)
         self.check_foreign()
 
-    def check_foreign(self, full: bool = False) -> None:
+    def check_foreign(self) -> None:
         """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
         line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
-        (an untagged topic) taints the run. `full`: every topic now (else a slice of them)."""
-        for f in self.watch.check(full):
+        (an untagged topic) taints the run."""
+        for f in self.watch.check():
             self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
             if f.tainting:
                 self.foreign.append(str(f))
