@@ -409,6 +409,7 @@ class WorldNode(Node):
 
     def close(self) -> None:
         self.recording.close(
+            {f.topic for f in self.watch.found},
             wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
             sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
             server_stale_ticks=json.dumps(self.server_stale_ticks),

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 
 from rclpy.node import Node
@@ -98,10 +98,11 @@ class WorldRecording:
     def live(self) -> LiveView | None:
         return self.recorder.live if self.recorder is not None else None
 
-    def close(self, **metadata: str) -> None:
-        """Write the run's totals into the bag's metadata and close it."""
+    def close(self, each: Collection[str] = (), **metadata: str) -> None:
+        """Write the run's totals into the bag's metadata and close it; `each`: the topics whose
+        offered QoS is asked for one by one (`Recorder.record_offered_qos`)."""
         if self.recorder is not None:
-            self.recorder.close(**metadata)
+            self.recorder.close(each, **metadata)
 
 
 def _live_view(host: str, port: int) -> LiveView | None:
