@@ -75,11 +75,13 @@ def main() -> None:
                         default=[(1000, 38.0)], metavar="ROBOTS=SIDE",
                         help="arena side for runs of ROBOTS robots, resources scaled (as profile_batch.py)")
     parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--run-arg", action="append", default=[], metavar="ARG",
+                        help="a swarm-run option, e.g. --run-arg=--no-parameter-services (repeatable)")
     parser.add_argument("--discovery", nargs="+", default=["server"], choices=("server", "simple"),
                         help="one or both (alternated) of swarm-run's discovery modes")
     args = parser.parse_args()
     for n in args.robots:
-        sets = []
+        sets = list(args.run_arg)
         for key, value in scaled_fields(args.scenario, n, dict(args.arena).get(n)).items():
             if key != "robots__count":
                 sets += ["--set", f"{key.replace('__', '.')}={value}"]

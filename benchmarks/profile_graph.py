@@ -23,7 +23,8 @@ seconds to the first after ``--warmup + --window``):
   (nothing in the project changes), its exclusive times summed by category (`CATEGORIES`).
   cProfile makes Python code ~2x slower, and C calls not at all: read its shares as the Python
   side's split, not as times;
-- RSS of every process at the window's end (per robot node: the controllers' sum / robots);
+- RSS and PSS of every process at the window's end (per robot node: the controllers' sum / robots;
+  PSS counts the pages forked robot processes share once);
 - the run's own real-time factor and stale ticks (its JSON summary).
 """
 
@@ -110,7 +111,8 @@ def scenario_sets(robots: int, arena: float | None) -> list[str]:
 
 
 def tree(root: int) -> dict[int, str]:
-    """pid -> role (launcher, world, controllers, server, other) of `root` and its descendants."""
+    """pid -> role (launcher, world, controllers, server, other) of `root` and its descendants; the
+process that forks the robot processes counts as the launcher's."""
     children: dict[int, list[int]] = defaultdict(list)
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -119,16 +121,17 @@ def tree(root: int) -> dict[int, str]:
                     children[int(f.read().rsplit(")", 1)[1].split()[1])].append(int(entry))
             except (OSError, IndexError, ValueError):
                 continue
-    out, stack = {}, [root]
+    out, stack = {}, [(root, 0)]
     while stack:
-        pid = stack.pop()
-        stack.extend(children.get(pid, []))
+        pid, parent = stack.pop()
+        stack.extend((child, pid) for child in children.get(pid, []))
         try:
             cmd = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
         except OSError:
             continue
-        role = ("world" if "world_node" in cmd else "controllers" if "controller_node" in cmd
-                else "server" if "server_node" in cmd else "launcher" if pid == root else "other")
+        forking = "controller_node" in cmd and " --fork" in cmd and parent == root  # runs no robot itself
+        role = ("world" if "world_node" in cmd else "launcher" if pid == root or forking
+                else "controllers" if "controller_node" in cmd else "server" if "server_node" in cmd else "other")
         out[pid] = role
     return out
 
@@ -164,14 +167,18 @@ def snapshot(pids: dict[int, str]) -> dict[tuple[int, int], tuple[str, str, floa
     return out
 
 
-def rss_mb(pid: int) -> float:
+def memory_mb(pid: int) -> tuple[float, float]:
+    """(RSS, PSS) of `pid` [MB]: PSS splits the pages forked robot processes share with their
+    parent (and libraries shared by all) among their users, so PSS adds up to the machine's use."""
+    out = [0.0, 0.0]
     try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
+        for line in Path(f"/proc/{pid}/smaps_rollup").read_text().splitlines():
+            for i, key in enumerate(("Rss:", "Pss:")):
+                if line.startswith(key):
+                    out[i] = int(line.split()[1]) / 1024
     except OSError:
         pass
-    return 0.0
+    return out[0], out[1]
 
 
 def classify(predicates, key: str) -> str:
@@ -221,7 +228,8 @@ def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
         env["SWARM_PROFILE_DIR"] = str(tmp / "prof")
     cmd = [sys.executable, "-m", "launch_py.run", "--scenario", "cpfa", "--robots", str(robots),
            "--duration", str(args.duration), "--controller-processes", str(processes), "--bag", str(tmp / "bag"),
-           "--json", "--tick-timeout", str(args.tick_timeout), *scenario_sets(robots, arena), *args.set]
+           "--json", "--tick-timeout", str(args.tick_timeout), *scenario_sets(robots, arena), *args.set,
+           *args.run_arg]
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     result: dict = {"robots": robots, "processes": processes, "arena": arena}
@@ -251,7 +259,7 @@ def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
             if args.perf:
                 world = [p for p, r in pids.items() if r == "world"]
                 ctrl = sorted(p for p, r in pids.items() if r == "controllers")
-                ctrl = ctrl[1:2] if processes == 0 else ctrl[:1]  # a robot's own process, not the fork parent
+                ctrl = ctrl[:1]
                 for label, pid in (("world", world[0]), ("controller", ctrl[0])):
                     perf.append(subprocess.Popen(["perf", "record", "-F", "499", "-e", "cpu-clock", "-o",
                                                   str(tmp / f"{label}.perf"), "-p", str(pid)],
@@ -265,7 +273,7 @@ def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
                 for pid, role in pids.items():
                     if role in ("world", "controllers"):
                         os.kill(pid, signal.SIGUSR2)
-            result["rss_mb"] = {pid: (role, rss_mb(pid)) for pid, role in pids.items()}
+            result["rss_mb"] = {pid: (role, *memory_mb(pid)) for pid, role in pids.items()}
     proc.wait()
     for p in perf:
         p.wait()
@@ -290,8 +298,8 @@ def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
         result["perf"] = {label: perf_libraries(tmp / f"{label}.perf") for label in ("world", "controller")}
     if args.cprofile:
         time.sleep(0.5)
-        world = [tmp / "prof" / f"{p}.prof" for p, (r, _) in result["rss_mb"].items() if r == "world"]
-        ctrl = [tmp / "prof" / f"{p}.prof" for p, (r, _) in result["rss_mb"].items() if r == "controllers"]
+        world = [tmp / "prof" / f"{p}.prof" for p, (r, *_) in result["rss_mb"].items() if r == "world"]
+        ctrl = [tmp / "prof" / f"{p}.prof" for p, (r, *_) in result["rss_mb"].items() if r == "controllers"]
         result["cprofile"] = {"world": cprofile_categories([f for f in world if f.exists()], args.top),
                               "controllers": cprofile_categories([f for f in ctrl if f.exists()], args.top)}
     return result
@@ -320,14 +328,13 @@ def report(result: dict) -> None:
     print(f"  {'total':38s} | " + " | ".join(f"{sum(v for c, v in cpu.items() if c.startswith(r + '|')):7.2f}"
                                              for r in roles) + f"   (all: {sum(cpu.values()):.2f} ms, "
           f"wall {1e3 * result['window_wall_s'] / ticks:.2f} ms a tick)")
-    rss = result["rss_mb"]
-    world = sum(v for r, v in rss.values() if r == "world")
-    ctrl = [v for r, v in rss.values() if r == "controllers"]
-    if k == 0:
-        ctrl = sorted(ctrl)[:-1] if len(ctrl) > 1 else ctrl  # the fork parent is the largest: not a robot
-    print(f"RSS: world {world:.0f} MB; {len(ctrl)} controller processes {sum(ctrl):.0f} MB "
-          f"({sum(ctrl) / max(len(ctrl), 1):.1f} MB each, {sum(ctrl) / n:.2f} MB per robot node); "
-          f"all processes {sum(v for _, v in rss.values()):.0f} MB")
+    mem = result["rss_mb"]
+    for i, kind in ((0, "RSS"), (1, "PSS")):
+        world = sum(m[i] for r, *m in mem.values() if r == "world")
+        ctrl = [m[i] for r, *m in mem.values() if r == "controllers"]
+        print(f"{kind}: world {world:.0f} MB; {len(ctrl)} controller process(es) {sum(ctrl):.0f} MB "
+              f"({sum(ctrl) / max(len(ctrl), 1):.1f} MB each, {sum(ctrl) / n:.2f} MB per robot node); "
+              f"all processes {sum(m[i] for _, *m in mem.values()):.0f} MB")
     for label, shares in result.get("perf", {}).items():
         print(f"perf, {label} process, share of samples: " + ", ".join(
             f"{name} {pct:.0f} %" for name, pct in sorted(shares.items(), key=lambda x: -x[1]) if pct >= 0.5))
@@ -354,6 +361,8 @@ def main() -> None:
                         default=[(1000, 38.0)], metavar="ROBOTS=SIDE",
                         help="arena side for runs of ROBOTS robots, resources scaled (as profile_batch.py)")
     parser.add_argument("--set", action="append", default=[], type=lambda t: f"--set={t}", metavar="KEY=VALUE")
+    parser.add_argument("--run-arg", action="append", default=[], metavar="ARG",
+                        help="a swarm-run option, e.g. --run-arg=--no-parameter-services (repeatable)")
     parser.add_argument("--perf", action="store_true", help="perf record the world and one controller process")
     parser.add_argument("--cprofile", action="store_true", help="cProfile the world and the controller processes")
     parser.add_argument("--top", type=int, default=0, help="with --cprofile: list the N costliest functions")
