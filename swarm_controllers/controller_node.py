@@ -188,10 +188,16 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
             executor.add_node(nodes[-1])
         share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
+        # One call dispatches one message, so the loop asks a flag, not rclpy.ok() (4-9 us a call:
+        # 5 ms a tick in a process of 112 robots).
+        stopped = []
+        rclpy.get_default_context().on_shutdown(lambda: stopped.append(True))
         connecting = list(nodes)
-        while rclpy.ok():
-            executor.spin_once(timeout_sec=0.1 if connecting else 0.5)
+        while connecting and not stopped:
+            executor.spin_once(timeout_sec=0.1)
             connecting = [n for n in connecting if not n.connect()]
+        while not stopped:
+            executor.spin_once(timeout_sec=0.5)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
