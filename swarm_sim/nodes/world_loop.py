@@ -95,13 +95,16 @@ class WorldLoop:
               flush=True)
         deadline = start + node.config.startup_timeout
         missing = list(robots)
-        said = checked = start
+        said = checked = counted = start
         while missing and time.monotonic() < deadline:
             self.spin(executor, 0.1)
-            if time.monotonic() - checked >= 1.0:
-                checked = time.monotonic()
+            now = time.monotonic()
+            if now - checked >= 1.0:
+                checked = now
                 node.check_foreign()  # foreign nodes by name, counts within the budget
-            missing = node.unconnected()
+            if now - counted >= 0.1:  # not at each of the start-up's many wake-ups: 5 counts a robot
+                counted = now
+                missing = node.unconnected(missing)
             if missing and time.monotonic() - said >= node.config.progress_period:
                 said = time.monotonic()
                 self.print_startup(missing, said - start)

@@ -349,11 +349,12 @@ class WorldNode(Node):
         if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
             self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
 
-    def unconnected(self) -> list[str]:
-        """Robots whose controller is not matched on every topic yet, and the servers if any
-        has no ack publisher yet."""
+    def unconnected(self, among: list[str] | None = None) -> list[str]:
+        """Robots (of `among`, default all) whose controller is not matched on every topic yet,
+        and the servers if any has no ack publisher yet."""
+        robots = self.robots if among is None else [r for r in among if r in self._cmd_subs]
         missing = [
-            r for r in self.robots
+            r for r in robots
             if self._cmd_subs[r].get_publisher_count() == 0
             or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
         ]
