@@ -22,7 +22,8 @@ seconds to the first after ``--warmup + --window``):
   processes (forked robot processes too) through a ``sitecustomize`` on PYTHONPATH and two signals
   (nothing in the project changes), its exclusive times summed by category (`CATEGORIES`).
   cProfile makes Python code ~2x slower, and C calls not at all: read its shares as the Python
-  side's split, not as times;
+  side's split, not as times; the executor's C++ ``spin_once`` includes the time a process waits
+  for messages (the thread CPU above says how busy it was);
 - RSS and PSS of every process at the window's end (per robot node: the controllers' sum / robots;
   PSS counts the pages forked robot processes share once);
 - the run's own real-time factor and stale ticks (its JSON summary).
@@ -70,7 +71,7 @@ the profiler on the main thread, SIGUSR2 stops it and writes PID.prof."""
 CATEGORIES = (
     # (category, predicate on (file, function)); the first that matches wins.
     ("publish (rmw + Fast DDS: serialise, send)", lambda f, n: f == "~" and "publish" in n),
-    ("executor: wait, take, dispatch (C++)", lambda f, n: f == "~" and "spin_once" in n),
+    ("executor C++: wait (idle included), take, dispatch", lambda f, n: f == "~" and "spin_once" in n),
     ("executor (rclpy Python)", lambda f, n: "rclpy/executors" in f or "rclpy/task" in f),
     ("graph queries (foreign watch, discovery)", lambda f, n: "taint.py" in f or (f == "~" and re.search(
         r"get_count_publishers|get_publishers_info|get_topic_names|get_node_names|get_publisher_count", n))
