@@ -279,8 +279,9 @@ def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
     for p in perf:
         p.wait()
     result["wall_s"] = time.perf_counter() - t0
+    summary = [line for line in lines if line.startswith("{")]  # swarm-run's --json line (verdicts follow it)
     try:
-        result["summary"] = json.loads(lines[-1])
+        result["summary"] = json.loads(summary[-1])
     except (ValueError, IndexError):
         result["summary"] = {}
         print("".join(lines[-20:]), file=sys.stderr)
