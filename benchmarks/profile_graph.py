@@ -36,6 +36,7 @@ import json
 import marshal
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -218,8 +219,15 @@ def cprofile_categories(files: list[Path], top: int) -> tuple[dict[str, float], 
 
 
 def one_run(args: argparse.Namespace, robots: int, processes: int) -> dict:
+    tmp = Path(tempfile.mkdtemp(prefix="profile-graph-"))  # the bag, profiles, perf data
+    try:
+        return measure(args, robots, processes, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def measure(args: argparse.Namespace, robots: int, processes: int, tmp: Path) -> dict:
     arena = dict(args.arena).get(robots)
-    tmp = Path(tempfile.mkdtemp(prefix="profile-graph-"))
     env = dict(os.environ)
     if args.cprofile:
         (tmp / "site").mkdir()
