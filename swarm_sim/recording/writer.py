@@ -54,8 +54,8 @@ class _Writer(Writer):
     """mcap's `Writer` whose `add_message` writes a message into the open chunk in a few steps:
     the same bytes, index and statistics as mcap's own (a dataclass, a dozen method calls and a
     seek back per message), which were a fifth of the world node's Python with 112 robots (560
-    messages recorded a tick). Relies on mcap 1.x's private members, checked when the file
-    starts; without them it is mcap's own `add_message`."""
+    messages recorded a tick). Relies on mcap 1.x's private members, checked at import; without
+    them it is mcap's own `add_message`."""
 
     _OWN = hasattr(Writer, "_Writer__maybe_finalize_chunk")
 
