@@ -90,6 +90,15 @@ class Recorder:
         if self.live is not None:
             self.live.write(topic, now, data)
 
+    def write_all(self, items: list[tuple[str, bytes]]) -> None:
+        """`write` for many (topic, data), stamped alike."""
+        now = self._now_ns()
+        if self.bag is not None:
+            self.bag.write_all(now, items)
+        if self.live is not None:
+            for topic, data in items:
+                self.live.write(topic, now, data)
+
     def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
         """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
         node = self._node

@@ -151,6 +151,9 @@ class WorldNode(Node):
             }
             for r in self.robots
         }
+        self._obs_targets = {r: {name: (pub, topics.robot_topic(r, name)) for name, pub in pubs.items()}
+                             for r, pubs in self._obs_pubs.items()}
+        """Robot -> observation name -> (publisher, topic)."""
         self._commands: dict[RobotId, Command] = {}
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
@@ -379,16 +382,17 @@ class WorldNode(Node):
         # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
         # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
         poses = self.world.odometry_poses()
+        out = []  # (publisher, topic, data), published and recorded in one go
         for r, o in obs.items():
-            pubs = self._obs_pubs[r]
+            targets = self._obs_targets[r]
             encoded = {
                 topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
                 topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
                 **self.sensing.encode_all(t_ns, o.sensed),
             }
-            for name, data in encoded.items():
-                publish(pubs[name], data, topics.robot_topic(r, name), send=send)
+            out += [(*targets[name], data) for name, data in encoded.items()]
             self._sent[r] = encoded
+        self.recording.publish_all(out, send=send)
         if self.state_topics:
             values = self.world.task.state()
             for st, pub in zip(self.state_topics, self._state_pubs):

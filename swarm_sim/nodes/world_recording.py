@@ -81,6 +81,14 @@ class WorldRecording:
             pub.publish(data)
         self.write(topic, data)
 
+    def publish_all(self, items: list[tuple[object, str, bytes]], *, send: bool = True) -> None:
+        """`publish` for many (publisher, topic, data), recorded in one go afterwards."""
+        if send:
+            for pub, _, data in items:
+                pub.publish(data)
+        if self.recorder is not None:
+            self.recorder.write_all([(topic, data) for _, topic, data in items])
+
     def discover(self, on_new: Callable[[str], None]) -> None:
         """Record every topic other nodes publish; `on_new(topic)` is told of each new one."""
         if self.recorder is not None:

@@ -239,6 +239,28 @@ class BagWriter:
             if stamp_ns > stats.end_ns:
                 stats.end_ns = stamp_ns
 
+    def write_all(self, stamp_ns: int, items: list[tuple[str, bytes]]) -> None:
+        """`write` for many (topic, data) of one stamp: one lock, one clock read (a tick's
+        observations: 4,000 messages with 1000 robots)."""
+        with self._lock:
+            now = self._clock()
+            if now >= self._deadline:
+                self._on_deadline(now)
+            if not 0 <= stamp_ns < _U64:
+                raise BagError(f"{self.path}: stamp_ns {stamp_ns!r} outside [0, 2**64)")
+            writer, stats, channels = self._writer, self._file, self._channels
+            assert writer is not None and stats is not None
+            counts = stats.counts
+            for topic, data in items:
+                channel = channels.get(topic)
+                if channel is None:
+                    raise self._unwritable(topic)
+                writer.add_message(channel, stamp_ns, data, stamp_ns)
+                counts[topic] += 1
+            if items:
+                stats.start_ns = min(stats.start_ns, stamp_ns)
+                stats.end_ns = max(stats.end_ns, stamp_ns)
+
     def poll(self) -> None:
         """Apply the flush/split policy without writing (for idle periods)."""
         with self._lock:
