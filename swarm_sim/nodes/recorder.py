@@ -25,7 +25,6 @@ from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_p
 from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.recording import BagWriter
 
-
 _ROBOT_NAMESPACE = re.compile(r"^/robot_\d+/")
 
 

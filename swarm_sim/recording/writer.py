@@ -44,7 +44,6 @@ from swarm_sim.recording.metadata import (
     flatten_metadata,
 )
 
-
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 """An MCAP Message record's head: opcode 0x05, record length, channel id, sequence, log time,
 publish time (the data follows)."""
