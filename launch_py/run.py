@@ -41,8 +41,10 @@ from launch_py.dds import (
     discovery_port,
     discovery_server_env,
     loopback_env,
+    remove_dead_shm_files,
     robot_profile,
     server_profile,
+    with_shared_memory,
 )
 from swarm_msgs_py import auth
 from swarm_sim import registry
@@ -183,6 +185,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--discovery", choices=("server", "simple"), default="server",
                         help="DDS discovery: the world node as discovery server for every other node (default; "
                              "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
+    parser.add_argument("--no-parameter-services", dest="parameter_services", action="store_false",
+                        help="no ros2 param services on the controller nodes: 12 DDS endpoints a robot fewer, "
+                             "45 %% less start-up CPU with 1000 robots (README, Benchmarks)")
+    parser.add_argument("--shared-memory", action="store_true",
+                        help="DDS data between the run's processes through shared memory (/dev/shm), UDP 127.0.0.1 "
+                             "for discovery and anyone else (default: UDP 127.0.0.1 only); less CPU with a few "
+                             "controller processes, more with one per robot (README, Benchmarks)")
     parser.add_argument("--foxglove", type=number(int, 0, 65535), nargs="?", const=DEFAULT_PORT, metavar="PORT",
                         help=f"serve the run live to Foxglove over WebSocket (default port {DEFAULT_PORT}; 0: any free)")
     parser.add_argument("--foxglove-host", default=LOOPBACK,
@@ -223,14 +232,22 @@ def main(argv: list[str] | None = None) -> int:
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
+    local = with_shared_memory if args.shared_memory else (lambda profile: profile)
+
+    def profile_env(base: dict[str, str], name: str, profile: str) -> dict[str, str]:
+        (profiles / name).write_text(local(profile), encoding="utf-8")
+        return {**base, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profiles / name),
+                "FASTDDS_DEFAULT_PROFILES_FILE": str(profiles / name)}
+
+    if args.shared_memory:
+        remove_dead_shm_files()  # what killed runs left
+        env = profile_env(env, "loopback.xml", PROFILE_PATH.read_text(encoding="utf-8"))
     world_env = env
     if port is not None:
-        (profiles / "discovery_server.xml").write_text(server_profile(port), encoding="utf-8")
-        world_env = discovery_server_env(env, profiles / "discovery_server.xml")
+        world_env = discovery_server_env(profile_env(env, "discovery_server.xml", server_profile(port)),
+                                         profiles / "discovery_server.xml")
     # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
-    (profiles / "robots.xml").write_text(robot_profile(), encoding="utf-8")
-    robots_env = {**env, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profiles / "robots.xml"),
-                  "FASTDDS_DEFAULT_PROFILES_FILE": str(profiles / "robots.xml")}
+    robots_env = profile_env(env, "robots.xml", robot_profile())
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -264,12 +281,14 @@ def main(argv: list[str] | None = None) -> int:
         world_cmd += ["--pace", str(pace)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
+    options = [] if args.parameter_services else ["--no-parameter-services"]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
         controllers = [("controller processes (one per robot)",
-                        [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names])]
+                        [*python, "swarm_controllers.controller_node", "--fork", *options, "--robots",
+                         *scenario.robot_names])]
     else:
         controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
-                        [*python, "swarm_controllers.controller_node", "--robots", *g]) for g in groups]
+                        [*python, "swarm_controllers.controller_node", *options, "--robots", *g]) for g in groups]
     children: list[tuple[str, subprocess.Popen]] = []
     world: subprocess.Popen | None = None
     interrupted = False
@@ -305,6 +324,8 @@ def main(argv: list[str] | None = None) -> int:
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
         shutil.rmtree(profiles, ignore_errors=True)
+        if args.shared_memory:
+            remove_dead_shm_files()  # robot processes leave without tearing their segments down
         os.close(domain_lock)  # every node is stopped: the domain is free again
 
     if world is None:  # interrupted before anything ran

@@ -16,7 +16,9 @@ behaviour itself, is counted on ``/diagnostics``.
 The node serves the standard parameter services (``ros2 param list/get``), created with it:
 twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
 discovery (README, Benchmarks); the discovery server only tells each process of the endpoints on
-its own topics.
+its own topics. ``--no-parameter-services`` leaves them out: more than half of a controller's
+endpoints, and with 1000 robots 45 % of the start-up's CPU (Fast DDS pairs every endpoint it
+learns of with every local one: the world, as discovery server, learns of them all).
 
 ``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process;
 with ``--fork`` it gives every robot its own process instead, forked from this one once the
@@ -66,12 +68,12 @@ class ControllerNode(Node):
     of the same seed."""
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
-                 **kwargs) -> None:
+                 parameter_services: bool = True, **kwargs) -> None:
         """`scenario`: the one `config` names, already loaded (saves each forked process the
-        parse)."""
+        parse); `parameter_services`: serve ``ros2 param`` (see the module docstring)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
-            "controller", namespace=robot, enable_rosout=False,
+            "controller", namespace=robot, enable_rosout=False, start_parameter_services=parameter_services,
             # No type description service: our types are standard ones every peer has, and its two
             # endpoints per robot are start-up cost with a process per robot.
             parameter_overrides=[Parameter("use_sim_time", value=True),
@@ -161,17 +163,20 @@ class ControllerNode(Node):
         self._cmd_pub.publish(self._answer)
 
 
-def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool]:
+def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool, bool]:
+    """(robots, config, ROS arguments, fork, parameter services)."""
     parser = argparse.ArgumentParser(prog="swarm-controllers", description=first_paragraph(__doc__))
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
     add_endpoint_arguments(parser)
     parser.add_argument("--fork", action="store_true", help="one process per robot, forked from this one")
+    parser.add_argument("--no-parameter-services", dest="parameter_services", action="store_false",
+                        help="no ros2 param services on the controller nodes (12 DDS endpoints a robot fewer)")
     args, ros_args = parser.parse_known_args(argv)
-    return args.robots, endpoint_config(args), ros_args, args.fork
+    return args.robots, endpoint_config(args), ros_args, args.fork, args.parameter_services
 
 
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
-          scenario: Scenario | None = None) -> int:
+          scenario: Scenario | None = None, parameter_services: bool = True) -> int:
     """The robots' controller nodes in this process, spun until shut down; `teardown=False`
     leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
@@ -179,14 +184,20 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     try:
         executor = make_executor()
         for robot in robots:
-            nodes.append(ControllerNode(robot, config, scenario=scenario))
+            nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services))
             executor.add_node(nodes[-1])
         share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
+        # One call dispatches one message, so the loop asks a flag, not rclpy.ok() (4-9 us a call:
+        # 5 ms a tick in a process of 112 robots).
+        stopped = []
+        rclpy.get_default_context().on_shutdown(lambda: stopped.append(True))
         connecting = list(nodes)
-        while rclpy.ok():
-            executor.spin_once(timeout_sec=0.1 if connecting else 0.5)
+        while connecting and not stopped:
+            executor.spin_once(timeout_sec=0.1)
             connecting = [n for n in connecting if not n.connect()]
+        while not stopped:
+            executor.spin_once(timeout_sec=0.5)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -225,7 +236,8 @@ STOP_GRACE = 5.0
 """Wall seconds the forked robot processes get to leave after Ctrl-C/SIGTERM before SIGKILL."""
 
 
-def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str]) -> int:
+def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str], *,
+                 parameter_services: bool = True) -> int:
     """One process per robot, forked from this one (see the module docstring).
 
     A robot process leaves without tearing its DDS participant down (`os._exit` once its loop
@@ -245,7 +257,8 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
             set_process_name(robot)
             code = 1
             try:
-                code = serve([robot], config, ros_args, teardown=False, scenario=scenario)
+                code = serve([robot], config, ros_args, teardown=False, scenario=scenario,
+                             parameter_services=parameter_services)
             finally:
                 sys.stdout.flush()
                 sys.stderr.flush()
@@ -284,9 +297,9 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
 
 
 def main(argv: list[str] | None = None) -> int:
-    robots, config, ros_args, fork = parse_args(sys.argv[1:] if argv is None else argv)
+    robots, config, ros_args, fork, parameter_services = parse_args(sys.argv[1:] if argv is None else argv)
     auth.load_from_environment()  # the run's key, when the launcher handed one down (forks inherit it)
-    return (serve_forked if fork else serve)(robots, config, ros_args)
+    return (serve_forked if fork else serve)(robots, config, ros_args, parameter_services=parameter_services)
 
 
 if __name__ == "__main__":

@@ -619,3 +619,30 @@ def test_analysis_takes_no_more_than_the_live_graph(tmp_path: Path) -> None:
     assert summary["oae_by_robot"] == {"robot_0": 3, "robot_1": 0}
     assert summary["malformed_messages"] == 3
     assert analyze([str(bag), "--json", "--plot", str(tmp_path / "plot.png")]) == 0
+
+
+def test_the_fast_message_path_writes_the_bytes_mcap_writes() -> None:
+    """`_Writer.add_message` (the world's recording path) against mcap's own, byte for byte:
+    several channels, out-of-order and equal stamps, chunks finished on size."""
+    import io
+    import random
+
+    from mcap.writer import Writer
+
+    from swarm_sim.recording.writer import _Writer
+
+    assert _Writer._OWN  # the fast path is taken with the mcap we ship
+    outputs = []
+    for cls in (Writer, _Writer):
+        stream = io.BytesIO()
+        writer = cls(stream, chunk_size=4096)
+        writer.start(profile="ros2", library="test")
+        schema = writer.register_schema("std_msgs/msg/String", "ros2msg", b"string data")
+        channels = [writer.register_channel(f"/t{i}", "cdr", schema) for i in range(3)]
+        gen = random.Random(3)
+        for k in range(500):
+            stamp = gen.randrange(10**12) if k % 7 == 0 else 10**9 * (k // 5)
+            writer.add_message(channels[k % 3], stamp, gen.randbytes(gen.randrange(300)), stamp)
+        writer.finish()
+        outputs.append(stream.getvalue())
+    assert outputs[0] == outputs[1] and len(outputs[0]) > 4 * 4096

@@ -452,3 +452,30 @@ def test_a_claimed_domain_is_refused_to_a_second_claim_until_released() -> None:
     finally:
         os.close(lock)
     os.close(dds.claim_domain(domain))
+
+
+def test_the_shared_memory_profile_keeps_udp_on_loopback_and_adds_no_socket() -> None:
+    """`with_shared_memory`: the SHM transport beside the UDP one (which stays on the 127.0.0.1
+    allow-list, with discovery on 127.0.0.1), and no explicit UDP default locator to hide it."""
+    for profile in (dds.robot_profile(), dds.server_profile(7123), dds.PROFILE_PATH.read_text()):
+        shm = dds.with_shared_memory(profile)
+        assert "<type>SHM</type>" in shm and "<useBuiltinTransports>false</useBuiltinTransports>" in shm
+        assert "defaultUnicastLocatorList" not in shm
+        assert shm.count("swarmforage_shm") == 2 and shm.count("swarmforage_udp_lo") == 2
+        assert "<address>127.0.0.1</address>" in shm.split("interfaceWhiteList")[1]
+        assert "metatrafficUnicastLocatorList" in shm and "0.0.0.0" not in shm
+
+
+def test_dead_shared_memory_files_are_removed_and_live_ones_kept(tmp_path) -> None:
+    import fcntl
+
+    for base in ("fastrtps_0123456789abcdef", "fastrtps_port7411", "fastrtps_fedcba9876543210"):
+        (tmp_path / base).write_bytes(b"x")
+        (tmp_path / f"{base}_el").write_bytes(b"")
+    (tmp_path / "sem.fastrtps_port7411_mutex").write_bytes(b"")
+    (tmp_path / "other_el").write_bytes(b"")  # not Fast DDS's
+    with open(tmp_path / "fastrtps_fedcba9876543210_el", "ab") as live:
+        fcntl.flock(live, fcntl.LOCK_EX | fcntl.LOCK_NB)  # its owner lives
+        assert dds.remove_dead_shm_files(tmp_path) == 5
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fastrtps_fedcba9876543210", "fastrtps_fedcba9876543210_el",
+                                                          "other_el"]

@@ -31,3 +31,22 @@ def test_graph_lockstep_equals_batch(tmp_path):
     for key in COMPARED:
         assert graph[key] == expected[key], key
     assert graph["resources_delivered"] > 0
+
+
+def test_graph_with_a_process_per_robot_equals_batch_at_112_robots(tmp_path):
+    """Issue 27's scale: 112 robot processes (the CPFA scenario's swarm, its arena), 10 s: every
+    odometry sample the bag holds is the batch run's pose, and the metrics agree."""
+    robots, duration, seed = 112, 10.0, 5
+    bag = tmp_path / "graph"
+    graph = run_graph(bag, "--robots", str(robots), "--duration", str(duration), "--seed", str(seed),
+                      "--controller-processes", "0")
+    scenario = load_scenario("cpfa", robots__count=robots, sim__duration=duration, seed=seed)
+    batch = run_batch(scenario, record_poses=True)
+    expected = summarize(batch.trace)
+    odom = load_odometry(bag)
+    assert len(odom) == robots
+    for i, (robot, rows) in enumerate(odom.items()):
+        np.testing.assert_array_equal(rows[:, 1:], batch.poses[:, i, :], err_msg=robot)
+    for key in COMPARED:
+        assert graph[key] == expected[key], key
+    assert graph["stale_ticks"] == 0 and graph["dead_nodes"] == []

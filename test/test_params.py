@@ -47,3 +47,19 @@ def test_param_list_and_get_answer_on_every_node(context, make, name, seed):
         executor.shutdown()
         node.destroy_node()
         client_node.destroy_node()
+
+
+def test_a_controller_without_parameter_services_still_holds_its_parameters(context):
+    """``--no-parameter-services`` (issue 27: fewer endpoints at scale): no service endpoints, the
+    parameters declared all the same."""
+    with_services = ControllerNode("robot_0", ControllerConfig("cpfa", SMALL, 7), context=context)
+    without = ControllerNode("robot_1", ControllerConfig("cpfa", SMALL, 7), context=context, parameter_services=False)
+    try:
+        services = lambda node: {n for n, _ in node.get_service_names_and_types_by_node(node.get_name(),  # noqa: E731
+                                                                                       node.get_namespace())}
+        assert "/robot_0/controller/list_parameters" in services(with_services)
+        assert not any("parameter" in s for s in services(without))
+        assert without.get_parameter("seed").value == 7
+    finally:
+        with_services.destroy_node()
+        without.destroy_node()

@@ -27,6 +27,17 @@ class LockstepBarrier:
         """Participants declared dead (final)."""
         self._answered: dict[str, int] = {}
         self.dead_after = dead_after
+        self._open: int | None = None
+        self.outstanding: set[str] = set()
+        """The live participants that have not answered the open tick (`open_tick`) yet: kept
+        as answers arrive, so the world's wait loop asks in O(1) per wake-up (with a thousand
+        robots, rebuilding the list of those waiting at each of a tick's ~1000 wake-ups cost
+        more than the tick's physics)."""
+
+    def open_tick(self, stamp_ns: int) -> None:
+        """Tick `stamp_ns` went out: `outstanding` follows its answers from now on."""
+        self._open = stamp_ns
+        self.outstanding = {p for p in self.live() if self._answered.get(p) != stamp_ns}
 
     def answered(self, who: str, stamp_ns: int) -> bool:
         """`who` answered tick `stamp_ns`; False (and nothing recorded) for a participant that
@@ -34,6 +45,8 @@ class LockstepBarrier:
         if who not in self.missed or who in self.dead:
             return False
         self._answered[who] = stamp_ns
+        if stamp_ns == self._open:
+            self.outstanding.discard(who)
         return True
 
     def heard(self, who: str) -> None:

@@ -13,7 +13,8 @@ message also goes to the Foxglove clients, as the same bytes.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import re
+from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 
 from rclpy.node import Node
@@ -23,6 +24,8 @@ from swarm_msgs_py import topics
 from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_profile
 from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.recording import BagWriter
+
+_ROBOT_NAMESPACE = re.compile(r"^/robot_\d+/")
 
 
 class Recorder:
@@ -86,6 +89,15 @@ class Recorder:
         if self.live is not None:
             self.live.write(topic, now, data)
 
+    def write_all(self, items: list[tuple[str, bytes]]) -> None:
+        """`write` for many (topic, data), stamped alike."""
+        now = self._now_ns()
+        if self.bag is not None:
+            self.bag.write_all(now, items)
+        if self.live is not None:
+            for topic, data in items:
+                self.live.write(topic, now, data)
+
     def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
         """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
         node = self._node
@@ -108,17 +120,24 @@ class Recorder:
                 RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
-    def record_offered_qos(self) -> None:
+    def record_offered_qos(self, each: Collection[str] = ()) -> None:
         """Write each topic's offered QoS (one profile per publisher, as the graph reports it) and
         type description hash into the bag, as ``ros2 bag record`` does; topics without a
-        publisher left keep the profile they were added with."""
+        publisher left keep the profile they were added with. The robots' topics of one name
+        (``/robot_<i>/odom``, ...) have publishers made by the same code with the same QoS, so the
+        graph is asked for one of them for all (each question walks the whole graph: with 1000
+        robots, asking for each of ~8,000 topics took minutes at the run's end); a topic in `each`
+        (one where a foreign publisher was found) is asked for itself."""
         if self.bag is None:
             return
+        answers: dict[str, list] = {}
         for topic in sorted(self.known):
+            family = topic if topic in each else _ROBOT_NAMESPACE.sub("/robot_*/", topic, count=1)
             try:
-                infos = self._node.get_publishers_info_by_topic(topic)
+                infos = answers.get(family) or self._node.get_publishers_info_by_topic(topic)
             except Exception:  # noqa: BLE001 - the graph is gone (shutdown): keep the defaults
                 return
+            answers[family] = infos
             recorded = self._recorded_types.get(topic)
             infos = [i for i in infos if i.topic_type == recorded]  # a foreign type's publisher is not the topic's
             if not infos:
@@ -136,13 +155,14 @@ class Recorder:
         if self.bag is not None:
             self.bag.poll()
 
-    def close(self, **metadata: str) -> None:
-        """Write the run's totals into the metadata and finish the bag (idempotent)."""
+    def close(self, each: Collection[str] = (), **metadata: str) -> None:
+        """Write the run's totals into the metadata and finish the bag (idempotent); `each`: as
+        `record_offered_qos`."""
         if not self.closed:
             self.closed = True
             if self.live is not None:
                 self.live.close()
             if self.bag is not None:
-                self.record_offered_qos()
+                self.record_offered_qos(each)
                 self.bag.set_metadata(**metadata)
                 self.bag.close()

@@ -10,9 +10,9 @@ publisher's messages are refused and counted where they arrive. Observations, co
 and the task's state topics are standard types that cannot carry a tag: there only the graph can
 tell. `ForeignWatch` asks it (the world is the discovery server and sees every endpoint of the
 run): a publisher on a run's topic whose node is none of the topic's publishers, or one more than
-the topic has, is foreign. The world looks every wall second (commands, acks, the robots'
-messages and ``/clock`` every time, the observation and state topics a fifth at a time:
-`SWEEP_CHECKS`) and reports each at once (an error line, a ``foreign publisher``
+the topic has, is foreign. The world looks every wall second (every node that is none of the run's, by name; the
+counts of commands, acks, the robots' messages and ``/clock``; the observation and state topics'
+counts a few at a time, within `SWEEP_BUDGET`) and reports each at once (an error line, a ``foreign publisher``
 count on ``/diagnostics``) and the run is *tainted* (``foreign_publishers`` in the bag's metadata
 and the summary, `swarm-run` exit 6) when the topic carries no tag or the run has no key: what it
 sent may have reached a core. The run goes on to its end either way, so its bag holds everything.
@@ -25,6 +25,7 @@ judged by the count alone until its name is known.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -118,33 +119,45 @@ def _full(namespace: str, name: str) -> str:
     return "?" if name == UNKNOWN else f"{namespace.rstrip('/')}/{name}"
 
 
-SWEEP_CHECKS = 5
-"""`ForeignWatch.check` counts the graph's publishers of a fifth of the run's topics per call (each
-topic every 5 s at one call a wall second): a count costs ~35 us in a 112-robot graph, all 700
-topics ~25 ms, 2 % of the world's time. Topics the world itself hears (commands, acks, the robots'
-messages) are counted every call, from its subscriptions' matches (local, ~1 us), and so is
-``/clock``."""
+SWEEP_BUDGET = 0.005
+"""Wall seconds a `ForeignWatch.check` (one a wall second) may spend on the graph's per-topic
+queries beyond its node pass: a count or a topic's publisher list walks the whole graph (~35 us in a
+112-robot graph, ~0.5 ms with 1000 robots and 16,000 endpoints), so a fixed share of the topics
+per check (a fifth, before issue 27) cost the 1000-robot world 0.4 s a wall second, and at
+start-up, when every topic's count changes, seconds. Within the budget it judges the topics whose
+count changed and counts the next of the others; the rotation through all of them takes ~5 s at 112
+robots and minutes at 1000. Foreign nodes are found faster than that by name (`ForeignWatch.check`)."""
 
 
 class ForeignWatch:
     """The world's check of the graph for foreign publishers on the run's topics (see the module
     docstring). A topic's publishers are looked at only when their count changed since it was
-    last counted."""
+    last counted, or when a node that is none of the run's publishes on it."""
 
     def __init__(self, scenario: Scenario, publishers_info: Callable[[str], list],
-                 count_publishers: Callable[[str], int]) -> None:
+                 count_publishers: Callable[[str], int], node_names: Callable[[], list] = lambda: [],
+                 publishers_of_node: Callable[[str, str], list] = lambda name, namespace: []) -> None:
+        """`node_names()`: (name, namespace) of every node in the graph; `publishers_of_node(name,
+        namespace)`: that node's (topic, types) (rclpy's names for both)."""
         self.topics = run_topics(scenario)
         self._info = publishers_info
         self._count = count_publishers
+        self._node_names = node_names
+        self._publishers_of_node = publishers_of_node
+        self._ours = set().union(*(t.publishers for t in self.topics.values()))
         self.heard: dict[str, Callable[[], int]] = {}
         """Topic -> the matched publisher count of the world's own subscription to it (`hear`)."""
         self._sweep = [t for t in self.topics]
         self._cursor = 0
         self._counts: dict[str, int] = {}
+        self._due: dict[str, None] = {}
+        """Topics whose publishers are to be judged (their count changed), oldest first."""
         self._known: set[tuple[str, str]] = set()
         """(topic, GID) of every publisher judged so far (ours and foreign)."""
         self._unnamed: set[str] = set()
         """Topics that had a publisher of a node not named yet: looked at again next time."""
+        self._judged: set[tuple[str, str, str]] = set()
+        """(namespace, name, topic) of the suspect nodes' publishers judged so far."""
         self.found: list[Foreign] = []
 
     def hear(self, topic: str, matched: Callable[[], int]) -> None:
@@ -153,25 +166,70 @@ class ForeignWatch:
             self.heard[topic] = matched
             self._sweep = [t for t in self._sweep if t != topic]
 
-    def check(self, full: bool = False) -> list[Foreign]:
-        """The foreign publishers that appeared since the last check: on the topics the world
-        hears, on the next slice of the others (all of them with `full`), and on the topics whose
-        publishers' nodes were not all named yet."""
+    def check(self, budget: float = SWEEP_BUDGET) -> list[Foreign]:
+        """The foreign publishers that appeared since the last check: every publisher of a node
+        that is none of the run's (or that shares the name of one of them), and, within `budget`
+        wall seconds, on the topics the world hears whose count changed, on the next of the others,
+        and on the topics whose publishers' nodes were not all named yet (``math.inf``: all of
+        them, once)."""
+        new = self._by_node()
+        for topic, matched in self.heard.items():
+            self._recount(topic, matched())
+        self._recount(CLOCK, self._count(CLOCK))
+        for topic in self._unnamed:
+            self._due[topic] = None
+        self._unnamed = set()
+        stop = time.perf_counter() + budget  # past it, one more of each (so each check moves on)
+        judged = 0
+        while self._due and (not judged or time.perf_counter() < stop):
+            topic = next(iter(self._due))
+            del self._due[topic]
+            new += self._judge(topic, self.topics[topic])
+            judged += 1
         n = len(self._sweep)
-        size = n if full else -(-n // SWEEP_CHECKS)
-        start, self._cursor = self._cursor, (self._cursor + size) % max(n, 1)
-        swept = [self._sweep[(start + k) % n] for k in range(min(size, n))]
-        new: list[Foreign] = []
-        for topic in dict.fromkeys([*self.heard, CLOCK, *swept, *self._unnamed]):
-            matched = self.heard.get(topic)
-            count = matched() if matched is not None else self._count(topic)
-            if count == self._counts.get(topic) and topic not in self._unnamed:
-                continue
-            self._counts[topic] = count
-            self._unnamed.discard(topic)
-            if count:
+        for k in range(n):
+            if k and time.perf_counter() >= stop:
+                break
+            topic = self._sweep[self._cursor]
+            self._cursor = (self._cursor + 1) % n
+            if self._recount(topic, self._count(topic)):
+                del self._due[topic]
                 new += self._judge(topic, self.topics[topic])
         self.found += new
+        return new
+
+    def _recount(self, topic: str, count: int) -> bool:
+        """Note `topic`'s publisher count; True (and the topic due to be judged) if it changed to
+        a non-zero count."""
+        if count == self._counts.get(topic):
+            return False
+        self._counts[topic] = count
+        if count:
+            self._due[topic] = None
+        return bool(count)
+
+    def _by_node(self) -> list[Foreign]:
+        """Publishers on the run's topics of nodes that are none of the run's, or that bear the
+        name of one of the run's nodes twice: one node list, then a publisher list per such node
+        (few), every check."""
+        names = [(namespace, name) for name, namespace in self._node_names()]
+        seen: set[tuple[str, str]] = set()
+        suspects = []
+        for node in names:
+            if node not in self._ours or node in seen:
+                suspects.append(node)
+            seen.add(node)
+        new: list[Foreign] = []
+        for namespace, name in dict.fromkeys(suspects):
+            try:
+                published = self._publishers_of_node(name, namespace)
+            except Exception:  # noqa: BLE001 - the node left between the two queries
+                continue
+            for topic, _ in published:
+                if topic in self.topics and (namespace, name, topic) not in self._judged:
+                    self._judged.add((namespace, name, topic))
+                    self._due.pop(topic, None)
+                    new += self._judge(topic, self.topics[topic])
         return new
 
     def _judge(self, topic: str, spec: RunTopic) -> list[Foreign]:

@@ -28,6 +28,10 @@ _IMPORTED = time.monotonic()
 """When the world node's imports were done (start-up lines count from here)."""
 
 
+POLL_PERIOD = 0.05
+"""Wall seconds between the lockstep wait's polls of the bag (it flushes every second)."""
+
+
 class Interrupted(Exception):
     """SIGINT or SIGTERM arrived: stop at the next safe point and close the bag."""
 
@@ -50,7 +54,7 @@ class WorldLoop:
         cfg, sim, world = node.config, node.scenario.sim, node.world
         node.discover()
         self.wait_for_controllers(executor)
-        node.check_foreign(full=True)
+        node.check_foreign()  # at every foreign node; at every topic's count within minutes at 1000 robots
         node.outputs.start_live_view(node.discover)
         obs = world.reset()
         wall0 = last_progress = time.monotonic()
@@ -91,13 +95,16 @@ class WorldLoop:
               flush=True)
         deadline = start + node.config.startup_timeout
         missing = list(robots)
-        said = checked = start
+        said = checked = counted = start
         while missing and time.monotonic() < deadline:
             self.spin(executor, 0.1)
-            if time.monotonic() - checked >= 1.0:
-                checked = time.monotonic()
-                node.check_foreign(full=True)  # before the first tick: every topic, every second
-            missing = node.unconnected()
+            now = time.monotonic()
+            if now - checked >= 1.0:
+                checked = now
+                node.check_foreign()  # foreign nodes by name, counts within the budget
+            if now - counted >= 0.1:  # not at each of the start-up's many wake-ups: 5 counts a robot
+                counted = now
+                missing = node.unconnected(missing)
             if missing and time.monotonic() - said >= node.config.progress_period:
                 said = time.monotonic()
                 self.print_startup(missing, said - start)
@@ -109,27 +116,35 @@ class WorldLoop:
             )
 
     def await_commands(self, executor: Executor) -> None:
-        """Lockstep barrier: spin until every live controller and server answered this tick."""
+        """Lockstep barrier: spin until every live controller and server answered this tick.
+        One wake-up dispatches one message (the EventsExecutor), so the loop does as little as
+        it can per wake-up: the barrier keeps the set of those outstanding, the stop flag is a
+        read, and the bag is polled every `POLL_PERIOD`."""
         node = self.node
         stamp = node.world.t_ns
-        waiting = node.barrier.live()
+        barrier = node.barrier
+        barrier.open_tick(stamp)
+        outstanding = barrier.outstanding
         now = time.monotonic()
         deadline, resend = now + node.config.tick_timeout, now + node.config.resend_period
-        while True:
-            waiting = node.barrier.waiting(stamp, waiting)
+        next_poll = now + POLL_PERIOD
+        while outstanding:
+            if node.stop_requested:
+                raise Interrupted
             now = time.monotonic()
-            if not waiting:
-                break
             if now >= deadline:  # take what has already arrived before calling anyone stale
-                for _ in range(4 * len(waiting)):
+                for _ in range(4 * len(outstanding)):
                     executor.spin_once(timeout_sec=0.0)
                 break
             if now >= resend:  # a sample lost (e.g. while discovery settles): ask again
                 resend = now + node.config.resend_period
-                node.resend(waiting, stamp)
-            bag_time = self.spin(executor, min(0.05, max(0.0, deadline - now)))
-            deadline += bag_time
-            resend += bag_time
+                node.resend([p for p in barrier.live() if p in outstanding], stamp)
+            executor.spin_once(timeout_sec=min(0.05, deadline - now))
+            if now >= next_poll:
+                bag_time = node.recording.poll()  # flushing the bag is not the controllers' time
+                deadline += bag_time
+                resend += bag_time
+                next_poll = now + POLL_PERIOD
         node.close_tick(stamp)
 
     def await_wall(self, executor: Executor, until: float) -> None:

@@ -114,7 +114,8 @@ class WorldNode(Node):
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
-        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers)
+        self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers,
+                                  self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node)
         """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
         self.foreign: list[str] = []
         """The foreign publishers found whose messages may have reached a core: the run is tainted."""
@@ -148,6 +149,9 @@ class WorldNode(Node):
             }
             for r in self.robots
         }
+        self._obs_targets = {r: {name: (pub, topics.robot_topic(r, name)) for name, pub in pubs.items()}
+                             for r, pubs in self._obs_pubs.items()}
+        """Robot -> observation name -> (publisher, topic)."""
         self._commands: dict[RobotId, Command] = {}
         self._taken_cmd: dict[RobotId, bytes] = {}
         """Each robot's last command taken, as received (its repeats are not recorded again)."""
@@ -339,11 +343,11 @@ class WorldNode(Node):
         self.recording.discover(self._warn_unknown_commands)
         self.check_foreign()
 
-    def check_foreign(self, full: bool = False) -> None:
+    def check_foreign(self) -> None:
         """Report each new foreign publisher on a run's topic (`swarm_sim.nodes.taint`): an error
         line, a ``foreign publisher`` count on ``/diagnostics``; one that can have reached a core
-        (an untagged topic) taints the run. `full`: every topic now (else a slice of them)."""
-        for f in self.watch.check(full):
+        (an untagged topic) taints the run."""
+        for f in self.watch.check():
             self.inbound.reject(f.topic, Reason.FOREIGN, f"{f.node} (GID {f.gid[:16]}...)")
             if f.tainting:
                 self.foreign.append(str(f))
@@ -357,11 +361,12 @@ class WorldNode(Node):
         if topic.endswith("/" + topics.CMD_VEL) and topic not in self._cmd_topic:
             self.get_logger().warning(f"ignoring commands on {topic}: unknown robot namespace")
 
-    def unconnected(self) -> list[str]:
-        """Robots whose controller is not matched on every topic yet, and the servers if any
-        has no ack publisher yet."""
+    def unconnected(self, among: list[str] | None = None) -> list[str]:
+        """Robots (of `among`, default all) whose controller is not matched on every topic yet,
+        and the servers if any has no ack publisher yet."""
+        robots = self.robots if among is None else [r for r in among if r in self._cmd_subs]
         missing = [
-            r for r in self.robots
+            r for r in robots
             if self._cmd_subs[r].get_publisher_count() == 0
             or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
         ]
@@ -386,16 +391,17 @@ class WorldNode(Node):
         # Encode the unrounded odometry: the decoder applies the quaternion rounding exactly once,
         # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
         poses = self.world.odometry_poses()
+        out = []  # (publisher, topic, data), published and recorded in one go
         for r, o in obs.items():
-            pubs = self._obs_pubs[r]
+            targets = self._obs_targets[r]
             encoded = {
                 topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
                 topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
                 **self.sensing.encode_all(t_ns, o.sensed),
             }
-            for name, data in encoded.items():
-                publish(pubs[name], data, topics.robot_topic(r, name), send=send)
+            out += [(*targets[name], data) for name, data in encoded.items()]
             self._sent[r] = encoded
+        self.recording.publish_all(out, send=send)
         if self.state_topics:
             values = self.world.task.state()
             for st, pub in zip(self.state_topics, self._state_pubs):
@@ -417,6 +423,7 @@ class WorldNode(Node):
 
     def close(self) -> None:
         self.recording.close(
+            {f.topic for f in self.watch.found},
             wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
             sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
             server_stale_ticks=json.dumps(self.server_stale_ticks),

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 
 from rclpy.node import Node
@@ -81,6 +81,14 @@ class WorldRecording:
             pub.publish(data)
         self.write(topic, data)
 
+    def publish_all(self, items: list[tuple[object, str, bytes]], *, send: bool = True) -> None:
+        """`publish` for many (publisher, topic, data), recorded in one go afterwards."""
+        if send:
+            for pub, _, data in items:
+                pub.publish(data)
+        if self.recorder is not None:
+            self.recorder.write_all([(topic, data) for _, topic, data in items])
+
     def discover(self, on_new: Callable[[str], None]) -> None:
         """Record every topic other nodes publish; `on_new(topic)` is told of each new one."""
         if self.recorder is not None:
@@ -98,10 +106,11 @@ class WorldRecording:
     def live(self) -> LiveView | None:
         return self.recorder.live if self.recorder is not None else None
 
-    def close(self, **metadata: str) -> None:
-        """Write the run's totals into the bag's metadata and close it."""
+    def close(self, each: Collection[str] = (), **metadata: str) -> None:
+        """Write the run's totals into the bag's metadata and close it; `each`: the topics whose
+        offered QoS is asked for one by one (`Recorder.record_offered_qos`)."""
         if self.recorder is not None:
-            self.recorder.close(**metadata)
+            self.recorder.close(each, **metadata)
 
 
 def _live_view(host: str, port: int) -> LiveView | None:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import struct
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -15,6 +16,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any, BinaryIO
 
+from mcap.records import MessageIndex
 from mcap.writer import Writer
 
 try:
@@ -41,6 +43,45 @@ from swarm_sim.recording.metadata import (
     _type_hash,
     flatten_metadata,
 )
+
+_MESSAGE_HEAD = struct.Struct("<BQHIQQ")
+"""An MCAP Message record's head: opcode 0x05, record length, channel id, sequence, log time,
+publish time (the data follows)."""
+
+
+class _Writer(Writer):
+    """mcap's `Writer` whose `add_message` writes a message into the open chunk in a few steps:
+    the same bytes, index and statistics as mcap's own (a dataclass, a dozen method calls and a
+    seek back per message), which were a fifth of the world node's Python with 112 robots (560
+    messages recorded a tick). Relies on mcap 1.x's private members, checked at import; without
+    them it is mcap's own `add_message`."""
+
+    _OWN = hasattr(Writer, "_Writer__maybe_finalize_chunk")
+
+    def add_message(self, channel_id: int, log_time: int, data: bytes, publish_time: int, sequence: int = 0):
+        chunk = getattr(self, "_Writer__chunk_builder", None) if self._OWN else None
+        if chunk is None:
+            return super().add_message(channel_id, log_time, data, publish_time, sequence)
+        stats = self._Writer__statistics
+        if stats.message_count == 0 or log_time < stats.message_start_time:
+            stats.message_start_time = log_time
+        if log_time > stats.message_end_time:
+            stats.message_end_time = log_time
+        stats.channel_message_counts[channel_id] += 1
+        stats.message_count += 1
+        if chunk.num_messages == 0 or log_time < chunk.message_start_time:
+            chunk.message_start_time = log_time
+        if log_time > chunk.message_end_time:
+            chunk.message_end_time = log_time
+        buffer = chunk.record_writer._buffer
+        index = chunk.message_indices.get(channel_id)
+        if not index:
+            index = chunk.message_indices[channel_id] = MessageIndex(channel_id=channel_id, records=[])
+        index.records.append((log_time, buffer.tell()))
+        chunk.num_messages += 1
+        buffer.write(_MESSAGE_HEAD.pack(0x05, 22 + len(data), channel_id, sequence, log_time, publish_time))
+        buffer.write(data)
+        self._Writer__maybe_finalize_chunk()
 
 
 @dataclass(frozen=True)
@@ -197,6 +238,28 @@ class BagWriter:
             if stamp_ns > stats.end_ns:
                 stats.end_ns = stamp_ns
 
+    def write_all(self, stamp_ns: int, items: list[tuple[str, bytes]]) -> None:
+        """`write` for many (topic, data) of one stamp: one lock, one clock read (a tick's
+        observations: 4,000 messages with 1000 robots)."""
+        with self._lock:
+            now = self._clock()
+            if now >= self._deadline:
+                self._on_deadline(now)
+            if not 0 <= stamp_ns < _U64:
+                raise BagError(f"{self.path}: stamp_ns {stamp_ns!r} outside [0, 2**64)")
+            writer, stats, channels = self._writer, self._file, self._channels
+            assert writer is not None and stats is not None
+            counts = stats.counts
+            for topic, data in items:
+                channel = channels.get(topic)
+                if channel is None:
+                    raise self._unwritable(topic)
+                writer.add_message(channel, stamp_ns, data, stamp_ns)
+                counts[topic] += 1
+            if items:
+                stats.start_ns = min(stats.start_ns, stamp_ns)
+                stats.end_ns = max(stats.end_ns, stamp_ns)
+
     def poll(self) -> None:
         """Apply the flush/split policy without writing (for idle periods)."""
         with self._lock:
@@ -286,7 +349,7 @@ class BagWriter:
     def _start_file(self, now: float) -> None:
         name = f"{self.path.name}_{len(self._finished)}.mcap"
         stream = open(self.path / name, "xb")  # noqa: SIM115 - closed in _finalize or close
-        writer = Writer(stream, compression=self._compression)
+        writer = _Writer(stream, compression=self._compression)
         writer.start(profile="ros2", library=LIBRARY)
         if self._custom:
             writer.add_metadata(CUSTOM_RECORD, dict(self._custom))
