@@ -22,6 +22,7 @@ import argparse
 import json
 import os
 import secrets
+import shlex
 import shutil
 import signal
 import subprocess
@@ -365,6 +366,9 @@ def _done_lines(summary: dict, scenario: Scenario | None, bag: Path) -> list[str
     return [f"[swarm-run] done: {summary['sim_seconds']:.1f} s sim in {summary['wall_seconds']:.1f} s wall"
             + (f" ({rtf}x)" if rtf else ""),
             *summary_lines(summary, scenario),
+            *(f"  host {host:<26} {c['robots']} robots: {c['stale']} stale ticks, {c['late']} late commands, "
+              f"{c['lost']} ticks without a command, {c['resent']} ticks re-sent, {c['stopped']} stops by the "
+              "command timeout" for host, c in (summary.get("by_host") or {}).items()),
             f"[swarm-run] bag: {bag}  (swarm-analyze {bag} --trajectories for its figures)"]
 
 
@@ -415,7 +419,7 @@ def _print_remote(domain: int, server: tuple[str, int], remote: dict[str, list[s
           f"host joins with: eval \"$({join}python -m launch_py.hosts env --bind ITS_ADDRESS {where})\"", flush=True)
     for host, robots in remote.items():
         print(f"[swarm-run] on {host}: {join}SWARMFORAGE_KEY_FD=3 swarm-controllers --bind ITS_ADDRESS {where} "
-              f"--robots {' '.join(robots)} {' '.join(common)} 3<{key_file}", flush=True)
+              f"--robots {' '.join(robots)} {shlex.join(common)} 3<{shlex.quote(str(key_file))}", flush=True)
 
 
 def by_host(summary: dict, robots_of: dict[str, list[str]]) -> dict[str, dict]:

@@ -48,6 +48,7 @@ from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
+from swarm_sim.nodes.command_watch import CommandWatch
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.status_watch import StatusWatch
@@ -151,6 +152,10 @@ class WorldNode(Node):
             for r in self.robots
         }
         self._commands: dict[RobotId, Command] = {}
+        realtime = cfg.mode == "realtime"
+        self.command_watch = CommandWatch(self.robots, self.scenario.dt_ns, self.scenario.ticks,
+                                          round(self.scenario.sim.command_timeout * NS_PER_S) if realtime else 0)
+        """Late, lost, re-sent commands per robot; realtime: the command timeout."""
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
@@ -250,8 +255,15 @@ class WorldNode(Node):
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
                 self.barrier.heard(robot)  # slow, not dead
+                self.command_watch.taken(robot, stamp_ns, self.world.t_ns)
             self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
+            return False
+        if stamp_ns > self.world.t_ns:  # realtime: no robot can answer a tick not yet published
+            self.inbound.reject(topic, Reason.WRONG_TICK, f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
+            return False
+        if not self.command_watch.taken(robot, stamp_ns, self.world.t_ns):  # overtaken by a newer one
+            self.inbound.reject(topic, Reason.LATE, f"stamped {stamp_ns} ns, older than the command held")
             return False
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
@@ -280,8 +292,10 @@ class WorldNode(Node):
             self.barrier.answered(channel, stamp_ns)
 
     def commands(self) -> dict[RobotId, Command]:
-        """The last command of every robot that has sent one, in robot order."""
-        return {r: self._commands[r] for r in self.robots if r in self._commands}
+        """The last command of every robot that has sent one, in robot order (realtime: a robot
+        whose newest command is older than ``sim.command_timeout`` stopped, `CommandWatch`)."""
+        held = {r: self._commands[r] for r in self.robots if r in self._commands}
+        return self.command_watch.fresh(held, self.world.t_ns)
 
     def close_tick(self, stamp: int) -> None:
         """Lockstep: tick `stamp` is over; count who was stale and declare who is dead."""
@@ -396,6 +410,7 @@ class WorldNode(Node):
         """Tick `stamp` again to those of `waiting` (robots: their observations; servers: the clock)."""
         for r in waiting:
             if r in self._sent:
+                self.command_watch.resent[r] += 1
                 for name, data in self._sent[r].items():
                     self._obs_pubs[r][name].publish(data)
             else:  # a server: it answers a repeated /clock with its ack
@@ -414,6 +429,8 @@ class WorldNode(Node):
             ended=self.ended,
             dead_nodes=json.dumps([e.node for e in self.down]),
             foreign_publishers=json.dumps(self.foreign),
+            commands_by_robot=json.dumps(self.command_watch.counts(
+                {r: s.stale_ticks for r, s in self.world.stats.items()})),
         )
         self.world.close()
 

@@ -53,6 +53,8 @@ def _ip(*args: str, ns: str | None = None) -> None:
 class Testbed:
     """Hosts `names` (each its namespace and address) on one bridge; see the module docstring."""
 
+    __test__ = False  # not a test class (pytest collects Test*)
+
     def __init__(self, names: Sequence[str]) -> None:
         self.tag = f"{PREFIX}{os.getpid()}"
         self.switch = f"{self.tag}-switch"
