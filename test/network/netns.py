@@ -2,9 +2,10 @@
 
 `Testbed` makes, as root, one namespace per host (``sfnet<pid>-<host>``) with an interface
 ``eth0`` holding 198.18.0.N/24 (RFC 2544's benchmarking range: no real network uses it) and a
-``switch`` namespace holding the bridge that joins them. Nothing is made in this machine's own
-namespace: every veth end is created inside a namespace of the testbed, so no traffic can leave
-them. `netem` shapes a host's link both ways (loss, delay, jitter), `partition` cuts it.
+``switch`` namespace joining them: a kernel bridge, or with ``shaped=True`` the user-space switch
+`linkemu` (this machine's kernel has no netem), whose links `netem` shapes both ways (loss, delay,
+jitter) and `partition` cuts. Nothing is made in this machine's own namespace: every veth end is
+created inside a namespace of the testbed, so no traffic can leave them.
 
 `Testbed.close` removes what it made by the names it made: it kills every process still inside
 its namespaces (``ip netns pids``) and the process groups it started, then deletes the
@@ -19,10 +20,13 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
 
+EMULATOR = Path(__file__).with_name("linkemu.py")
 SUBNET = "198.18.0"
 """The testbed's /24: RFC 2544 benchmarking addresses, inside the testbed's namespaces only."""
 PREFIX = "sfnet"
@@ -31,8 +35,8 @@ PREFIX = "sfnet"
 def available() -> str | None:
     """Why namespaces cannot be made here, or None."""
     if os.geteuid() != 0:
-        return "network namespaces need root (ip netns, veth, tc netem)"
-    for tool in ("ip", "tc", "ss"):
+        return "network namespaces need root (ip netns, veth, AF_PACKET)"
+    for tool in ("ip", "ss"):
         if shutil.which(tool) is None:
             return f"no {tool!r} command (iproute2)"
     probe = f"{PREFIX}{os.getpid()}-probe"
@@ -55,28 +59,41 @@ class Testbed:
 
     __test__ = False  # not a test class (pytest collects Test*)
 
-    def __init__(self, names: Sequence[str]) -> None:
+    def __init__(self, names: Sequence[str], shaped: bool = False) -> None:
         self.tag = f"{PREFIX}{os.getpid()}"
         self.switch = f"{self.tag}-switch"
         self.namespaces: list[str] = []
         self.procs: list[subprocess.Popen] = []
         self.address: dict[str, str] = {}
         self.ns: dict[str, str] = {}
+        self.shape: dict[str, dict[str, float]] = {}
+        self.stats: dict = {}
+        """The user-space switch's counters per host port, once closed (`linkemu`)."""
+        self._dir = tempfile.mkdtemp(prefix=f"{self.tag}-")
+        self._config = os.path.join(self._dir, "links.json")
+        self._emulator: subprocess.Popen | None = None
         try:
             self._add_ns(self.switch)
-            _ip("ip", "link", "add", "br0", "type", "bridge", ns=self.switch)
-            _ip("ip", "link", "set", "br0", "up", ns=self.switch)
+            if not shaped:
+                _ip("ip", "link", "add", "br0", "type", "bridge", ns=self.switch)
+                _ip("ip", "link", "set", "br0", "up", ns=self.switch)
             for i, name in enumerate(names):
                 ns = f"{self.tag}-{name}"
                 self._add_ns(ns)
                 # Both ends made inside the testbed's namespaces: nothing in this machine's own.
                 _ip("ip", "link", "add", "eth0", "netns", ns, "type", "veth", "peer", "name", name[:15],
                     "netns", self.switch)
-                _ip("ip", "link", "set", name[:15], "master", "br0", "up", ns=self.switch)
+                _ip("ip", "link", "set", name[:15], *(() if shaped else ("master", "br0")), "up", ns=self.switch)
                 self.address[name] = f"{SUBNET}.{i + 1}"
                 self.ns[name] = ns
                 _ip("ip", "addr", "add", f"{self.address[name]}/24", "dev", "eth0", ns=ns)
                 _ip("ip", "link", "set", "eth0", "up", ns=ns)
+                if shaped:  # frames relayed from user space go as they are: real checksums, within the MTU
+                    _ip(sys.executable, str(EMULATOR), "offload", "eth0", ns=ns)
+            if shaped:
+                self._write_shape()
+                self._emulator = self.popen_in(self.switch, [sys.executable, str(EMULATOR), "run", self._config,
+                                                             *(n[:15] for n in names)])
         except BaseException:
             self.close()
             raise
@@ -90,7 +107,10 @@ class Testbed:
 
     def popen(self, host: str, cmd: Sequence[str], **kwargs) -> subprocess.Popen:
         """`cmd` on `host` (in its namespace), in a process group of its own."""
-        proc = subprocess.Popen(["ip", "netns", "exec", self.ns[host], *cmd], start_new_session=True, **kwargs)
+        return self.popen_in(self.ns[host], cmd, **kwargs)
+
+    def popen_in(self, ns: str, cmd: Sequence[str], **kwargs) -> subprocess.Popen:
+        proc = subprocess.Popen(["ip", "netns", "exec", ns, *cmd], start_new_session=True, **kwargs)
         self.procs.append(proc)
         return proc
 
@@ -112,25 +132,26 @@ class Testbed:
 
     # ------------------------------------------------------------------ links
 
-    def _qdisc(self, host: str, verb: str, netem: Sequence[str]) -> None:
-        _ip("tc", "qdisc", verb, "dev", "eth0", "root", "netem", *netem, ns=self.ns[host])
-        _ip("tc", "qdisc", verb, "dev", host[:15], "root", "netem", *netem, ns=self.switch)
+    def _write_shape(self) -> None:
+        with open(self._config + ".new", "w", encoding="utf-8") as f:
+            json.dump({h[:15]: v for h, v in self.shape.items()}, f)
+        os.replace(self._config + ".new", self._config)  # the switch re-reads it whole
 
-    def netem(self, host: str, *netem: str) -> None:
-        """Shape `host`'s link both ways, e.g. ``netem("b", "loss", "5%", "delay", "20ms", "10ms")``."""
-        self._qdisc(host, "replace", netem)
+    def netem(self, host: str, loss: float = 0.0, delay: float = 0.0, jitter: float = 0.0) -> None:
+        """Shape `host`'s link both ways (needs ``shaped=True``): loss probability, delay and jitter
+        [s], e.g. ``netem("hosta", 0.05, 0.020, 0.010)``."""
+        assert self._emulator is not None, "a Testbed(shaped=True) shapes its links"
+        self.shape[host] = {"loss": loss, "delay": delay, "jitter": jitter}
+        self._write_shape()
+        time.sleep(0.1)  # the switch checks every 20 ms
 
-    def partition(self, host: str, seconds: float, *restore: str) -> None:
-        """Cut `host` off for `seconds` (every packet either way dropped), then shape its link with
-        `restore` again (netem arguments; none: a plain link)."""
-        self._qdisc(host, "replace", ("loss", "100%"))
-        time.sleep(seconds)
-        self._qdisc(host, "replace", restore or ("delay", "0ms"))
-
-    def link_stats(self, host: str) -> dict:
-        """The netem qdisc's counters on `host`'s side (sent, dropped packets)."""
-        data = json.loads(self.run(host, ["tc", "-s", "-j", "qdisc", "show", "dev", "eth0"]))
-        return {k: data[0].get(k) for k in ("packets", "drops")} if data else {}
+    def partition(self, host: str, seconds: float) -> None:
+        """Cut `host` off for `seconds` (every frame either way dropped), then shape its link as
+        before."""
+        before = dict(self.shape.get(host, {}))
+        self.netem(host, loss=1.0)
+        time.sleep(seconds - 0.1)
+        self.netem(host, **before)
 
     # ------------------------------------------------------------------ clean-up
 
@@ -144,6 +165,14 @@ class Testbed:
 
     def close(self) -> None:
         """Every process of the testbed killed, every namespace of it deleted (by its name)."""
+        if self._emulator is not None and self._emulator.poll() is None:
+            self._emulator.terminate()  # it writes its counters
+            try:
+                self._emulator.wait(5)
+                with open(self._config + ".stats", encoding="utf-8") as f:
+                    self.stats = json.load(f)
+            except (subprocess.TimeoutExpired, OSError, ValueError):
+                pass
         for proc in self.procs:
             if proc.poll() is None:
                 try:
@@ -163,6 +192,7 @@ class Testbed:
         for ns in reversed(self.namespaces):
             subprocess.run(["ip", "netns", "del", ns], capture_output=True)
         self.namespaces.clear()
+        shutil.rmtree(self._dir, ignore_errors=True)
 
 
 def leftovers() -> list[str]:

@@ -25,21 +25,25 @@ SMALL_ARENA = ["arena.size=5.0", "resources.distribution=uniform", "resources.co
                "resources.min_depot_clearance=0.3"]
 COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
             "trips_by_robot", "clamped_commands", "stale_ticks")
-LOSSY = ("loss", "5%", "delay", "20ms", "10ms")
-"""netem on both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay."""
+LOSSY = {"loss": 0.05, "delay": 0.020, "jitter": 0.010}
+"""Both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay (`netns.Testbed.netem`)."""
 
 
 @pytest.fixture
-def testbed():
+def testbed(request):
+    """The four hosts; ``@pytest.mark.parametrize("testbed", [True], indirect=True)``: shaped links."""
     why = available()
     if why is not None:
         pytest.skip(f"no network namespaces here: {why}")
-    bed = Testbed(("world", "hosta", "hostb", "cli"))
+    bed = Testbed(("world", "hosta", "hostb", "cli"), shaped=getattr(request, "param", False))
     try:
         yield bed
     finally:
         bed.close()
         assert leftovers() == []
+
+
+shaped = pytest.mark.parametrize("testbed", [True], indirect=True, ids=["shaped"])
 
 
 def _flags(robots: int, duration: float, seed: int) -> list[str]:
@@ -82,15 +86,16 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["resources_delivered"] > 0
 
 
+@shaped
 def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
     mid-run: the barrier re-sends unanswered ticks, so the run is the batch run of its seed."""
     robots, duration, seed = 8, 12.0, 11
     for host in robots_of(robots):
-        testbed.netem(host, *LOSSY)
+        testbed.netem(host, **LOSSY)
     run = MultiHostRun(testbed, tmp_path, robots, *_flags(robots, duration, seed), "--tick-timeout", "20")
     run.wait_sim(duration / 3, 120)
-    cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0, *LOSSY))
+    cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
     cut.start()
     while cut.is_alive():
         run.note_sockets()
@@ -102,17 +107,18 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     _assert_equals_batch(run, graph, robots, duration, seed)  # ... and recovered from
 
 
+@shaped
 def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
     """Realtime at 1x over lossy links, hostb cut off for 3 s: its robots are stopped once their
     newest command is older than sim.command_timeout (0.5 s), hosta's drive on, the run completes,
     and the summary counts per host."""
     robots, duration, timeout = 8, 14.0, 0.5
     for host in robots_of(robots):
-        testbed.netem(host, *LOSSY)
+        testbed.netem(host, **LOSSY)
     run = MultiHostRun(testbed, tmp_path, robots, *_flags(robots, duration, 3), "--mode", "realtime",
                        "--real-time-factor", "1", "--set", f"sim.command_timeout={timeout}")
     run.wait_sim(5.0, 120)
-    testbed.partition("hostb", 3.0, *LOSSY)
+    testbed.partition("hostb", 3.0)
     graph = run.finish(120)
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["mode"] == "realtime"
