@@ -14,14 +14,42 @@ import time
 import warnings
 from pathlib import Path
 
+import numpy as np
 from netns import Testbed
 
+from swarm_sim.analysis.metrics import summarize
+from swarm_sim.analysis.replay import load_odometry
+from swarm_sim.batch import run_batch
 from swarm_sim.recording import BagTruncatedWarning, bag_info
+from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S
 
 REPO = Path(__file__).resolve().parents[2]
 HOSTS = ("world", "hosta", "hostb", "cli")
 CONTROLLER_HOSTS = ("hosta", "hostb")
+SMALL_ARENA = ["arena.size=5.0", "resources.distribution=uniform", "resources.count=150",
+               "resources.min_depot_clearance=0.3"]
+"""test_determinism's busy arena (CPFA): a short run delivers resources."""
+COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
+            "trips_by_robot", "clamped_commands", "stale_ticks")
+
+
+def flags(duration: float, seed: int) -> list[str]:
+    """swarm-run's flags for the small arena."""
+    return ["--duration", str(duration), "--seed", str(seed), *(a for item in SMALL_ARENA for a in ("--set", item))]
+
+
+def batch_differences(bag: Path, graph: dict, robots: int, duration: float, seed: int) -> list[str]:
+    """Where the graph run (its bag and summary) differs from the batch run of its seed."""
+    scenario = load_scenario("cpfa", SMALL_ARENA, robots__count=robots, sim__duration=duration, seed=seed)
+    batch = run_batch(scenario, record_poses=True)
+    expected = summarize(batch.trace)
+    odom = load_odometry(bag)
+    out = [] if len(odom) == robots else [f"odometry of {len(odom)} robots"]
+    for i, (robot, rows) in enumerate(odom.items()):
+        if not np.array_equal(rows[:, 1:], batch.poses[:, i, :]):  # False for other shapes too
+            out.append(f"{robot}'s odometry")
+    return out + [key for key in COMPARED if graph[key] != expected[key]]
 
 
 def robots_of(count: int) -> dict[str, list[str]]:

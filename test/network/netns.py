@@ -9,7 +9,8 @@ created inside a namespace of the testbed, so no traffic can leave them.
 
 `Testbed.close` removes what it made by the names it made: it kills every process still inside
 its namespaces (``ip netns pids``) and the process groups it started, then deletes the
-namespaces (their veth pairs go with them). It runs at the end of the fixture whatever happened.
+namespaces (their veth pairs go with them). It runs at the end of the fixture whatever happened;
+while a testbed is up, SIGTERM raises SystemExit in the main thread so that it runs then too.
 `available` says why namespaces cannot be made here (not root, no ``ip``), for a skip.
 """
 
@@ -72,6 +73,7 @@ class Testbed:
         self._dir = tempfile.mkdtemp(prefix=f"{self.tag}-")
         self._config = os.path.join(self._dir, "links.json")
         self._emulator: subprocess.Popen | None = None
+        self._sigterm = signal.signal(signal.SIGTERM, _exit_on_sigterm)
         try:
             self._add_ns(self.switch)
             if not shaped:
@@ -193,6 +195,13 @@ class Testbed:
             subprocess.run(["ip", "netns", "del", ns], capture_output=True)
         self.namespaces.clear()
         shutil.rmtree(self._dir, ignore_errors=True)
+        if self._sigterm is not None:
+            signal.signal(signal.SIGTERM, self._sigterm)
+            self._sigterm = None
+
+
+def _exit_on_sigterm(*_: object) -> None:
+    raise SystemExit(143)  # unwinds through the `finally` that closes the testbed
 
 
 def leftovers() -> list[str]:

@@ -13,18 +13,11 @@ import threading
 
 import numpy as np
 import pytest
-from multihost import MultiHostRun, robots_of
+from multihost import MultiHostRun, batch_differences, flags, robots_of
 from netns import Testbed, available, leftovers
 
-from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
-from swarm_sim.batch import run_batch
-from swarm_sim.scenario import load_scenario
 
-SMALL_ARENA = ["arena.size=5.0", "resources.distribution=uniform", "resources.count=150",
-               "resources.min_depot_clearance=0.3"]
-COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
-            "trips_by_robot", "clamped_commands", "stale_ticks")
 LOSSY = {"loss": 0.05, "delay": 0.020, "jitter": 0.010}
 """Both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay (`netns.Testbed.netem`)."""
 
@@ -46,26 +39,9 @@ def testbed(request):
 shaped = pytest.mark.parametrize("testbed", [True], indirect=True, ids=["shaped"])
 
 
-def _flags(robots: int, duration: float, seed: int) -> list[str]:
-    return ["--duration", str(duration), "--seed", str(seed),
-            *(a for item in SMALL_ARENA for a in ("--set", item))]
-
-
-def _assert_equals_batch(run: MultiHostRun, graph: dict, robots: int, duration: float, seed: int) -> None:
-    scenario = load_scenario("cpfa", SMALL_ARENA, robots__count=robots, sim__duration=duration, seed=seed)
-    batch = run_batch(scenario, record_poses=True)
-    expected = summarize(batch.trace)
-    odom = load_odometry(run.bag)
-    assert len(odom) == robots
-    for i, (robot, rows) in enumerate(odom.items()):
-        np.testing.assert_array_equal(rows[:, 1:], batch.poses[:, i, :], err_msg=robot)
-    for key in COMPARED:
-        assert graph[key] == expected[key], key
-
-
 def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_path):
     robots, duration, seed = 8, 30.0, 11
-    run = MultiHostRun(testbed, tmp_path, robots, *_flags(robots, duration, seed), "--tick-timeout", "20")
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20")
     echo = run.echo("/robot_1/cmd_vel", 5, 60)  # robot_1's controller is on hostb
     run.wait_sim(duration / 2, 90)
     run.note_sockets()
@@ -82,7 +58,7 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert set(graph["by_host"]) == {"hosta", "hostb"}
     assert graph["by_host"]["hosta"]["robots"] == 4
-    _assert_equals_batch(run, graph, robots, duration, seed)
+    assert batch_differences(run.bag, graph, robots, duration, seed) == []
     assert graph["resources_delivered"] > 0
 
 
@@ -93,7 +69,7 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     robots, duration, seed = 8, 12.0, 11
     for host in robots_of(robots):
         testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *_flags(robots, duration, seed), "--tick-timeout", "20")
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20")
     run.wait_sim(duration / 3, 120)
     cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
     cut.start()
@@ -104,7 +80,7 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
-    _assert_equals_batch(run, graph, robots, duration, seed)  # ... and recovered from
+    assert batch_differences(run.bag, graph, robots, duration, seed) == []  # ... and recovered from
 
 
 @shaped
@@ -115,7 +91,7 @@ def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
     robots, duration, timeout = 8, 14.0, 0.5
     for host in robots_of(robots):
         testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *_flags(robots, duration, 3), "--mode", "realtime",
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, 3), "--mode", "realtime",
                        "--real-time-factor", "1", "--set", f"sim.command_timeout={timeout}")
     run.wait_sim(5.0, 120)
     testbed.partition("hostb", 3.0)
