@@ -197,6 +197,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--remote-controllers", type=remote_option, action="append", default=[],
                         metavar="HOST=ROBOT,...", help="with --bind: these robots' controllers run on HOST (started "
                         "there by hand, as printed): none is started here; the summary counts per host")
+    parser.add_argument("--plain-twist", action="store_true",
+                        help="realtime, with --remote-controllers: the remote robots' computers speak plain "
+                             "geometry_msgs/Twist on wall-clock time (swarm-controllers --plain-twist), as "
+                             "TurtleBot-class robots do")
     parser.add_argument("--key-file", type=Path, metavar="PATH",
                         help="write the run's credential here (mode 0600), for the controllers on other hosts "
                              "(SWARMFORAGE_KEY_FD=3 ... 3<PATH); required with --remote-controllers")
@@ -276,7 +280,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.key_file is not None:
         _write_key(args.key_file, run_key)
     if bind is not None:
-        _print_remote(domain, (bind, port), remote, common, args.key_file)
+        _print_remote(domain, (bind, port), remote, common + (["--plain-twist"] if args.plain_twist else []),
+                      args.key_file)
 
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
         key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
@@ -293,6 +298,8 @@ def main(argv: list[str] | None = None) -> int:
         world_cmd += ["--pace", str(pace)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
+    if args.plain_twist:
+        world_cmd += ["--plain-twist", *(r for robots in remote.values() for r in robots)]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
         controllers = [("controller processes (one per robot)",
                         [*python, "swarm_controllers.controller_node", "--fork", "--robots", *scenario.robot_names])]
@@ -391,9 +398,13 @@ def _hosts(args: argparse.Namespace, scenario: Scenario) -> tuple[str | None, di
     for host, robots in args.remote_controllers:
         remote.setdefault(host, []).extend(robots)
     if not remote:
+        if args.plain_twist:
+            raise hosts.HostError("--plain-twist is for the robots' own computers: name them with --remote-controllers")
         return bind, remote
     if bind is None or args.key_file is None:
         raise hosts.HostError("--remote-controllers needs --bind (an address the other hosts reach) and --key-file")
+    if args.plain_twist and args.mode != "realtime":
+        raise hosts.HostError("--plain-twist: a plain Twist carries no tick, so only --mode realtime can take it")
     named = [r for robots in remote.values() for r in robots]
     if unknown := sorted(set(named) - set(scenario.robot_names)):
         raise hosts.HostError(f"--remote-controllers: no robot {unknown[0]!r} in this run "

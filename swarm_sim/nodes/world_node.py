@@ -106,6 +106,10 @@ class WorldNodeConfig:
     -1: no live view), `swarm_sim.nodes.live_view`."""
     foxglove_host: str = "127.0.0.1"
     """Address the live view binds (loopback unless asked otherwise)."""
+    plain_twist: tuple[str, ...] = ()
+    """Realtime: robots whose commands come as plain ``geometry_msgs/Twist`` (a robot's own
+    computer on wall-clock time, TurtleBot-style: no stamp); a command's time is the tick it
+    arrived at."""
 
 
 class WorldNode(Node):
@@ -114,9 +118,13 @@ class WorldNode(Node):
         self.config = cfg = declare_config(self, WorldNodeConfig, config)
         if cfg.mode not in ("lockstep", "realtime"):
             raise ValueError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
+        if cfg.plain_twist and cfg.mode != "realtime":
+            raise ValueError("plain_twist: a plain Twist carries no tick, so only a realtime run can take it")
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
+        if unknown := set(cfg.plain_twist) - set(self.robots):
+            raise ValueError(f"plain_twist: no robot {sorted(unknown)[0]!r} in this run")
         self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers)
         """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
         self.foreign: list[str] = []
@@ -173,9 +181,10 @@ class WorldNode(Node):
         self._topic_of_cmd = {r: t for t, r in self._cmd_topic.items()}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
-            self.recording.add(topic, topics.type_string(topic))
+            type_name = twist.PLAIN_TYPE_NAME if robot in cfg.plain_twist else topics.type_string(topic)
+            self.recording.add(topic, type_name)
             self._cmd_subs[robot] = self.create_subscription(
-                topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
+                topics.import_type(type_name), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
             self.watch.hear(topic, self._cmd_subs[robot].get_publisher_count)
@@ -241,7 +250,8 @@ class WorldNode(Node):
 
     def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool:
         """Take a command (True), or refuse and count it (False: recorded apart)."""
-        decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
+        plain = robot in self.config.plain_twist
+        decoded = self.inbound.decode(topic, self._decode_plain if plain else twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
             return False
         stamp_ns, linear, angular = decoded
@@ -268,6 +278,10 @@ class WorldNode(Node):
         self._commands[robot] = Command(linear, angular)
         self.barrier.answered(robot, stamp_ns)
         return True
+
+    def _decode_plain(self, data: bytes) -> tuple[int, float, float]:
+        """A plain Twist as (the tick it arrived at, linear, angular)."""
+        return (self.world.t_ns, *twist.decode_plain_twist(data))
 
     def _on_ack(self, data: bytes) -> None:
         refused = self.rejections.total
@@ -455,11 +469,15 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
                         help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
     parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host,
                         help=f"address the live view binds (default {WorldNodeConfig.foxglove_host})")
+    parser.add_argument("--plain-twist", nargs="+", default=[], metavar="ROBOT",
+                        help="realtime: these robots' commands come as plain geometry_msgs/Twist (a robot's own "
+                             "computer on wall-clock time); each counts from the tick it arrives at")
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
         foxglove_port=args.foxglove, foxglove_host=args.foxglove_host, pace=args.pace or 0.0,
+        plain_twist=tuple(args.plain_twist),
     )
     return config, ros_args
 

@@ -83,6 +83,21 @@ class _Lines:
         return "".join(self.lines)
 
 
+def start_echo(testbed: Testbed, server: str, topic: str, count: int, timeout: float, tmp: Path) -> subprocess.Popen:
+    """The stand-in ``ros2 topic echo`` (`echo.py`) on host ``cli``, in the environment the README's
+    recipe gives a stock ``ros2`` there (``python -m launch_py.hosts env``)."""
+    lines = testbed.run("cli", [sys.executable, "-m", "launch_py.hosts", "env", "--bind", "eth0",
+                                "--discovery-server", server, "--profile", str(tmp / "cli.xml")])
+    env = {k: v for k, v in _env().items() if not k.startswith(("ROS_", "FAST", "RMW_"))}
+    for line in lines.splitlines():
+        if line.startswith("export "):
+            key, _, value = line[7:].partition("=")
+            env[key] = value
+    return testbed.popen("cli", [sys.executable, str(Path(__file__).with_name("echo.py")), topic, str(count),
+                                 str(timeout)], env=env, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True)
+
+
 class MultiHostRun:
     """swarm-run on ``world`` bound to its address, every controller remote (see the module doc)."""
 
@@ -118,18 +133,8 @@ class MultiHostRun:
         self.sockets: dict[str, set[tuple[str, str, str]]] = {h: set() for h in HOSTS}
 
     def echo(self, topic: str, count: int, timeout: float) -> subprocess.Popen:
-        """The stand-in ``ros2 topic echo`` on ``cli``, in the environment the README's recipe gives
-        a stock ``ros2`` there (``python -m launch_py.hosts env``)."""
-        lines = self.tb.run("cli", [sys.executable, "-m", "launch_py.hosts", "env", "--bind", "eth0",
-                                    "--discovery-server", self.server, "--profile", str(self.bag.parent / "cli.xml")])
-        env = {k: v for k, v in _env().items() if not k.startswith(("ROS_", "FAST", "RMW_"))}
-        for line in lines.splitlines():
-            if line.startswith("export "):
-                key, _, value = line[7:].partition("=")
-                env[key] = value
-        return self.tb.popen("cli", [sys.executable, str(Path(__file__).with_name("echo.py")), topic, str(count),
-                                     str(timeout)], env=env, cwd=REPO, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
+        """`start_echo` on ``cli``."""
+        return start_echo(self.tb, self.server, topic, count, timeout, self.bag.parent)
 
     def sim_time(self) -> float:
         """The last /clock recorded so far [s] (0 before the bag exists)."""
