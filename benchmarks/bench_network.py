@@ -33,13 +33,13 @@ SETTINGS = [  # (label, loss, delay [s], jitter [s], partition)
 ]
 
 
-def one(mode: str, setting: tuple, robots: int, duration: float, seed: int) -> str:
+def one(mode: str, setting: tuple, robots: int, duration: float, seed: int, resend: float) -> str:
     label, loss, delay, jitter, partition = setting
     bed = Testbed(("world", "hosta", "hostb", "cli"), shaped=True)
     try:
         for host in robots_of(robots):
             bed.netem(host, loss, delay, jitter)
-        extra = ["--tick-timeout", "20"] if mode == "lockstep" else ["--mode", "realtime", "--real-time-factor", "1"]
+        extra = ["--tick-timeout", "20", "--resend-period", str(resend)] if mode == "lockstep" else ["--mode", "realtime", "--real-time-factor", "1"]
         with tempfile.TemporaryDirectory() as tmp:
             run = MultiHostRun(bed, Path(tmp), robots, *flags(duration, seed), *extra)
             if partition:
@@ -57,6 +57,7 @@ def one(mode: str, setting: tuple, robots: int, duration: float, seed: int) -> s
     stale = graph["stale_ticks"]
     equal = "-" if diff is None else ("yes" if not diff else f"no ({', '.join(diff[:3])})")
     print(f"# {mode} {label}: {hosts} frames {frames}", file=sys.stderr, flush=True)
+    mode = f"{mode}, re-send {resend:g} s" if mode == "lockstep" else mode
     return (f"| {mode} | {label} | {graph['real_time_factor']} | {stale} | {late} | "
             f"{sum(c['resent'] for c in hosts.values())} | {sum(c['lost'] for c in hosts.values())} | "
             f"{sum(c['stopped'] for c in hosts.values())} | {equal} |")
@@ -68,6 +69,10 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=12.0)
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--modes", nargs="+", default=["lockstep", "realtime"])
+    parser.add_argument("--resend-period", type=float, nargs="+", default=[0.25, 0.1],
+                        help="lockstep: the world's re-send periods to try [s]")
+    parser.add_argument("--settings", type=int, nargs="+", default=list(range(len(SETTINGS))),
+                        help="which rows of SETTINGS (default all)")
     args = parser.parse_args()
     if (why := available()) is not None:
         sys.exit(f"bench_network: {why}")
@@ -77,8 +82,9 @@ def main() -> None:
           "| ticks without a command | stops by the timeout | equals batch |")
     print("|---|---|---|---|---|---|---|---|---|")
     for mode in args.modes:
-        for setting in SETTINGS:
-            print(one(mode, setting, args.robots, args.duration, args.seed), flush=True)
+        for resend in args.resend_period if mode == "lockstep" else [0.25]:
+            for i in args.settings:
+                print(one(mode, SETTINGS[i], args.robots, args.duration, args.seed, resend), flush=True)
 
 
 if __name__ == "__main__":

@@ -113,13 +113,26 @@ def rebind(profile: str, address: str) -> str:
     return profile.replace(ours, f"<address>{address}</address>")
 
 
+HEARTBEAT_NS = 100_000_000
+"""Reliable writers' heartbeat period across hosts [ns] (Fast DDS's default: 3 s). A reader learns
+that it missed a sample from the writer's next heartbeat (or a later sample), so on a lossy link
+a lost status or protocol message waited up to 3 s: at the end of a run, longer than the world
+listens for the robots' last messages (measured: 5 % loss, a robot's last status missing from the
+bag). Writers send periodic heartbeats only while a reader has not acknowledged everything."""
+
+
 def host_profile(role: str, bind: str, server_port: int) -> str:
-    """The Fast DDS profile of a process in `role` (`ROLES`) bound to `bind`."""
+    """The Fast DDS profile of a process in `role` (`ROLES`) bound to `bind`, its reliable writers
+    heartbeating every `HEARTBEAT_NS`."""
     if role == "server":
-        return rebind(dds.server_profile(server_port), bind)
-    if role == "robot":
-        return rebind(dds.robot_profile(), bind)
-    return rebind(dds.PROFILE_PATH.read_text(encoding="utf-8"), bind)
+        profile = dds.server_profile(server_port)
+    elif role == "robot":
+        profile = dds.robot_profile()
+    else:
+        profile = dds.PROFILE_PATH.read_text(encoding="utf-8")
+    writer = (f'<data_writer profile_name="swarmforage_hosts_writer" is_default_profile="true"><times>'
+              f"<heartbeatPeriod><sec>0</sec><nanosec>{HEARTBEAT_NS}</nanosec></heartbeatPeriod></times></data_writer>")
+    return rebind(profile, bind).replace("</profiles>", writer + "</profiles>", 1)
 
 
 def host_env(role: str, domain_id: int, bind: str, server: tuple[str, int], profile_path: Path,

@@ -179,6 +179,9 @@ def main(argv: list[str] | None = None) -> int:
                              "the fastest it may go (default: as fast as the nodes answer; 1 with --foxglove)")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
+    parser.add_argument("--resend-period", type=number(float, 0, 3600, open_low=True), default=0.25,
+                        help="lockstep: wall s after which a tick is sent again to the nodes that have not answered "
+                             "(default 0.25; across lossy links a few round trips, e.g. 0.1)")
     parser.add_argument("--domain-id", type=domain_option,
                         help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID}, or auto: a free one (default: the user's ROS_DOMAIN_ID, "
                              "else a free one); a run refuses a domain anything else uses")
@@ -293,7 +296,8 @@ def main(argv: list[str] | None = None) -> int:
         return label, proc
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
-                 "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor or 1.0)]
+                 "--tick-timeout", str(args.tick_timeout), "--resend-period", str(args.resend_period),
+                 "--real-time-factor", str(args.real_time_factor or 1.0)]
     if pace:
         world_cmd += ["--pace", str(pace)]
     if args.foxglove is not None:

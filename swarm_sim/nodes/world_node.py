@@ -460,6 +460,10 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
                              "step at --real-time-factor with the commands that arrived")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout,
                         help=f"lockstep: wall seconds to wait for a tick's answers (default {WorldNodeConfig.tick_timeout:g})")
+    parser.add_argument("--resend-period", type=number(float, 0, 3600, open_low=True),
+                        default=WorldNodeConfig.resend_period,
+                        help="lockstep: wall seconds after which a tick is sent again to the nodes that have not "
+                             f"answered (default {WorldNodeConfig.resend_period:g}; a few round trips on a lossy link)")
     parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0,
                         help="realtime: target sim seconds per wall second (default 1)")
     parser.add_argument("--pace", type=number(float, 0, 1e6, open_low=True),
@@ -477,7 +481,7 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
         foxglove_port=args.foxglove, foxglove_host=args.foxglove_host, pace=args.pace or 0.0,
-        plain_twist=tuple(args.plain_twist),
+        resend_period=args.resend_period, plain_twist=tuple(args.plain_twist),
     )
     return config, ros_args
 
