@@ -21,7 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test" / "network"))
 
-from multihost import MultiHostRun, batch_differences, flags, robots_of  # noqa: E402
+from multihost import SMALL_ARENA, MultiHostRun, batch_differences, flags, robots_of  # noqa: E402
 from netns import Testbed, available  # noqa: E402
 
 SETTINGS = [  # (label, loss, delay [s], jitter [s], partition)
@@ -33,7 +33,8 @@ SETTINGS = [  # (label, loss, delay [s], jitter [s], partition)
 ]
 
 
-def one(mode: str, setting: tuple, robots: int, duration: float, seed: int, resend: float) -> str:
+def one(mode: str, setting: tuple, robots: int, duration: float, seed: int, resend: float,
+        scenario: list[str]) -> str:
     label, loss, delay, jitter, partition = setting
     bed = Testbed(("world", "hosta", "hostb", "cli"), shaped=True)
     try:
@@ -41,14 +42,14 @@ def one(mode: str, setting: tuple, robots: int, duration: float, seed: int, rese
             bed.netem(host, loss, delay, jitter)
         extra = ["--tick-timeout", "20", "--resend-period", str(resend)] if mode == "lockstep" else ["--mode", "realtime", "--real-time-factor", "1"]
         with tempfile.TemporaryDirectory() as tmp:
-            run = MultiHostRun(bed, Path(tmp), robots, *flags(duration, seed), *extra)
+            run = MultiHostRun(bed, Path(tmp), robots, *flags(duration, seed, *scenario), *extra)
             if partition:
                 run.wait_sim(duration / 3, 300)
                 cut = threading.Thread(target=bed.partition, args=("hostb", 3.0))
                 cut.start()
                 cut.join()
             graph = run.finish(900)
-            diff = batch_differences(run.bag, graph, robots, duration, seed) if mode == "lockstep" else None
+            diff = batch_differences(run.bag, graph, robots, duration, seed, *scenario) if mode == "lockstep" else None
     finally:
         bed.close()
     hosts = graph["by_host"]
@@ -68,6 +69,9 @@ def main() -> None:
     parser.add_argument("--robots", type=int, default=8)
     parser.add_argument("--duration", type=float, default=12.0)
     parser.add_argument("--seed", type=int, default=11)
+    parser.add_argument("--scenario", default="cpfa", help="default: cpfa in the small arena")
+    parser.add_argument("--set", dest="overrides", action="append", metavar="KEY=VALUE",
+                        help="scenario overrides (default for cpfa: the small arena)")
     parser.add_argument("--modes", nargs="+", default=["lockstep", "realtime"])
     parser.add_argument("--resend-period", type=float, nargs="+", default=[0.25, 0.1],
                         help="lockstep: the world's re-send periods to try [s]")
@@ -77,14 +81,16 @@ def main() -> None:
     if (why := available()) is not None:
         sys.exit(f"bench_network: {why}")
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(101, 199)))
-    print(f"{args.robots} robots, {args.duration:g} s of sim time, seed {args.seed}")
+    scenario = [args.scenario, args.overrides if args.overrides is not None else
+                (SMALL_ARENA if args.scenario == "cpfa" else [])]
+    print(f"{args.scenario}: {args.robots} robots, {args.duration:g} s of sim time, seed {args.seed}")
     print("| mode | links (both controller hosts) | real-time factor | stale ticks | late commands | ticks re-sent "
           "| ticks without a command | stops by the timeout | equals batch |")
     print("|---|---|---|---|---|---|---|---|---|")
     for mode in args.modes:
         for resend in args.resend_period if mode == "lockstep" else [0.25]:
             for i in args.settings:
-                print(one(mode, SETTINGS[i], args.robots, args.duration, args.seed, resend), flush=True)
+                print(one(mode, SETTINGS[i], args.robots, args.duration, args.seed, resend, scenario), flush=True)
 
 
 if __name__ == "__main__":

@@ -113,6 +113,12 @@ def rebind(profile: str, address: str) -> str:
     return profile.replace(ours, f"<address>{address}</address>")
 
 
+ACK_WAIT_ENV = "SWARMFORAGE_ACK_WAIT"
+"""`swarm_sim.nodes.endpoint.ACK_WAIT_ENV` (not imported: this module runs before rclpy is)."""
+ACK_WAIT = 10.0
+"""Across hosts, wall seconds a node waits for its reliable messages of a tick to be acknowledged
+before it answers the tick (`swarm_sim.nodes.endpoint.wait_acked`): past a partition of that
+length a run may leave the batch run's path. Keep swarm-run's ``--tick-timeout`` above it."""
 HEARTBEAT_NS = 100_000_000
 """Reliable writers' heartbeat period across hosts [ns] (Fast DDS's default: 3 s). A reader learns
 that it missed a sample from the writer's next heartbeat (or a later sample), so on a lossy link
@@ -140,6 +146,7 @@ def host_env(role: str, domain_id: int, bind: str, server: tuple[str, int], prof
     """The environment of a process in `role` of a run on `domain_id` across hosts: the profile
     at `profile_path` (`host_profile`), and for every role but the server the server's address."""
     env = dds.loopback_env(domain_id, 1, base)
+    env[ACK_WAIT_ENV] = str(ACK_WAIT)
     env["FASTRTPS_DEFAULT_PROFILES_FILE"] = env["FASTDDS_DEFAULT_PROFILES_FILE"] = str(profile_path)
     if role != "server":
         env["ROS_DISCOVERY_SERVER"] = f"{server[0]}:{server[1]}"

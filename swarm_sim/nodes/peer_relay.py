@@ -19,6 +19,7 @@ from swarm_msgs_py import auth, topics
 from swarm_msgs_py.qos import EVENTS
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound
+from swarm_sim.nodes.endpoint import ack_wait, wait_acked
 from swarm_sim.nodes.world_recording import WorldRecording
 
 
@@ -29,6 +30,7 @@ class PeerRelay:
         self._relays = {}
         """Peer topic -> publisher on ``heard(topic)``."""
         self._relayed: list[tuple[str, bytes]] = []
+        self._ack_wait = ack_wait()
         """What arrived since the last tick went out, in order."""
         self.subscriptions = {}
         """Peer topic -> the world's subscription to it."""
@@ -55,4 +57,6 @@ class PeerRelay:
         if send:
             for topic, data in self._relayed:
                 self._relays[topic].publish(data)
+            if self._relayed:  # across lossy links: heard by every robot before the tick (`endpoint.wait_acked`)
+                wait_acked({self._relays[t] for t, _ in self._relayed}, self._ack_wait)
         self._relayed = []

@@ -34,14 +34,16 @@ COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_
             "trips_by_robot", "clamped_commands", "stale_ticks")
 
 
-def flags(duration: float, seed: int) -> list[str]:
-    """swarm-run's flags for the small arena."""
-    return ["--duration", str(duration), "--seed", str(seed), *(a for item in SMALL_ARENA for a in ("--set", item))]
+def flags(duration: float, seed: int, scenario: str = "cpfa", overrides: list[str] = SMALL_ARENA) -> list[str]:
+    """swarm-run's flags (default: the small arena)."""
+    return ["--scenario", scenario, "--duration", str(duration), "--seed", str(seed),
+            *(a for item in overrides for a in ("--set", item))]
 
 
-def batch_differences(bag: Path, graph: dict, robots: int, duration: float, seed: int) -> list[str]:
+def batch_differences(bag: Path, graph: dict, robots: int, duration: float, seed: int, scenario: str = "cpfa",
+                      overrides: list[str] = SMALL_ARENA) -> list[str]:
     """Where the graph run (its bag and summary) differs from the batch run of its seed."""
-    scenario = load_scenario("cpfa", SMALL_ARENA, robots__count=robots, sim__duration=duration, seed=seed)
+    scenario = load_scenario(scenario, overrides, robots__count=robots, sim__duration=duration, seed=seed)
     batch = run_batch(scenario, record_poses=True)
     expected = summarize(batch.trace)
     odom = load_odometry(bag)
