@@ -31,6 +31,7 @@ import socket
 import struct
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -135,7 +136,7 @@ def host_profile(role: str, bind: str, server_port: int) -> str:
     elif role == "robot":
         profile = dds.robot_profile()
     else:
-        profile = dds.PROFILE_PATH.read_text(encoding="utf-8")
+        profile = ET.tostring(dds._loopback_profile(), encoding="unicode")  # as the others: no comments
     writer = (f'<data_writer profile_name="swarmforage_hosts_writer" is_default_profile="true"><times>'
               f"<heartbeatPeriod><sec>0</sec><nanosec>{HEARTBEAT_NS}</nanosec></heartbeatPeriod></times></data_writer>")
     return rebind(profile, bind).replace("</profiles>", writer + "</profiles>", 1)

@@ -57,6 +57,11 @@ def main(topic: str, count: int, timeout: float) -> int:
     node.create_subscription(import_type(type_name), topic, on_message, qos)
     while len(stamps) < count and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.2)
+    # The publishers' node names come with the ROS graph's own announcements, which can trail
+    # the endpoints (as `ros2 topic info -v` shows them unknown until then).
+    while any(p.node_name == "_NODE_NAME_UNKNOWN_" for p in publishers) and time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.2)
+        publishers = node.get_publishers_info_by_topic(topic) or publishers
     print(json.dumps({"type": type_name, "stamps": stamps,
                       "publishers": sorted(f"{p.node_namespace.rstrip('/')}/{p.node_name}" for p in publishers)}),
           flush=True)

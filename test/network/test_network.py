@@ -18,6 +18,8 @@ from netns import Testbed, available, leftovers
 
 from swarm_sim.analysis.replay import load_odometry
 
+MDBSA = ("mdbsa_d", [])
+"""The spiral paper's MDBSA-D (8 x 8 m): robots and its center exchange messages every few ticks."""
 LOSSY = {"loss": 0.05, "delay": 0.020, "jitter": 0.010}
 """Both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay (`netns.Testbed.netem`)."""
 
@@ -65,11 +67,14 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
 @shaped
 def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
-    mid-run: the barrier re-sends unanswered ticks, so the run is the batch run of its seed."""
-    robots, duration, seed = 8, 12.0, 11
+    mid-run, with a server (MDBSA-D's center) and its protocol: the barrier re-sends unanswered
+    ticks and every node waits for its reliable messages to be acknowledged before answering a
+    tick, so the run is the batch run of its seed."""
+    robots, duration, seed = 8, 15.0, 11
     for host in robots_of(robots):
         testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20")
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *MDBSA), "--tick-timeout", "20",
+                       "--resend-period", "0.1")
     run.wait_sim(duration / 3, 120)
     cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
     cut.start()
@@ -80,7 +85,7 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
-    assert batch_differences(run.bag, graph, robots, duration, seed) == []  # ... and recovered from
+    assert batch_differences(run.bag, graph, robots, duration, seed, *MDBSA) == []  # ... and recovered from
 
 
 @shaped

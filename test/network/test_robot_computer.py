@@ -28,7 +28,7 @@ from swarm_sim.recording import read_bag
 TURTLEBOT = ["--ros-args", "-r", "/robot_0/cmd_vel:=/cmd_vel", "-r", "/robot_0/odom:=/odom",
              "-r", "/robot_0/scan:=/scan"]
 """The robot's topics under a TurtleBot's root names, for both ends."""
-SCENARIO = ["--scenario", "cpfa", "--seed", "5", "--set", "robots.count=1", "--set", "sim.duration=8"]
+SCENARIO = ["--scenario", "cpfa", "--seed", "5", "--set", "robots.count=1", "--set", "sim.duration=12"]
 
 
 def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
@@ -47,7 +47,7 @@ def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
                                     "--discovery-server", server, "--robots", "robot_0", "--plain-twist", *SCENARIO,
                                     *TURTLEBOT], env=_env(), cwd=REPO, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True)
-        echo = start_echo(bed, server, "/cmd_vel", 5, 60, tmp_path)  # a TurtleBot's command topic
+        echo = start_echo(bed, server, "/cmd_vel", 3, 60, tmp_path)  # a TurtleBot's command topic
         sockets = set()
         deadline = time.monotonic() + 120
         while world.poll() is None:
