@@ -231,30 +231,33 @@ def node_main(kind: str, argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=prog, add_help=False)
     add_host_arguments(parser)
     args, rest = parser.parse_known_args(argv)
-    if "-h" in rest or "--help" in rest:
-        print(f"across hosts (README, *Across hosts*):\n{parser.format_help().split(chr(10), 2)[2]}")
-    elif args.bind is not None or args.discovery_server is not None:
+    if "-h" in rest or "--help" in rest:  # the node's help, then these two options'
+        try:
+            return importlib.import_module(module).main(rest)
+        finally:
+            print(f"\nacross hosts (README, *Across hosts*):\n{parser.format_help().split(chr(10), 2)[2]}")
+    if args.bind is not None or args.discovery_server is not None:
         try:
             apply(role, args.bind, args.discovery_server)
         except HostError as exc:
             print(f"{prog}: {exc}", file=sys.stderr)
             return 2
-    return importlib.import_module(module).main(rest)
+    return importlib.import_module(module).main(rest)  # after `apply`: the node imports rclpy
 
 
-def world() -> int:
+def world(argv: list[str] | None = None) -> int:
     """``swarm-world``."""
-    return node_main("world")
+    return node_main("world", argv)
 
 
-def server() -> int:
+def server(argv: list[str] | None = None) -> int:
     """``swarm-server``."""
-    return node_main("server")
+    return node_main("server", argv)
 
 
-def controllers() -> int:
+def controllers(argv: list[str] | None = None) -> int:
     """``swarm-controllers``."""
-    return node_main("controllers")
+    return node_main("controllers", argv)
 
 
 def main(argv: list[str] | None = None) -> int:
