@@ -283,8 +283,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.key_file is not None:
         _write_key(args.key_file, run_key)
     if bind is not None:
-        _print_remote(domain, (bind, port), remote, common + (["--plain-twist"] if args.plain_twist else []),
-                      args.key_file)
+        _print_remote(domain, (bind, port), remote,
+                      [*common, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
 
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
         key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
@@ -310,6 +310,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
                         [*python, "swarm_controllers.controller_node", "--robots", *g]) for g in groups]
+    controllers = [(label, [*cmd, "--mode", args.mode]) for label, cmd in controllers]
     children: list[tuple[str, subprocess.Popen]] = []
     world: subprocess.Popen | None = None
     interrupted = False

@@ -20,7 +20,7 @@ A robot's controller node and a server node both load the scenario from the same
 A node creates its `Endpoint` before its other subscriptions: in a wait set where both are
 ready, rclpy runs the earlier subscription first.
 
-Across lossy links (``SWARMFORAGE_ACK_WAIT`` set, as `launch_py.hosts` does) a node waits, after
+Across lossy links (``SWARMFORAGE_ACK_WAIT`` set, as `launch_py.hosts` does) a lockstep node waits, after
 sending a tick's messages, until every reader has acknowledged them (`wait_acked`) before it
 answers the tick: the lockstep barrier re-sends a lost tick or command, but a lost reliable
 message comes again only by DDS's retransmission, which could otherwise arrive after the tick
@@ -142,8 +142,9 @@ class Endpoint:
         self.topic_of = {cls: t for t, f in outbound.items() for cls, ft in f.topics.items() if ft == t}
         """Message class -> the topic this node sends it on."""
         self.report = RejectionReport(node, self.rejections)
-        self.ack_wait = ack_wait()
-        """Wall seconds `send` waits for its messages to be acknowledged (`ACK_WAIT_ENV`)."""
+        self.ack_wait = ack_wait() if getattr(node, "config", EndpointConfig()).mode == "lockstep" else 0.0
+        """Lockstep: wall seconds `send` waits for its messages to be acknowledged (`ACK_WAIT_ENV`;
+        realtime waits for nothing)."""
 
     def take(self, stamp_ns: int) -> tuple[object, ...]:
         """Tick `stamp_ns` begins: the messages stamped before it, in delivery order."""

@@ -30,7 +30,8 @@ class PeerRelay:
         self._relays = {}
         """Peer topic -> publisher on ``heard(topic)``."""
         self._relayed: list[tuple[str, bytes]] = []
-        self._ack_wait = ack_wait()
+        self.ack_wait = ack_wait() if node.config.mode == "lockstep" else 0.0
+        """Lockstep: wall seconds `flush` waits for the robots to acknowledge what it relayed."""
         """What arrived since the last tick went out, in order."""
         self.subscriptions = {}
         """Peer topic -> the world's subscription to it."""
@@ -58,5 +59,5 @@ class PeerRelay:
             for topic, data in self._relayed:
                 self._relays[topic].publish(data)
             if self._relayed:  # across lossy links: heard by every robot before the tick (`endpoint.wait_acked`)
-                wait_acked({self._relays[t] for t, _ in self._relayed}, self._ack_wait)
+                wait_acked({self._relays[t] for t, _ in self._relayed}, self.ack_wait)
         self._relayed = []

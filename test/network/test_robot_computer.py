@@ -44,7 +44,7 @@ def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
                                     "--mode", "realtime", "--plain-twist", "robot_0", "--bag", str(bag), *TURTLEBOT],
                           env=_env(), cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         robot = bed.popen("hosta", [sys.executable, "-m", "launch_py.hosts", "controllers", "--bind", "eth0",
-                                    "--discovery-server", server, "--robots", "robot_0", "--plain-twist", *SCENARIO,
+                                    "--discovery-server", server, "--robots", "robot_0", "--plain-twist", "--mode", "realtime", *SCENARIO,
                                     *TURTLEBOT], env=_env(), cwd=REPO, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True)
         echo = start_echo(bed, server, "/cmd_vel", 3, 60, tmp_path)  # a TurtleBot's command topic
