@@ -30,9 +30,9 @@ class PeerRelay:
         self._relays = {}
         """Peer topic -> publisher on ``heard(topic)``."""
         self._relayed: list[tuple[str, bytes]] = []
+        """What arrived since the last tick went out, in order."""
         self.ack_wait = ack_wait() if node.config.mode == "lockstep" else 0.0
         """Lockstep: wall seconds `flush` waits for the robots to acknowledge what it relayed."""
-        """What arrived since the last tick went out, in order."""
         self.subscriptions = {}
         """Peer topic -> the world's subscription to it."""
         for topic, family in registry.peer_topics(algorithm).items():
