@@ -191,29 +191,40 @@ def add_host_arguments(parser: argparse.ArgumentParser) -> None:
                              "domain); required with --bind for every node but the world")
 
 
-_PROFILES: list[Path] = []
+def profile_dir() -> Path:
+    """This user's directory of the node commands' profiles (mode 0700), without the profiles of
+    processes that have ended: a node removes its own when it exits, one killed outright leaves
+    it for the next to prune. (Fast DDS takes a profile only from a real file: it resolves the
+    path, so an anonymous memory file does not do.)"""
+    path = Path(tempfile.gettempdir()) / f"swarmforage-hosts-{os.getuid()}"
+    path.mkdir(mode=0o700, exist_ok=True)
+    info = path.lstat()
+    if not path.is_dir() or path.is_symlink() or info.st_uid != os.getuid() or info.st_mode & 0o077:
+        raise HostError(f"{path}: not a private directory of this user; remove it")
+    for old in path.glob("*.xml"):
+        pid = old.stem.rpartition("-")[2]
+        if pid.isdigit() and not Path(f"/proc/{pid}").exists():
+            with contextlib.suppress(OSError):
+                old.unlink()
+    return path
 
 
 def apply(role: str, bind: str | None, server: str | None) -> None:
-    """Make this process a `role` of a run across hosts: its profile written to a private file
-    (removed at exit) and its environment set. Call before ``rclpy.init`` (the rmw reads both
-    when the first participant is made). Raises HostError."""
+    """Make this process a `role` of a run across hosts: its profile written to `profile_dir`
+    (removed when it exits) and its environment set. Call before ``rclpy.init`` (the rmw reads
+    both when the first participant is made). Raises HostError."""
     domain = run_domain()
     address, found = resolve(role, bind, server, domain)
-    fd, path = tempfile.mkstemp(prefix=f"swarmforage-{role}-", suffix=".xml")
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        f.write(host_profile(role, address, found[1]))
-    _PROFILES.append(Path(path))
-    if len(_PROFILES) == 1:
-        atexit.register(_remove_profiles, os.getpid())
-    dds.apply_to_current_process(host_env(role, domain, address, found, Path(path)))
+    path = profile_dir() / f"{role}-{os.getpid()}.xml"
+    path.write_text(host_profile(role, address, found[1]), encoding="utf-8")
+    atexit.register(_remove, path, os.getpid())
+    dds.apply_to_current_process(host_env(role, domain, address, found, path))
 
 
-def _remove_profiles(owner: int) -> None:
-    if os.getpid() == owner:  # not in a forked child that happens to run atexit
-        for path in _PROFILES:
-            with contextlib.suppress(OSError):
-                path.unlink()
+def _remove(path: Path, owner: int) -> None:
+    if os.getpid() == owner:  # not in a forked robot process that happens to run atexit
+        with contextlib.suppress(OSError):
+            path.unlink()
 
 
 NODES = {

@@ -20,6 +20,7 @@ import json
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -74,6 +75,7 @@ class Testbed:
         self._config = os.path.join(self._dir, "links.json")
         self._emulator: subprocess.Popen | None = None
         self._sigterm = signal.signal(signal.SIGTERM, _exit_on_sigterm)
+        own = socket.if_nameindex()  # this machine's own namespace: must stay as it is
         try:
             self._add_ns(self.switch)
             if not shaped:
@@ -92,6 +94,8 @@ class Testbed:
                 _ip("ip", "link", "set", "eth0", "up", ns=ns)
                 if shaped:  # frames relayed from user space go as they are: real checksums, within the MTU
                     _ip(sys.executable, str(EMULATOR), "offload", "eth0", ns=ns)
+            if socket.if_nameindex() != own:
+                raise RuntimeError("the testbed changed this machine's own interfaces")
             if shaped:
                 self._write_shape()
                 self._emulator = self.popen_in(self.switch, [sys.executable, str(EMULATOR), "run", self._config,
@@ -175,21 +179,20 @@ class Testbed:
                     self.stats = json.load(f)
             except (subprocess.TimeoutExpired, OSError, ValueError):
                 pass
-        for proc in self.procs:
-            if proc.poll() is None:
-                try:
-                    os.killpg(proc.pid, signal.SIGKILL)
-                except ProcessLookupError:
-                    pass
+        for sig, grace in ((signal.SIGINT, 5.0), (signal.SIGKILL, 10.0)):  # a chance to leave cleanly first
+            for proc in self.procs:
+                if proc.poll() is None:
+                    try:
+                        os.killpg(proc.pid, sig)
+                    except ProcessLookupError:
+                        pass
+            deadline = time.monotonic() + grace
+            while any(p.poll() is None for p in self.procs) and time.monotonic() < deadline:
+                time.sleep(0.05)
         for pid in self.pids():
             try:
                 os.kill(pid, signal.SIGKILL)
             except ProcessLookupError:
-                pass
-        for proc in self.procs:
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
                 pass
         for ns in reversed(self.namespaces):
             subprocess.run(["ip", "netns", "del", ns], capture_output=True)
