@@ -10,7 +10,13 @@ locators), so every socket binds that address alone: never 0.0.0.0, no multicast
 
 ``--bind`` refuses the unspecified address (0.0.0.0), multicast and broadcast addresses, and any
 address no interface of this machine (or network namespace) holds. The domain is the run's
-``ROS_DOMAIN_ID``, which every host must share.
+``ROS_DOMAIN_ID``, which every host must share. Across hosts, links lose packets, so reliable
+writers heartbeat every 100 ms (`HEARTBEAT_NS`) and lockstep nodes wait for their reliable
+messages of a tick to be acknowledged before they answer it (`ACK_WAIT`).
+
+swarm-run takes ``--bind`` itself (`launch_py.run`); ``swarm-world``, ``swarm-server`` and
+``swarm-controllers`` take both flags through `node_main`, which sets the process's environment
+(its profile in `profile_dir`) before the node imports rclpy.
 
 ``python -m launch_py.hosts env --bind ADDR --discovery-server ADDR:PORT`` prints the environment
 (and writes the profile) that lets a stock ``ros2`` CLI on that host join the run, as a super
@@ -119,7 +125,9 @@ ACK_WAIT_ENV = "SWARMFORAGE_ACK_WAIT"
 ACK_WAIT = 10.0
 """Across hosts, wall seconds a node waits for its reliable messages of a tick to be acknowledged
 before it answers the tick (`swarm_sim.nodes.endpoint.wait_acked`): past a partition of that
-length a run may leave the batch run's path. Keep swarm-run's ``--tick-timeout`` above it."""
+length a run may leave the batch run's path. A node waiting longer than the world's tick timeout
+is stale at that tick first (and dead after three): runs across unreliable links want a
+``--tick-timeout`` above the outages they should ride out (README, *Across hosts*)."""
 HEARTBEAT_NS = 100_000_000
 """Reliable writers' heartbeat period across hosts [ns] (Fast DDS's default: 3 s). A reader learns
 that it missed a sample from the writer's next heartbeat (or a later sample), so on a lossy link
