@@ -195,6 +195,9 @@ class DepotAdmission:
         self._reported: dict[str, tuple[str, int]] = {}
         self._left = 0
         self._t = 0.0
+        self.version = 0
+        """Bumped by every change of what `snapshot` reports (cells owned, robots' places and
+        routes, robots inside): a reader may keep its last snapshot while this is unchanged."""
         if m.kind == "single":
             e_in = m.xy[m.line_ids[m.entry_names[0]][-1]]
             a0 = _bearing(e_in, m.center)
@@ -274,6 +277,7 @@ class DepotAdmission:
         r.pos = r.end = cell
         self._owner[c] = robot
         self._robots[robot] = r
+        self.version += 1
         return Refusal.NONE
 
     def arrived(self, robot: str, line: str, cell: int, t: float) -> None:
@@ -295,6 +299,7 @@ class DepotAdmission:
             raise ValueError(f"{robot}: ({line}, {cell}) is beyond its grant {r.labels[r.end]}")
         if p == r.pos:
             return
+        self.version += 1
         for c in r.route[r.pos : p]:
             self._owner[c] = None
         r.pos, r.key = p, t
@@ -320,6 +325,7 @@ class DepotAdmission:
         r = self._robots.pop(robot, None)
         if r is None:
             return False
+        self.version += 1
         for c, owner in enumerate(self._owner):
             if owner == robot:
                 self._owner[c] = None
@@ -412,6 +418,7 @@ class DepotAdmission:
     def _set_route(self, r: _Robot, k: int | None) -> None:
         """Route of template k (None: single-queue entry line only, before dispatch)."""
         tpl = self._m.template(k)
+        self.version += 1
         r.route, r.labels, r.lookup = tpl.ids, tpl.labels, tpl.lookup
         r.entry_len, r.complete = tpl.entry_len, tpl.complete
         r.inner, r.dock_pos, r.inner_end = tpl.inner, tpl.dock_pos, tpl.inner_end
@@ -468,6 +475,7 @@ class DepotAdmission:
                 claims[x] = max(claims[x], rank)
 
     def _grant_to(self, r: _Robot, end: int) -> None:
+        self.version += 1
         for c in r.route[r.end + 1 : end + 1]:
             self._owner[c] = r.name
         r.end = end

@@ -54,12 +54,18 @@ class DepotServer:
         self.lost: set[str] = set()
         """Robots declared dead."""
         self._last: dict[str, bool] = {}
+        self._state: tuple[int, dict[str, DepotView]] | None = None
 
     def state(self) -> dict[str, DepotView]:
-        """``depot``: the queues, docks, inner queues and owned slots now."""
-        s = self.admission.snapshot()
-        return {"depot": DepotView(tuple(zip(s.entry_lines, s.entry_queue_lengths)), s.dock_occupants,
-                                   s.inner_queue_counts, s.occupied)}
+        """``depot``: the queues, docks, inner queues and owned slots now. Asked every tick (the
+        ``queue_lengths`` series reads it) but changed on few: kept while the admission's
+        `version` stands."""
+        adm = self.admission
+        if self._state is None or self._state[0] != adm.version:
+            s = adm.snapshot()
+            self._state = (adm.version, {"depot": DepotView(tuple(zip(s.entry_lines, s.entry_queue_lengths)),
+                                                            s.dock_occupants, s.inner_queue_counts, s.occupied)})
+        return self._state[1]
 
     def robot_lost(self, robot: str, stamp_ns: int) -> None:
         """`robot` was declared dead: free everything it holds, refuse what it sends later."""

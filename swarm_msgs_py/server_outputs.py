@@ -115,6 +115,9 @@ def outputs_of(spec: registry.ServerSpec) -> ServerOutputs:
     return registry.resolve(spec.outputs) if spec.outputs else NO_OUTPUTS
 
 
+_NOTHING = object()
+
+
 class StateWatch:
     """Which state values to publish after a tick: those that differ from the last published
     (all of them at the first tick)."""
@@ -127,7 +130,8 @@ class StateWatch:
         out = []
         for st in self.states:
             value = values[st.field]
-            if st.field not in self._last or self._last[st.field] != value:
+            last = self._last.get(st.field, _NOTHING)
+            if last is not value and (last is _NOTHING or last != value):
                 self._last[st.field] = value
                 out.append((st, value))
         return out

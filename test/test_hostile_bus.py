@@ -180,6 +180,7 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     assert rejected[DEPOT_GRANTS]["unauthenticated"] >= 5 * 6
     assert rejected[topics.WORLD_EVENTS]["unauthenticated"] >= 5
     assert rejected[topics.LOCKSTEP_ACK]["unauthenticated"] >= 5
+    assert rejected["/robot_0/status"]["unauthenticated"] >= 5  # by the world's status watch
     assert rejected[DEPOT_REPORTS]["foreign publisher"] == 1  # reported, not tainting
     assert summary["foreign_publishers"] == [] and summary["dead_nodes"] == []
     assert "/radio" not in rejected and max(summary["oae_by_robot"].values()) < 5000

@@ -18,6 +18,7 @@ from swarm_msgs_py import diagnostics, gripper, odometry, resources, scan, topic
 from swarm_msgs_py.executor import share_sim_time
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_run
+from swarm_sim.inbound import Reason
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
 from swarm_sim.scenario import load_scenario
@@ -30,8 +31,10 @@ SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.dist
 class ScriptedControllers(Node):
     """Answers every robot's observations with a command chosen by `policy(robot, stamp)`."""
 
-    def __init__(self, robots, policy, context, skip=(), forge=(), mute=None):
+    def __init__(self, robots, policy, context, skip=(), forge=(), mute=None, repeat=()):
         super().__init__("scripted", context=context)
+        self.repeat = repeat
+        """Robots that send each answer twice (as for a re-sent tick), then a different one."""
         self.mute = mute or {}
         """robot -> the stamp [ns] from which it stops answering (its controller died)."""
         self.forge = forge
@@ -58,15 +61,18 @@ class ScriptedControllers(Node):
         if stamp >= self.mute.get(robot, stamp + 1):
             return
         self.pubs[robot].publish(twist.encode_twist(robot, stamp, linear, angular))
+        if robot in self.repeat:
+            self.pubs[robot].publish(twist.encode_twist(robot, stamp, linear, angular))
+            self.pubs[robot].publish(twist.encode_twist(robot, stamp, 0.15, 0.0))
         if robot in self.forge and stamp > 0:  # a late (or forged) answer for the previous tick,
             # sent last: were it applied, the robot would drive at 0.15 m/s
             self.pubs[robot].publish(twist.encode_twist(robot, stamp - 10**8, 0.15, 0.0))
 
 
-def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), forge=(), mute=None, **config):
+def run_world(context, tmp_path, policy, overrides=SMALL, skip=(), forge=(), mute=None, repeat=(), **config):
     cfg = WorldNodeConfig(overrides=overrides, bag=str(tmp_path / "bag"), startup_timeout=10.0, **config)
     world = WorldNode(cfg, context=context)
-    peer = ScriptedControllers(world.robots, policy, context, skip=skip, forge=forge, mute=mute)
+    peer = ScriptedControllers(world.robots, policy, context, skip=skip, forge=forge, mute=mute, repeat=repeat)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(world)
     executor.add_node(peer)
@@ -250,6 +256,20 @@ def test_commands_stamped_for_another_tick_are_ignored_in_lockstep(context, tmp_
     assert world.world.stats["robot_0"].stale_ticks == 0
     rows = load_odometry(bag)["robot_0"]
     assert (rows[:, 1:3] == rows[0, 1:3]).all()  # it never drove: the forged 0.15 m/s was not applied
+
+
+def test_an_answer_repeated_is_recorded_once_and_a_different_second_one_refused(context, tmp_path):
+    """A controller repeats its answer for every topic of a re-sent tick: the bag keeps one command
+    per robot and tick. A second, different command for a tick already answered is refused and
+    recorded apart, never applied."""
+    from swarm_sim.analysis.replay import load_odometry
+
+    world, _, bag = run_world(context, tmp_path, lambda r, s: (0.0, 0.0), repeat=("robot_0",))
+    ticks = world.world.tick
+    assert bag_info(bag).message_counts["/robot_0/cmd_vel"] == ticks == 10
+    assert world.rejections.counts[("/robot_0/cmd_vel", Reason.REFUSED.value)] == ticks
+    rows = load_odometry(bag)["robot_0"]
+    assert (rows[:, 1:3] == rows[0, 1:3]).all()  # the second answer's 0.15 m/s was never applied
 
 
 def test_a_dead_controllers_robot_stops_instead_of_driving_on_blind(context, tmp_path):

@@ -1,9 +1,10 @@
 """The robots' behaviour statuses as the world node hears them (``/<robot>/status``).
 
 The world records each status as it arrives (the recorder's own discovery would otherwise) and
-keeps every robot's last one, checked like any bus message (`swarm_sim.inbound`: decodable,
-from the robot whose namespace it came on, stamped for a tick the world has sent). Two things
-read them: the progress line, where the algorithm's registry record says what to make of them
+keeps every robot's last one, checked like any bus message (`swarm_sim.inbound`: within the size
+cap, tagged with the run's credential (`swarm_msgs_py.auth`), decodable, from the robot whose
+namespace it came on, stamped for a tick the world has sent). Two things read them: the progress
+line, where the algorithm's registry record says what to make of them
 (`swarm_sim.registry.Algorithm.progress`, e.g. the caging stage), and the end of a run with
 ``sim.stop_when_finished``, once every live robot's status says its task is over
 (``BehaviourStatus.finished``), as the batch runner stops once every behaviour is ``finished``.
@@ -21,11 +22,14 @@ from collections.abc import Collection, Mapping
 from rclpy.executors import Executor
 from rclpy.node import Node
 
-from swarm_msgs_py import diagnostics, topics
+from swarm_msgs_py import auth, diagnostics, topics
 from swarm_msgs_py.qos import EVENTS
 from swarm_sim.inbound import Inbound, Reason
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.types import BehaviourStatus, RobotId
+
+_DECODE_STATUS = auth.verified(diagnostics.decode_status)
+"""A status must carry the run's tag: a forged `finished` would end the run early."""
 
 
 class StatusWatch:
@@ -35,6 +39,7 @@ class StatusWatch:
         self._inbound = inbound
         self._recording = recording
         self._dt_ns = dt_ns
+        self._max_bytes = inbound.bounds.message_bytes if inbound.bounds is not None else None
         self.statuses: dict[RobotId, BehaviourStatus] = {}
         """Each robot's last admitted status."""
         self.subscriptions = {}
@@ -51,10 +56,8 @@ class StatusWatch:
         self._recording.write_taken(topic, data, self._take(robot, topic, data))
 
     def _take(self, robot: RobotId, topic: str, data: bytes) -> bool:
-        try:
-            status = diagnostics.decode_status(data)
-        except ValueError as exc:
-            self._inbound.reject(topic, Reason.MALFORMED, str(exc)[:200])
+        status = self._inbound.decode(topic, _DECODE_STATUS, data, self._max_bytes)
+        if status is None:
             return False
         if status.robot != robot:
             self._inbound.reject(topic, Reason.UNKNOWN_ROBOT, f"status of {status.robot[:40]!r} on {topic}")

@@ -38,9 +38,8 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from swarm_msgs_py import ack as ack_codec
-from swarm_msgs_py import auth
+from swarm_msgs_py import auth, odometry, scan, topics, twist
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py import odometry, scan, topics, twist
 from swarm_msgs_py.executor import make_executor
 from swarm_msgs_py.params import declare_config
 from swarm_msgs_py.qos import SENSOR_LOCKSTEP
@@ -59,7 +58,6 @@ from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
-
 
 COMMAND_BYTES = 512
 """Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""
@@ -164,6 +162,8 @@ class WorldNode(Node):
         self.command_watch = CommandWatch(self.robots, self.scenario.dt_ns, self.scenario.ticks,
                                           round(self.scenario.sim.command_timeout * NS_PER_S) if realtime else 0)
         """Late, lost, re-sent commands per robot; realtime: the command timeout."""
+        self._taken_cmd: dict[RobotId, bytes] = {}
+        """Each robot's last command taken, as received (its repeats are not recorded again)."""
         self._sent: dict[RobotId, dict[str, bytes]] = {}
         """This tick's encoded observations per robot, to re-send if an answer is late."""
         self.servers: tuple[str, ...] = tuple(spec.channel for spec in algorithm.servers)
@@ -246,10 +246,15 @@ class WorldNode(Node):
 
     def _on_cmd(self, robot: RobotId, data: bytes) -> None:
         topic = self._topic_of_cmd[robot]
-        self.recording.write_taken(topic, data, self._take_cmd(robot, topic, data))
+        taken = self._take_cmd(robot, topic, data)
+        if taken is not None:
+            self.recording.write_taken(topic, data, taken)
 
-    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool:
-        """Take a command (True), or refuse and count it (False: recorded apart)."""
+    def _take_cmd(self, robot: RobotId, topic: str, data: bytes) -> bool | None:
+        """Take a command (True), or refuse and count it (False: recorded apart); None for a robot's
+        answer again to a tick it has answered (the world re-sent the tick, `resend_period`, and
+        the controller repeats its answer for each re-sent topic): the bag keeps one command per
+        robot and tick, as the run used."""
         plain = robot in self.config.plain_twist
         decoded = self.inbound.decode(topic, self._decode_plain if plain else twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
@@ -258,9 +263,12 @@ class WorldNode(Node):
         if robot in self.barrier.dead:
             self.inbound.reject(topic, Reason.DEAD, f"{robot} was declared dead; its robot stays stopped")
             return False
+        if self.config.mode == "lockstep" and self.barrier.has_answered(robot, stamp_ns):
+            if data == self._taken_cmd.get(robot):
+                return None  # its answer again, to a tick the world re-sent (`resend_period`)
+            self.inbound.reject(topic, Reason.REFUSED, f"a second, different command for tick {stamp_ns} ns")
+            return False
         if self.config.mode == "lockstep" and stamp_ns != self.world.t_ns:
-            if self.barrier.has_answered(robot, stamp_ns):
-                return True  # its answer again, to a tick the world re-sent (`resend_period`) and has closed
             # A command for another tick (late, or forged on the bus) would break lockstep.
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
@@ -276,6 +284,7 @@ class WorldNode(Node):
             self.inbound.reject(topic, Reason.LATE, f"stamped {stamp_ns} ns, older than the command held")
             return False
         self._commands[robot] = Command(linear, angular)
+        self._taken_cmd[robot] = data
         self.barrier.answered(robot, stamp_ns)
         return True
 

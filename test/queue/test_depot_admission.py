@@ -14,7 +14,7 @@ joined). Every robot must leave within twice that (+10 ticks) of joining.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -24,6 +24,7 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from depot_manager.admission import DepotAdmission
+from depot_manager.codec import OUTPUTS
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import (
     DepotGeometryConfig,
@@ -33,7 +34,6 @@ from depot_manager.geometry import (
     make_layout,
 )
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
-from depot_manager.codec import OUTPUTS
 from depot_manager.server import DepotServer
 from swarm_controllers.spiral.protocol import ProgressReport
 from swarm_msgs_py.server_outputs import StateWatch
@@ -158,6 +158,7 @@ def simulate(
     run = Run(bots=bots)
     work = 0.0
     reported: set[str] = set()
+    seen = (-1, None)  # (admission version, its snapshot without the time)
     for tick in range(max_ticks):
         t = float(tick)
         # arrivals join (entry point: cell 0; tail: a random cell behind the tail)
@@ -215,7 +216,11 @@ def simulate(
         reported |= set(changed)
         run.contests += check_fcfs(adm, g, before, by_name)
         check_invariants(adm, lay, g, bots)
-        run.max_inner = max([run.max_inner, *adm.snapshot().inner_queue_counts])
+        snap = replace(adm.snapshot(), t=0.0)
+        # Readers keep their last snapshot while the version stands (`DepotServer.state`).
+        assert adm.version != seen[0] or snap == seen[1], "the depot changed without a new version"
+        seen = (adm.version, snap)
+        run.max_inner = max([run.max_inner, *snap.inner_queue_counts])
         # route lengths, for the bound (a single-queue route is known once dispatched)
         for b in bots:
             if b.pos is not None and b.route_len == 0:
