@@ -59,7 +59,8 @@ def robots_of(count: int) -> dict[str, list[str]]:
     return {h: [f"robot_{i}" for i in range(k, count, 2)] for k, h in enumerate(CONTROLLER_HOSTS)}
 
 
-def _env() -> dict[str, str]:
+def node_env() -> dict[str, str]:
+    """This environment with this tree first on PYTHONPATH, for the processes on the hosts."""
     return {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
 
 
@@ -90,7 +91,7 @@ def start_echo(testbed: Testbed, server: str, topic: str, count: int, timeout: f
     recipe gives a stock ``ros2`` there (``python -m launch_py.hosts env``)."""
     lines = testbed.run("cli", [sys.executable, "-m", "launch_py.hosts", "env", "--bind", "eth0",
                                 "--discovery-server", server, "--profile", str(tmp / "cli.xml")])
-    env = {k: v for k, v in _env().items() if not k.startswith(("ROS_", "FAST", "RMW_"))}
+    env = {k: v for k, v in node_env().items() if not k.startswith(("ROS_", "FAST", "RMW_"))}
     for line in lines.splitlines():
         if line.startswith("export "):
             key, _, value = line[7:].partition("=")
@@ -113,7 +114,7 @@ class MultiHostRun:
         cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(self.bag), "--json", "--domain-id",
                os.environ["ROS_DOMAIN_ID"], "--bind", world, "--key-file", str(key), *remote, "--robots", str(robots),
                *args]
-        self.launcher = testbed.popen("world", cmd, env=_env(), cwd=REPO, stdout=subprocess.PIPE,
+        self.launcher = testbed.popen("world", cmd, env=node_env(), cwd=REPO, stdout=subprocess.PIPE,
                                       stderr=subprocess.PIPE, text=True)
         self.out, self.err = _Lines(self.launcher.stdout), _Lines(self.launcher.stderr)
         self.controllers = {}
@@ -127,7 +128,7 @@ class MultiHostRun:
             try:  # the key as the printed recipe hands it over: an inherited descriptor
                 self.controllers[host] = testbed.popen(
                     host, [sys.executable, "-m", "launch_py.hosts", "controllers", *node_args],
-                    env={**_env(), "SWARMFORAGE_KEY_FD": str(fd)}, pass_fds=(fd,), cwd=REPO,
+                    env={**node_env(), "SWARMFORAGE_KEY_FD": str(fd)}, pass_fds=(fd,), cwd=REPO,
                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             finally:
                 os.close(fd)

@@ -43,7 +43,9 @@ shaped = pytest.mark.parametrize("testbed", [True], indirect=True, ids=["shaped"
 
 def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_path):
     robots, duration, seed = 8, 30.0, 11
-    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20")
+    # At most 4x real time (it only adds waits): time for the echo to start and discover, on a busy machine.
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20",
+                       "--real-time-factor", "4")
     echo = run.echo("/robot_1/cmd_vel", 5, 60)  # robot_1's controller is on hostb
     run.wait_sim(duration / 2, 90)
     run.note_sockets()

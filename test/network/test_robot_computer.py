@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 import pytest
-from multihost import REPO, _env, start_echo
+from multihost import REPO, node_env, start_echo
 from netns import Testbed, available, leftovers
 
 from swarm_msgs_py.twist import decode_plain_twist
@@ -42,10 +42,10 @@ def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
         server = f"{world_address}:{7000 + int(os.environ['ROS_DOMAIN_ID'])}"
         world = bed.popen("world", [sys.executable, "-m", "launch_py.hosts", "world", "--bind", "eth0", *SCENARIO,
                                     "--mode", "realtime", "--plain-twist", "robot_0", "--bag", str(bag), *TURTLEBOT],
-                          env=_env(), cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                          env=node_env(), cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         robot = bed.popen("hosta", [sys.executable, "-m", "launch_py.hosts", "controllers", "--bind", "eth0",
                                     "--discovery-server", server, "--robots", "robot_0", "--plain-twist", "--mode", "realtime", *SCENARIO,
-                                    *TURTLEBOT], env=_env(), cwd=REPO, stdout=subprocess.DEVNULL,
+                                    *TURTLEBOT], env=node_env(), cwd=REPO, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True)
         echo = start_echo(bed, server, "/cmd_vel", 3, 60, tmp_path)  # a TurtleBot's command topic
         sockets = set()

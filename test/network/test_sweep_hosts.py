@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from multihost import _env
+from multihost import node_env
 from netns import Testbed, available, leftovers
 
 from swarm_sim.compare.sweep import RunPlan, run_sweep
@@ -51,16 +51,16 @@ def test_a_sweep_on_dask_workers_on_two_hosts_equals_the_local_pool(tmp_path):
     try:
         scheduler = f"tcp://{bed.address['sched']}:{PORT}"
         bed.popen("sched", [dask, "scheduler", "--host", bed.address["sched"], "--port", str(PORT),
-                            "--no-dashboard", "--no-show", "--dashboard-address", f"{bed.address['sched']}:0"], env=_env(), stdout=subprocess.DEVNULL,
+                            "--no-dashboard", "--no-show", "--dashboard-address", f"{bed.address['sched']}:0"], env=node_env(), stdout=subprocess.DEVNULL,
                   stderr=subprocess.DEVNULL)
         for host in ("hosta", "hostb"):
             bed.popen(host, [dask, "worker", scheduler, "--host", bed.address[host], "--nworkers", "1",
                              "--nthreads", "1", "--no-dashboard", "--name", host,
                              # without it a worker's HTTP server (health, metrics) listens on 0.0.0.0
-                             "--dashboard-address", f"{bed.address[host]}:0"], env=_env(),
+                             "--dashboard-address", f"{bed.address[host]}:0"], env=node_env(),
                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         client = bed.popen("client", [sys.executable, "-c", CLIENT, scheduler, str(tmp_path / "dask.jsonl")],
-                           env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                           env=node_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         sockets: set[tuple[str, str, str]] = set()
         deadline = time.monotonic() + 240
         while client.poll() is None:
