@@ -22,6 +22,7 @@ import argparse
 import json
 import os
 import secrets
+import shlex
 import shutil
 import signal
 import subprocess
@@ -31,6 +32,7 @@ import time
 from datetime import datetime
 from pathlib import Path
 
+from launch_py import hosts
 from launch_py.dds import (
     MAX_DOMAIN_ID,
     PROFILE_MAX_PROCESSES,
@@ -179,6 +181,9 @@ def main(argv: list[str] | None = None) -> int:
                              "the fastest it may go (default: as fast as the nodes answer; 1 with --foxglove)")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=2.0,
                         help="lockstep: wall s to wait per tick")
+    parser.add_argument("--resend-period", type=number(float, 0, 3600, open_low=True), default=0.25,
+                        help="lockstep: wall s after which a tick is sent again to the nodes that have not answered "
+                             "(default 0.25; across lossy links a few round trips, e.g. 0.1)")
     parser.add_argument("--domain-id", type=domain_option,
                         help=f"ROS_DOMAIN_ID 0-{MAX_DOMAIN_ID}, or auto: a free one (default: the user's ROS_DOMAIN_ID, "
                              "else a free one); a run refuses a domain anything else uses")
@@ -197,6 +202,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--foxglove-host", default=LOOPBACK,
                         help=f"address the live view binds (default {LOOPBACK}: this machine only)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
+    parser.add_argument("--bind", metavar="ADDR|IFACE",
+                        help="across hosts: the world (the discovery server, port 7000 + domain), the servers and "
+                             "the local controllers bind this IPv4 address (or the interface's) only, instead of "
+                             "loopback (README, *Across hosts*)")
+    parser.add_argument("--remote-controllers", type=remote_option, action="append", default=[],
+                        metavar="HOST=ROBOT,...", help="with --bind: these robots' controllers run on HOST (started "
+                        "there by hand, as printed): none is started here; the summary counts per host")
+    parser.add_argument("--plain-twist", action="store_true",
+                        help="realtime, with --remote-controllers: the remote robots' computers speak plain "
+                             "geometry_msgs/Twist on wall-clock time (swarm-controllers --plain-twist), as "
+                             "TurtleBot-class robots do")
+    parser.add_argument("--key-file", type=Path, metavar="PATH",
+                        help="write the run's credential here (mode 0600), for the controllers on other hosts "
+                             "(SWARMFORAGE_KEY_FD=3 ... 3<PATH); required with --remote-controllers")
     args = parser.parse_args(argv)
     # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
     # (nohup, some CI shells and test runners), so install the handlers explicitly.
@@ -213,7 +232,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f"swarm-run: {problem}", file=sys.stderr)
         return 2
     pace = _pace(args)
-    groups = split_robots(scenario.robot_names, args.controller_processes)
+    try:
+        bind, remote = _hosts(args, scenario)
+    except hosts.HostError as exc:
+        print(f"swarm-run: {exc}", file=sys.stderr)
+        return 2
+    local = [r for r in scenario.robot_names if r not in {r for robots in remote.values() for r in robots}]
+    groups = split_robots(local, args.controller_processes) if local else []
     servers = registry.of(scenario).servers
     processes = len(groups) + len(servers) + 1
     if processes > PROFILE_MAX_PROCESSES:
@@ -243,11 +268,18 @@ def main(argv: list[str] | None = None) -> int:
         remove_dead_shm_files()  # what killed runs left
         env = profile_env(env, "loopback.xml", PROFILE_PATH.read_text(encoding="utf-8"))
     world_env = env
-    if port is not None:
-        world_env = discovery_server_env(profile_env(env, "discovery_server.xml", server_profile(port)),
-                                         profiles / "discovery_server.xml")
-    # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
-    robots_env = profile_env(env, "robots.xml", robot_profile())
+    if bind is not None:  # across hosts: every process bound to `bind`, the world serves discovery there
+        envs = {}
+        for role in ("server", "client", "robot"):
+            (profiles / f"{role}.xml").write_text(hosts.host_profile(role, bind, port), encoding="utf-8")
+            envs[role] = {**env, **hosts.host_env(role, domain, bind, (bind, port), profiles / f"{role}.xml", env)}
+        world_env, env, robots_env = envs["server"], envs["client"], envs["robot"]
+    else:
+        if port is not None:
+            world_env = discovery_server_env(profile_env(env, "discovery_server.xml", server_profile(port)),
+                                             profiles / "discovery_server.xml")
+        # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
+        robots_env = profile_env(env, "robots.xml", robot_profile())
     common = scenario_args(args, scenario)
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
@@ -255,7 +287,7 @@ def main(argv: list[str] | None = None) -> int:
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
-    if port is not None:
+    if port is not None and bind is None:
         print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
               f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
               f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list --spin-time 2  (discovery takes "
@@ -265,6 +297,11 @@ def main(argv: list[str] | None = None) -> int:
     me = os.getpid()
 
     run_key = secrets.token_bytes(auth.KEY_BYTES)  # this run's credential (`swarm_msgs_py.auth`)
+    if args.key_file is not None:
+        _write_key(args.key_file, run_key)
+    if bind is not None:
+        _print_remote(domain, (bind, port), remote,
+                      [*common, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
 
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
         key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
@@ -276,12 +313,15 @@ def main(argv: list[str] | None = None) -> int:
         return label, proc
 
     world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
-                 "--tick-timeout", str(args.tick_timeout), "--real-time-factor", str(args.real_time_factor or 1.0)]
+                 "--tick-timeout", str(args.tick_timeout), "--resend-period", str(args.resend_period),
+                 "--real-time-factor", str(args.real_time_factor or 1.0)]
     if pace:
         world_cmd += ["--pace", str(pace)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     options = [] if args.parameter_services else ["--no-parameter-services"]
+    if args.plain_twist:
+        world_cmd += ["--plain-twist", *(r for robots in remote.values() for r in robots)]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
         controllers = [("controller processes (one per robot)",
                         [*python, "swarm_controllers.controller_node", "--fork", *options, "--robots",
@@ -289,6 +329,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
                         [*python, "swarm_controllers.controller_node", *options, "--robots", *g]) for g in groups]
+    controllers = [(label, [*cmd, "--mode", args.mode]) for label, cmd in controllers]
     children: list[tuple[str, subprocess.Popen]] = []
     world: subprocess.Popen | None = None
     interrupted = False
@@ -343,6 +384,8 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
         return 1
+    if remote:
+        summary["by_host"] = by_host(summary, {"local": local, **remote})
     if args.json:
         print(json.dumps(summary))
     else:
@@ -356,7 +399,78 @@ def _done_lines(summary: dict, scenario: Scenario | None, bag: Path) -> list[str
     return [f"[swarm-run] done: {summary['sim_seconds']:.1f} s sim in {summary['wall_seconds']:.1f} s wall"
             + (f" ({rtf}x)" if rtf else ""),
             *summary_lines(summary, scenario),
+            *(f"  host {host:<26} {c['robots']} robots: {c['stale']} stale ticks, {c['late']} late commands, "
+              f"{c['lost']} ticks without a command, {c['resent']} ticks re-sent, {c['stopped']} stops by the "
+              "command timeout" for host, c in (summary.get("by_host") or {}).items()),
             f"[swarm-run] bag: {bag}  (swarm-analyze {bag} --trajectories for its figures)"]
+
+
+def remote_option(text: str) -> tuple[str, list[str]]:
+    """``--remote-controllers HOST=ROBOT,ROBOT,...``."""
+    host, _, robots = text.partition("=")
+    names = [r for r in robots.split(",") if r]
+    if not host or not names:
+        raise argparse.ArgumentTypeError(f"expected HOST=ROBOT,ROBOT,..., got {text[:60]!r}")
+    return host, names
+
+
+def _hosts(args: argparse.Namespace, scenario: Scenario) -> tuple[str | None, dict[str, list[str]]]:
+    """(the address the run binds or None for loopback, {host: its robots}) from ``--bind``,
+    ``--remote-controllers`` and ``--key-file``; raises HostError with the line to print."""
+    bind = hosts.bind_address(args.bind) if args.bind else None
+    if bind is not None and args.discovery != "server":
+        raise hosts.HostError("--bind: a run across hosts discovers through the world (--discovery server)")
+    if bind is not None and args.shared_memory:
+        raise hosts.HostError("--shared-memory is for a run on one host: across hosts (--bind) the data goes by UDP")
+    remote: dict[str, list[str]] = {}
+    for host, robots in args.remote_controllers:
+        remote.setdefault(host, []).extend(robots)
+    if not remote:
+        if args.plain_twist:
+            raise hosts.HostError("--plain-twist is for the robots' own computers: name them with --remote-controllers")
+        return bind, remote
+    if bind is None or args.key_file is None:
+        raise hosts.HostError("--remote-controllers needs --bind (an address the other hosts reach) and --key-file")
+    if args.plain_twist and args.mode != "realtime":
+        raise hosts.HostError("--plain-twist: a plain Twist carries no tick, so only --mode realtime can take it")
+    named = [r for robots in remote.values() for r in robots]
+    if unknown := sorted(set(named) - set(scenario.robot_names)):
+        raise hosts.HostError(f"--remote-controllers: no robot {unknown[0]!r} in this run "
+                              f"({scenario.robot_names[0]}..{scenario.robot_names[-1]})")
+    if len(set(named)) != len(named):
+        raise hosts.HostError("--remote-controllers: a robot is named twice")
+    return bind, remote
+
+
+def _write_key(path: Path, key: bytes) -> None:
+    """The run's key for other hosts, readable by this user only (a new file: never overwritten)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+    with os.fdopen(fd, "wb") as f:
+        f.write(key)
+
+
+def _print_remote(domain: int, server: tuple[str, int], remote: dict[str, list[str]], common: list[str],
+                  key_file: Path | None) -> None:
+    """How other hosts join: a stock ros2 CLI, and each remote host's controllers."""
+    join = f"ROS_DOMAIN_ID={domain} "
+    where = f"--discovery-server {server[0]}:{server[1]}"
+    print(f"[swarm-run] across hosts: discovery server {server[0]}:{server[1]}, domain {domain}; a stock ros2 on a "
+          f"host joins with: eval \"$({join}python -m launch_py.hosts env --bind ITS_ADDRESS {where})\"", flush=True)
+    for host, robots in remote.items():
+        print(f"[swarm-run] on {host}: {join}SWARMFORAGE_KEY_FD=3 swarm-controllers --bind ITS_ADDRESS {where} "
+              f"--robots {' '.join(robots)} {shlex.join(common)} 3<{shlex.quote(str(key_file))}", flush=True)
+
+
+def by_host(summary: dict, robots_of: dict[str, list[str]]) -> dict[str, dict]:
+    """The summary's per-robot command counts (`commands_by_robot`) summed per host."""
+    per_robot = summary.get("commands_by_robot") or {}
+    out = {}
+    for host, robots in robots_of.items():
+        if robots:
+            counts = [per_robot.get(r, {}) for r in robots]
+            out[host] = {"robots": len(robots), **{k: sum(c.get(k, 0) for c in counts)
+                                                   for k in ("stale", "late", "lost", "resent", "stopped")}}
+    return out
 
 
 def _foxglove_problem(args: argparse.Namespace) -> str | None:

@@ -20,6 +20,13 @@ its own topics. ``--no-parameter-services`` leaves them out: more than half of a
 endpoints, and with 1000 robots 45 % of the start-up's CPU (Fast DDS pairs every endpoint it
 learns of with every local one: the world, as discovery server, learns of them all).
 
+With ``--plain-twist`` the node drives a robot of its own, as on a TurtleBot-class robot's
+computer: it publishes plain ``geometry_msgs/Twist`` on ``cmd_vel`` and steps on wall-clock time
+(a timer every ``sim.dt`` wall seconds, with the newest observations heard; the behaviour's clock
+is its own tick count times dt), not on the world's ticks; topic names are remapped the standard
+way (``--ros-args -r cmd_vel:=/my_robot/cmd_vel``). Against the world it needs a realtime run whose
+world takes that robot's plain Twist (``swarm-world --plain-twist``).
+
 ``swarm-controllers --robots robot_0 robot_1 ...`` hosts several such nodes in one process;
 with ``--fork`` it gives every robot its own process instead, forked from this one once the
 imports and the scenario are loaded (one process per robot, as on real hardware, without paying
@@ -68,18 +75,21 @@ class ControllerNode(Node):
     of the same seed."""
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
-                 parameter_services: bool = True, **kwargs) -> None:
+                 parameter_services: bool = True, plain_twist: bool = False, **kwargs) -> None:
         """`scenario`: the one `config` names, already loaded (saves each forked process the
-        parse); `parameter_services`: serve ``ros2 param`` (see the module docstring)."""
+        parse); `parameter_services`: serve ``ros2 param``; `plain_twist`: a robot's own computer
+        (see the module docstring)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, enable_rosout=False, start_parameter_services=parameter_services,
             # No type description service: our types are standard ones every peer has, and its two
             # endpoints per robot are start-up cost with a process per robot.
-            parameter_overrides=[Parameter("use_sim_time", value=True),
+            parameter_overrides=[Parameter("use_sim_time", value=not plain_twist),
                                  Parameter("start_type_description_service", value=False)], **kwargs,
         )
         self.robot = robot
+        self.plain_twist = plain_twist
+        self._wall_ticks = 0
         self.config = cfg = declare_config(self, ControllerConfig, config)
         self.scenario = scenario or load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
@@ -123,11 +133,25 @@ class ControllerNode(Node):
             return False
         if missing:
             self.get_logger().warning(f"answering without all peers matched on {', '.join(sorted(missing))}")
-        self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
+        if self.plain_twist:
+            self._cmd_pub = self.create_publisher(topics.import_type(twist.PLAIN_TYPE_NAME), topics.CMD_VEL,
+                                                  SENSOR_LOCKSTEP)
+            self.create_timer(self.scenario.sim.dt, self._wall_tick)  # the node's clock: wall time
+        else:
+            self._cmd_pub = self.create_publisher(topics.type_of(topics.CMD_VEL), topics.CMD_VEL, SENSOR_LOCKSTEP)
         return True
+
+    def _wall_tick(self) -> None:
+        """``--plain-twist``: a step on the wall clock with the newest observation of each topic."""
+        if len(self._latest) == self._expected:
+            self._wall_ticks += 1
+            self._tick(self._wall_ticks * self.scenario.dt_ns)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
         if self._cmd_pub is None:  # not connected yet: the world cannot have started
+            return
+        if self.plain_twist:  # its own clock steps it (`_wall_tick`)
+            self._latest[name] = decoded
             return
         stamp = decoded[0]
         if stamp == self._answered_stamp:  # the world re-sent a tick: our answer was late or lost
@@ -158,25 +182,31 @@ class ControllerNode(Node):
             self._last_status = key
             self._status_pub.publish(auth.sign(diagnostics.encode_status(status)))
         self.endpoint.report.publish(stamp_ns, self.behaviour)
+        if self.plain_twist:
+            self._cmd_pub.publish(twist.encode_plain_twist(command.linear, command.angular))
+            return
         self._answer = twist.encode_twist(self.robot, stamp_ns, command.linear, command.angular)
         self._answered_stamp = stamp_ns
         self._cmd_pub.publish(self._answer)
 
 
-def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool, bool]:
-    """(robots, config, ROS arguments, fork, parameter services)."""
+def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str], bool, bool, bool]:
+    """(robots, config, ROS arguments, fork, parameter services, plain Twist)."""
     parser = argparse.ArgumentParser(prog="swarm-controllers", description=first_paragraph(__doc__))
     parser.add_argument("--robots", nargs="+", required=True, help="robot ids, e.g. robot_0 robot_1")
     add_endpoint_arguments(parser)
     parser.add_argument("--fork", action="store_true", help="one process per robot, forked from this one")
     parser.add_argument("--no-parameter-services", dest="parameter_services", action="store_false",
                         help="no ros2 param services on the controller nodes (12 DDS endpoints a robot fewer)")
+    parser.add_argument("--plain-twist", action="store_true",
+                        help="a robot's own computer: plain geometry_msgs/Twist on cmd_vel, steps on wall-clock time "
+                             "(realtime runs; remap topics with --ros-args -r cmd_vel:=...)")
     args, ros_args = parser.parse_known_args(argv)
-    return args.robots, endpoint_config(args), ros_args, args.fork, args.parameter_services
+    return args.robots, endpoint_config(args), ros_args, args.fork, args.parameter_services, args.plain_twist
 
 
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
-          scenario: Scenario | None = None, parameter_services: bool = True) -> int:
+          scenario: Scenario | None = None, parameter_services: bool = True, plain_twist: bool = False) -> int:
     """The robots' controller nodes in this process, spun until shut down; `teardown=False`
     leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
@@ -184,7 +214,8 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     try:
         executor = make_executor()
         for robot in robots:
-            nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services))
+            nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services,
+                                        plain_twist=plain_twist))
             executor.add_node(nodes[-1])
         share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
@@ -237,7 +268,7 @@ STOP_GRACE = 5.0
 
 
 def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str], *,
-                 parameter_services: bool = True) -> int:
+                 parameter_services: bool = True, plain_twist: bool = False) -> int:
     """One process per robot, forked from this one (see the module docstring).
 
     A robot process leaves without tearing its DDS participant down (`os._exit` once its loop
@@ -258,7 +289,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
             code = 1
             try:
                 code = serve([robot], config, ros_args, teardown=False, scenario=scenario,
-                             parameter_services=parameter_services)
+                             parameter_services=parameter_services, plain_twist=plain_twist)
             finally:
                 sys.stdout.flush()
                 sys.stderr.flush()
@@ -297,9 +328,10 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
 
 
 def main(argv: list[str] | None = None) -> int:
-    robots, config, ros_args, fork, parameter_services = parse_args(sys.argv[1:] if argv is None else argv)
+    robots, config, ros_args, fork, parameter_services, plain_twist = parse_args(sys.argv[1:] if argv is None else argv)
     auth.load_from_environment()  # the run's key, when the launcher handed one down (forks inherit it)
-    return (serve_forked if fork else serve)(robots, config, ros_args, parameter_services=parameter_services)
+    return (serve_forked if fork else serve)(robots, config, ros_args, parameter_services=parameter_services,
+                                             plain_twist=plain_twist)
 
 
 if __name__ == "__main__":

@@ -61,3 +61,26 @@ def decode_twist(data: bytes) -> TwistData:
     except CATCH as exc:
         raise failure(TYPE_NAME, exc) from exc
     return TwistData(stamp_ns, linear, angular)
+
+
+PLAIN_TYPE_NAME = "geometry_msgs/msg/Twist"
+"""A robot's own computer (TurtleBot-class drivers): the bare velocity, no stamp, no frame."""
+
+_PLAIN = struct.Struct("<4s6d")
+
+
+def encode_plain_twist(linear: float, angular: float) -> bytes:
+    """geometry_msgs/msg/Twist: linear.x = `linear` [m/s], angular.z = `angular` [rad/s]."""
+    try:
+        return _PLAIN.pack(ENCAPSULATION, linear, 0.0, 0.0, 0.0, 0.0, angular)
+    except CATCH as exc:
+        raise failure(PLAIN_TYPE_NAME, exc) from exc
+
+
+def decode_plain_twist(data: bytes) -> tuple[float, float]:
+    """(linear.x, angular.z) of a geometry_msgs/msg/Twist, as sent (NaN and inf included)."""
+    try:
+        _, linear, _, _, _, _, angular = _PLAIN.unpack_from(data)
+    except CATCH as exc:
+        raise failure(PLAIN_TYPE_NAME, exc) from exc
+    return linear, angular

@@ -40,6 +40,8 @@ class RunTrace:
     """What each probe of the run's task observed (`swarm_sim.registry.Probe`), by name."""
     server_stale: dict[str, int] = field(default_factory=dict)
     """Lockstep ticks each server (by channel) did not acknowledge in time (graph runs)."""
+    commands: dict[str, dict] = field(default_factory=dict)
+    """Graph runs: per robot, what the network did to its commands (`swarm_sim.nodes.command_watch`)."""
     malformed: dict[str, int] = field(default_factory=dict)
     """Recorded messages that did not decode, by topic (skipped by the analysis)."""
     rejected: dict[str, dict[tuple[str, str], int]] = field(default_factory=dict)
@@ -148,6 +150,7 @@ def summarize(trace: RunTrace) -> dict[str, Any]:
         "stale_ticks": sum(s.stale_ticks for s in trace.stats.values()),
         "clamped_commands": sum(s.clamped_commands for s in trace.stats.values()),
         "server_stale_ticks": sum(trace.server_stale.values()),
+        "commands_by_robot": trace.commands,
         "malformed_messages": sum(trace.malformed.values()),
         "rejected_messages": rejected_messages(trace),
         "dead_nodes": [e.node for e in trace.down],

@@ -53,6 +53,7 @@ def load_run(path: Path | str) -> RunTrace:
         total_resources=scenario.resources.count, mode=meta.get("mode", "lockstep"), config=scenario,
     )
     trace.server_stale = _server_stale(path, str(meta.get("server_stale_ticks", "{}")))
+    trace.commands = _commands(path, str(meta.get("commands_by_robot", "{}")), trace.robots)
     algorithm = registry.of(scenario)
     servers = SeriesLog(algorithm.servers, trace.series)  # the servers' series, as the batch runner reads them
     server_topics = servers.topics
@@ -200,6 +201,23 @@ def _server_stale(path: Path, text: str) -> dict[str, int]:
     except ValueError:
         pass
     warnings.warn(f"{path}: ignoring malformed server_stale_ticks metadata {text[:80]!r}", MalformedMessageWarning,
+                  stacklevel=3)
+    return {}
+
+
+def _commands(path: Path, text: str, robots: tuple[str, ...]) -> dict[str, dict]:
+    """The bag's ``commands_by_robot`` metadata (`swarm_sim.nodes.command_watch`): {robot: {count:
+    int, "stops": [[ns, ns, ns], ...]}} for robots of the run; anything else is reported and ignored."""
+    try:
+        value = json.loads(text)
+        if isinstance(value, dict) and set(value) <= set(robots) and all(
+                isinstance(c, dict) and all(type(n) is int for k, n in c.items() if k != "stops")
+                and all(isinstance(s, list) and len(s) == 3 and all(type(t) is int for t in s)
+                        for s in c.get("stops", [])) for c in value.values()):
+            return value
+    except ValueError:
+        pass
+    warnings.warn(f"{path}: ignoring malformed commands_by_robot metadata {text[:80]!r}", MalformedMessageWarning,
                   stacklevel=3)
     return {}
 

@@ -19,6 +19,7 @@ from swarm_msgs_py import auth, topics
 from swarm_msgs_py.qos import EVENTS
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound
+from swarm_sim.nodes.endpoint import ack_wait, wait_acked
 from swarm_sim.nodes.world_recording import WorldRecording
 
 
@@ -30,6 +31,8 @@ class PeerRelay:
         """Peer topic -> publisher on ``heard(topic)``."""
         self._relayed: list[tuple[str, bytes]] = []
         """What arrived since the last tick went out, in order."""
+        self.ack_wait = ack_wait() if node.config.mode == "lockstep" else 0.0
+        """Lockstep: wall seconds `flush` waits for the robots to acknowledge what it relayed."""
         self.subscriptions = {}
         """Peer topic -> the world's subscription to it."""
         for topic, family in registry.peer_topics(algorithm).items():
@@ -55,4 +58,6 @@ class PeerRelay:
         if send:
             for topic, data in self._relayed:
                 self._relays[topic].publish(data)
+            if self._relayed:  # across lossy links: heard by every robot before the tick (`endpoint.wait_acked`)
+                wait_acked({self._relays[t] for t, _ in self._relayed}, self.ack_wait)
         self._relayed = []

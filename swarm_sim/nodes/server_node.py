@@ -44,7 +44,7 @@ from swarm_msgs_py.server_outputs import MARKER_ARRAY, StateWatch, outputs_of
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph
 from swarm_sim.inbound import Reason
-from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
+from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config, wait_acked
 from swarm_sim.protocol import Drawing, Lines, Server
 from swarm_sim.scenario import Scenario, load_scenario
 from swarm_sim.types import NS_PER_S, NodeDownEvent
@@ -144,6 +144,7 @@ class ServerNode(Node):
             self.lost = []
             self.endpoint.send(stamp, self.server.step(stamp, messages))
             self._publish_state(stamp)
+            wait_acked(self._state_pubs.values(), self.endpoint.ack_wait)  # across lossy links (`endpoint`)
             self.endpoint.report.publish(stamp, self.server)
             self._done = stamp
         if stamp == self._done:

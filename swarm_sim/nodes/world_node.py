@@ -47,6 +47,7 @@ from swarm_msgs_py.sensing import Sensing
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
+from swarm_sim.nodes.command_watch import CommandWatch
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.status_watch import StatusWatch
@@ -103,6 +104,10 @@ class WorldNodeConfig:
     -1: no live view), `swarm_sim.nodes.live_view`."""
     foxglove_host: str = "127.0.0.1"
     """Address the live view binds (loopback unless asked otherwise)."""
+    plain_twist: tuple[str, ...] = ()
+    """Realtime: robots whose commands come as plain ``geometry_msgs/Twist`` (a robot's own
+    computer on wall-clock time, TurtleBot-style: no stamp); a command's time is the tick it
+    arrived at."""
 
 
 class WorldNode(Node):
@@ -111,9 +116,13 @@ class WorldNode(Node):
         self.config = cfg = declare_config(self, WorldNodeConfig, config)
         if cfg.mode not in ("lockstep", "realtime"):
             raise ValueError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
+        if cfg.plain_twist and cfg.mode != "realtime":
+            raise ValueError("plain_twist: a plain Twist carries no tick, so only a realtime run can take it")
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
+        if unknown := set(cfg.plain_twist) - set(self.robots):
+            raise ValueError(f"plain_twist: no robot {sorted(unknown)[0]!r} in this run")
         self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers,
                                   self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node)
         """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
@@ -153,6 +162,10 @@ class WorldNode(Node):
                              for r, pubs in self._obs_pubs.items()}
         """Robot -> observation name -> (publisher, topic)."""
         self._commands: dict[RobotId, Command] = {}
+        realtime = cfg.mode == "realtime"
+        self.command_watch = CommandWatch(self.robots, self.scenario.dt_ns, self.scenario.ticks,
+                                          round(self.scenario.sim.command_timeout * NS_PER_S) if realtime else 0)
+        """Late, lost, re-sent commands per robot; realtime: the command timeout."""
         self._taken_cmd: dict[RobotId, bytes] = {}
         """Each robot's last command taken, as received (its repeats are not recorded again)."""
         self._sent: dict[RobotId, dict[str, bytes]] = {}
@@ -172,9 +185,10 @@ class WorldNode(Node):
         self._topic_of_cmd = {r: t for t, r in self._cmd_topic.items()}
         self._cmd_subs = {}
         for topic, robot in self._cmd_topic.items():
-            self.recording.add(topic, topics.type_string(topic))
+            type_name = twist.PLAIN_TYPE_NAME if robot in cfg.plain_twist else topics.type_string(topic)
+            self.recording.add(topic, type_name)
             self._cmd_subs[robot] = self.create_subscription(
-                topics.type_of(topic), topic, lambda data, r=robot: self._on_cmd(r, data),
+                topics.import_type(type_name), topic, lambda data, r=robot: self._on_cmd(r, data),
                 SENSOR_LOCKSTEP, raw=True,
             )
             self.watch.hear(topic, self._cmd_subs[robot].get_publisher_count)
@@ -245,7 +259,8 @@ class WorldNode(Node):
         answer again to a tick it has answered (the world re-sent the tick, `resend_period`, and
         the controller repeats its answer for each re-sent topic): the bag keeps one command per
         robot and tick, as the run used."""
-        decoded = self.inbound.decode(topic, twist.decode_twist, data, COMMAND_BYTES)
+        plain = robot in self.config.plain_twist
+        decoded = self.inbound.decode(topic, self._decode_plain if plain else twist.decode_twist, data, COMMAND_BYTES)
         if decoded is None:
             return False
         stamp_ns, linear, angular = decoded
@@ -262,13 +277,24 @@ class WorldNode(Node):
             late = 0 <= stamp_ns < self.world.t_ns and stamp_ns % self.world.dt_ns == 0
             if late:
                 self.barrier.heard(robot)  # slow, not dead
+                self.command_watch.taken(robot, stamp_ns, self.world.t_ns)
             self.inbound.reject(topic, Reason.LATE if late else Reason.WRONG_TICK,
                                 f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
+            return False
+        if stamp_ns > self.world.t_ns:  # realtime: no robot can answer a tick not yet published
+            self.inbound.reject(topic, Reason.WRONG_TICK, f"stamped {stamp_ns} ns at tick {self.world.t_ns} ns")
+            return False
+        if not self.command_watch.taken(robot, stamp_ns, self.world.t_ns):  # overtaken by a newer one
+            self.inbound.reject(topic, Reason.LATE, f"stamped {stamp_ns} ns, older than the command held")
             return False
         self._commands[robot] = Command(linear, angular)
         self._taken_cmd[robot] = data
         self.barrier.answered(robot, stamp_ns)
         return True
+
+    def _decode_plain(self, data: bytes) -> tuple[int, float, float]:
+        """A plain Twist as (the tick it arrived at, linear, angular)."""
+        return (self.world.t_ns, *twist.decode_plain_twist(data))
 
     def _on_ack(self, data: bytes) -> None:
         refused = self.rejections.total
@@ -293,8 +319,10 @@ class WorldNode(Node):
             self.barrier.answered(channel, stamp_ns)
 
     def commands(self) -> dict[RobotId, Command]:
-        """The last command of every robot that has sent one, in robot order."""
-        return {r: self._commands[r] for r in self.robots if r in self._commands}
+        """The last command of every robot that has sent one, in robot order (realtime: a robot
+        whose newest command is older than ``sim.command_timeout`` stopped, `CommandWatch`)."""
+        held = {r: self._commands[r] for r in self.robots if r in self._commands}
+        return self.command_watch.fresh(held, self.world.t_ns)
 
     def close_tick(self, stamp: int) -> None:
         """Lockstep: tick `stamp` is over; count who was stale and declare who is dead."""
@@ -411,6 +439,7 @@ class WorldNode(Node):
         """Tick `stamp` again to those of `waiting` (robots: their observations; servers: the clock)."""
         for r in waiting:
             if r in self._sent:
+                self.command_watch.resent[r] += 1
                 for name, data in self._sent[r].items():
                     self._obs_pubs[r][name].publish(data)
             else:  # a server: it answers a repeated /clock with its ack
@@ -430,6 +459,8 @@ class WorldNode(Node):
             ended=self.ended,
             dead_nodes=json.dumps([e.node for e in self.down]),
             foreign_publishers=json.dumps(self.foreign),
+            commands_by_robot=json.dumps(self.command_watch.counts(
+                {r: s.stale_ticks for r, s in self.world.stats.items()})),
         )
         self.world.close()
 
@@ -445,6 +476,10 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
                              "step at --real-time-factor with the commands that arrived")
     parser.add_argument("--tick-timeout", type=number(float, 0, 3600, open_low=True), default=WorldNodeConfig.tick_timeout,
                         help=f"lockstep: wall seconds to wait for a tick's answers (default {WorldNodeConfig.tick_timeout:g})")
+    parser.add_argument("--resend-period", type=number(float, 0, 3600, open_low=True),
+                        default=WorldNodeConfig.resend_period,
+                        help="lockstep: wall seconds after which a tick is sent again to the nodes that have not "
+                             f"answered (default {WorldNodeConfig.resend_period:g}; a few round trips on a lossy link)")
     parser.add_argument("--real-time-factor", type=number(float, 0, 1e6, open_low=True), default=1.0,
                         help="realtime: target sim seconds per wall second (default 1)")
     parser.add_argument("--pace", type=number(float, 0, 1e6, open_low=True),
@@ -454,11 +489,15 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
                         help="serve the run over the Foxglove WebSocket protocol (0: any free port)")
     parser.add_argument("--foxglove-host", default=WorldNodeConfig.foxglove_host,
                         help=f"address the live view binds (default {WorldNodeConfig.foxglove_host})")
+    parser.add_argument("--plain-twist", nargs="+", default=[], metavar="ROBOT",
+                        help="realtime: these robots' commands come as plain geometry_msgs/Twist (a robot's own "
+                             "computer on wall-clock time); each counts from the tick it arrives at")
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
         foxglove_port=args.foxglove, foxglove_host=args.foxglove_host, pace=args.pace or 0.0,
+        resend_period=args.resend_period, plain_twist=tuple(args.plain_twist),
     )
     return config, ros_args
 

@@ -46,6 +46,11 @@ class SimConfig:
     the caging robots once the object is delivered): the batch runner after that tick, the world
     node once every live robot's status says so (at that tick, or the next at the latest); the
     run's ``sim_seconds`` then says when, and its ``run_ended`` is ``finished``."""
+    command_timeout: float = 0.5
+    """Realtime mode: a robot whose newest command answers a tick more than this long before the
+    current one [s of sim time] is stopped until a fresh one arrives, as a real robot's driver
+    stops after its command timeout (diff_drive_controller's ``cmd_vel_timeout``, default 0.5 s);
+    0: never (the robot keeps its last command). Lockstep waits for every command instead."""
 
 
 @dataclass(frozen=True)

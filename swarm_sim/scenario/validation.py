@@ -69,6 +69,8 @@ def check_world(s: Scenario) -> None:
              f"sim.physics_substeps: must be between 1 and {MAX_SUBSTEPS}")
     _require(s.sim.duration >= s.sim.dt, "sim.duration: must be at least one tick (sim.dt)")
     _require(s.sim.duration <= MAX_DURATION, f"sim.duration: at most {MAX_DURATION:g} s of sim time")
+    _require(0.0 <= s.sim.command_timeout <= MAX_DURATION, "sim.command_timeout: must be between 0 (never) and "
+             f"{MAX_DURATION:g} s")
     _require(s.seed >= 0, "seed: must not be negative")
     _require(s.name == "" or NAME.fullmatch(s.name) is not None,
              f"name: {s.name[:40]!r} is not a plain name (letters, digits, _ . + -; it names the bag directory)")

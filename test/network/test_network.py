@@ -1,0 +1,124 @@
+"""The graph across hosts (issue 26): network namespaces stand in for the machines (`netns`).
+
+Host ``world`` runs swarm-run bound to its address (the world, its discovery server, any
+servers), ``hosta`` and ``hostb`` the controllers (even and odd robots) from the commands swarm-run
+prints, ``cli`` a stand-in for a stock ``ros2 topic echo``. Every test checks, while the run goes,
+that each host's sockets are bound to that host's address only. Skipped without root.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+
+import numpy as np
+import pytest
+from multihost import MultiHostRun, batch_differences, flags, robots_of
+from netns import Testbed, available, leftovers
+
+from swarm_sim.analysis.replay import load_odometry
+
+MDBSA = ("mdbsa_d", [])
+"""The spiral paper's MDBSA-D (8 x 8 m): robots and its center exchange messages every few ticks."""
+LOSSY = {"loss": 0.05, "delay": 0.020, "jitter": 0.010}
+"""Both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay (`netns.Testbed.netem`)."""
+
+
+@pytest.fixture
+def testbed(request):
+    """The four hosts; ``@pytest.mark.parametrize("testbed", [True], indirect=True)``: shaped links."""
+    why = available()
+    if why is not None:
+        pytest.skip(f"no network namespaces here: {why}")
+    bed = Testbed(("world", "hosta", "hostb", "cli"), shaped=getattr(request, "param", False))
+    try:
+        yield bed
+    finally:
+        bed.close()
+        assert leftovers() == []
+
+
+shaped = pytest.mark.parametrize("testbed", [True], indirect=True, ids=["shaped"])
+
+
+def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_path):
+    robots, duration, seed = 8, 30.0, 11
+    # At most 4x real time (it only adds waits): time for the echo to start and discover, on a busy machine.
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed), "--tick-timeout", "20",
+                       "--real-time-factor", "4")
+    echo = run.echo("/robot_1/cmd_vel", 5, 60)  # robot_1's controller is on hostb
+    run.wait_sim(duration / 2, 90)
+    run.note_sockets()
+    graph = run.finish(120)
+    out, _ = echo.communicate(timeout=30)
+    heard = json.loads(out.strip().splitlines()[-1])
+    assert heard["type"] == "geometry_msgs/msg/TwistStamped", heard
+    assert heard["publishers"] == ["/robot_1/controller"]
+    assert len(heard["stamps"]) >= 5 and out.count("linear:") >= 5
+
+    assert run.foreign_sockets() == []
+    for host in ("world", "hosta", "hostb", "cli"):
+        assert run.sockets[host], f"no socket seen on {host}"
+    assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
+    assert set(graph["by_host"]) == {"hosta", "hostb"}
+    assert graph["by_host"]["hosta"]["robots"] == 4
+    assert batch_differences(run.bag, graph, robots, duration, seed) == []
+    assert graph["resources_delivered"] > 0
+
+
+@shaped
+def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
+    """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
+    mid-run, with a server (MDBSA-D's center) and its protocol: the barrier re-sends unanswered
+    ticks and every node waits for its reliable messages to be acknowledged before answering a
+    tick, so the run is the batch run of its seed."""
+    robots, duration, seed = 8, 15.0, 11
+    for host in robots_of(robots):
+        testbed.netem(host, **LOSSY)
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *MDBSA), "--tick-timeout", "20",
+                       "--resend-period", "0.1")
+    run.wait_sim(duration / 3, 120)
+    cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
+    cut.start()
+    while cut.is_alive():
+        run.note_sockets()
+        cut.join(0.5)
+    graph = run.finish(240)
+    assert run.foreign_sockets() == []
+    assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
+    assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
+    assert batch_differences(run.bag, graph, robots, duration, seed, *MDBSA) == []  # ... and recovered from
+
+
+@shaped
+def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
+    """Realtime at 1x over lossy links, hostb cut off for 3 s: its robots are stopped once their
+    newest command is older than sim.command_timeout (0.5 s), hosta's drive on, the run completes,
+    and the summary counts per host."""
+    robots, duration, timeout = 8, 14.0, 0.5
+    for host in robots_of(robots):
+        testbed.netem(host, **LOSSY)
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, 3), "--mode", "realtime",
+                       "--real-time-factor", "1", "--set", f"sim.command_timeout={timeout}")
+    run.wait_sim(5.0, 120)
+    testbed.partition("hostb", 3.0)
+    graph = run.finish(120)
+    assert run.foreign_sockets() == []
+    assert graph["run_ended"] == "complete" and graph["mode"] == "realtime"
+    cut, kept = robots_of(robots)["hostb"], robots_of(robots)["hosta"]
+    commands = graph["commands_by_robot"]
+    odom = load_odometry(run.bag)
+    dt = 0.1
+    for robot in cut:
+        stops = [(last / 1e9, at / 1e9, (end if end >= 0 else duration * 1e9) / 1e9)
+                 for last, at, end in commands[robot]["stops"]]
+        assert all(at - last <= timeout + dt + 1e-9 for last, at, _ in stops), stops  # stopped in time
+        last, at, end = max(stops, key=lambda s: s[2] - s[1])  # the partition's stop
+        assert end - at >= 3.0 - timeout - 1.0, stops  # a 3 s cut, less the timeout and the links' delay
+        # The world really stood it still: its odometry does not move from the tick after the stop
+        # until it drives again.
+        rows = odom[robot]
+        still = rows[(rows[:, 0] > at + 1e-9) & (rows[:, 0] < end - 1e-9)]
+        assert len(still) >= 10 and np.allclose(np.diff(still[:, 1:], axis=0), 0.0, atol=1e-6), (robot, still)
+    assert graph["by_host"]["hostb"]["stopped"] >= len(cut)
+    assert sum(commands[r]["stopped_ticks"] for r in kept) < sum(commands[r]["stopped_ticks"] for r in cut)
