@@ -257,10 +257,10 @@ def main(argv: list[str] | None = None) -> int:
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
-    local = with_shared_memory if args.shared_memory else (lambda profile: profile)
+    transport = with_shared_memory if args.shared_memory else (lambda profile: profile)
 
     def profile_env(base: dict[str, str], name: str, profile: str) -> dict[str, str]:
-        (profiles / name).write_text(local(profile), encoding="utf-8")
+        (profiles / name).write_text(transport(profile), encoding="utf-8")
         return {**base, "FASTRTPS_DEFAULT_PROFILES_FILE": str(profiles / name),
                 "FASTDDS_DEFAULT_PROFILES_FILE": str(profiles / name)}
 
