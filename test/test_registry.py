@@ -5,8 +5,6 @@ runs like a shipped paper (its graph == batch check is in test_conformance)."""
 
 from __future__ import annotations
 
-import json
-import os
 import subprocess
 import sys
 from pathlib import Path

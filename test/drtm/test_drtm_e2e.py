@@ -9,7 +9,6 @@ import yaml
 from graph_helpers import overrides, run_graph
 from swarm_controllers.drtm.codec import NEST, NEST_REPORTS, NEST_STATE
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
-from swarm_msgs_py import topics
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.recording import bag_info, read_bag
