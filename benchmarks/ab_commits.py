@@ -68,8 +68,9 @@ def checkout(rev: str, into: Path) -> Path:
 def batch_run(tree: Path, spec: str) -> dict:
     name, robots, duration, *arena = spec.split(":")
     out = subprocess.run([sys.executable, "-c", _BATCH_CHILD, name, robots, duration, arena[0] if arena else ""],
-                         cwd=tree, env={**os.environ, "PYTHONPATH": str(tree)}, capture_output=True, text=True,
-                         check=True)
+                         cwd=tree, env={**os.environ, "PYTHONPATH": str(tree)}, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise SystemExit(f"batch run in {tree} exited {out.returncode}: {out.stderr.strip().splitlines()[-1:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
