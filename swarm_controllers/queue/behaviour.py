@@ -87,6 +87,11 @@ BRAKE_RANGE = 0.08
 not trigger it."""
 BRAKE_CONE = math.radians(25.0)
 """Half-angle of the braking cone about the heading [rad]."""
+PATH_CONE = 30.0
+"""[deg] a robot on a queue's path stops for what its proximity ring reads within this angle of its
+heading, on a robot model with a path rule of its own (`swarm_controllers.motion.Drive.path_stop`):
+the queue authors' ``GoStraightAngleRangeInDegreesInRegion`` (Artglz and Tameem786/
+Collision_Free_CPFA, ``CPFA_controller::CollisionDetection``)."""
 BRAKE_PATIENCE = 3.0
 """A robot braked this long [s] swerves round what blocks it (two robots braking face to face,
 e.g. one pushed off its line, would otherwise wait for each other forever)."""
@@ -101,8 +106,8 @@ class Phase(Enum):
     LEAVING = "leaving"
 
 
-_FORAGING, _TO_ENTRY, _SEEKING, _JOINING, _QUEUED = (
-    Phase.FORAGING, Phase.TO_ENTRY, Phase.SEEKING, Phase.JOINING, Phase.QUEUED
+_FORAGING, _TO_ENTRY, _SEEKING, _JOINING, _QUEUED, _LEAVING = (
+    Phase.FORAGING, Phase.TO_ENTRY, Phase.SEEKING, Phase.JOINING, Phase.QUEUED, Phase.LEAVING
 )
 """The phases every tick compares against, as module constants (a member looked up on its Enum
 class costs ~0.1 us in Python 3.11; see `swarm_controllers.cpfa.behaviour`)."""
@@ -244,7 +249,11 @@ class QueueBehaviour:
             linear, angular = self._leaving(obs, r)
             if self._phase is _FORAGING:
                 return self._forage(obs, r, out)
-        if phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= BRAKE_PATIENCE:
+        stop = self._drive.path_stop(obs.ranges, PATH_CONE) if phase is _QUEUED or phase is _LEAVING else None
+        if stop is not None:  # the robot model's own rule on a path (the authors' foot-bot: stop, never swerve)
+            if stop:
+                linear = angular = 0.0
+        elif phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= BRAKE_PATIENCE:
             override = self._avoid.update(obs.ranges)
             if override is not None:
                 linear, angular = override.linear, override.angular
