@@ -436,7 +436,7 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
     )
     found = {**comparisons(), "toy": toy}
     runner = FakeRunner()
-    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
+    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path), "--robot-model", "generic"]
     assert main(argv, run=runner, comparisons=found) == 0
     assert {c[0] for c in runner.calls} == {s for c in found.values() for s in c.strategies}
     assert all(c[2]["sim__duration"] == 5 for c in runner.calls if c[2])  # the toy plans set no fields
@@ -454,6 +454,27 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
     # a finished reproduction resumes to nothing new
     again = FakeRunner()
     assert main([*argv, "--resume"], run=again, comparisons=found) == 0 and again.calls == []
+
+
+def test_all_without_a_robot_model_runs_both_and_puts_the_claims_side_by_side(tmp_path):
+    """`swarm-compare all` on the authors' robots (OUT/authors/) and today's (OUT/generic/): one row
+    per claim with both results, a count per model, and OUT/CAUSES.md included."""
+    found = {"queue": comparisons()["queue"]}
+    (tmp_path / "CAUSES.md").write_text("# Why claims do not hold\n\nmeasured: the motion rule\n")
+    runner = FakeRunner()
+    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
+    assert main(argv, run=runner, comparisons=found) == 0
+    models = {next((o for o in c[1] if o.startswith("robots.model=")), None) for c in runner.calls}
+    assert models == {"robots.model=footbot_cpfa", "robots.model=generic"}  # queue runs on the foot-bot
+    for model in ("authors", "generic"):
+        assert (tmp_path / model / "queue" / "table.md").exists()
+    report = (tmp_path / "REPORT.md").read_text()
+    assert "| # | sweep | claim | paper | ours (authors' robots) | holds (authors' robots) | ours (generic robot) |" in report
+    row = next(line for line in report.splitlines() if "| Q_MT collects the most resources of all strategies |" in line)
+    assert row.startswith("| 1 | queue |") and row.count("|") == 9
+    assert "authors' robots: " in report and "generic robot: " in report and "claims hold" in report
+    assert "## Why claims do not hold" in report and "measured: the motion rule" in report
+    assert "![collected](authors/queue/collected.png)" in report and "![collected](generic/queue/collected.png)" in report
 
 
 def test_headlines_follow_the_means_and_the_tests():

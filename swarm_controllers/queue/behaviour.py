@@ -122,14 +122,15 @@ def _granted(messages: tuple[object, ...]) -> frozenset[str]:
 @lru_cache(maxsize=8)
 def _queues(
     geometry: DepotGeometryConfig, kind: str
-) -> tuple[QueueLayout, dict[str, np.ndarray], dict[str, list[tuple[float, float]]]]:
-    """The layout and every line's slots, computed once per process (the manager's cells), also
-    as (x, y) float pairs: a queued robot looks one or two up every tick, and a row of an array
-    unpacked into numpy scalars and computed with cost ~0.5 us more (measured)."""
+) -> tuple[QueueLayout, dict[str, np.ndarray], dict[str, list[tuple[float, float]]], frozenset[tuple[str, int]]]:
+    """The layout, every line's slots and the docks' slots, computed once per process (the manager's
+    cells), the slots also as (x, y) float pairs: a queued robot looks one or two up every tick,
+    and a row of an array unpacked into numpy scalars and computed with cost ~0.5 us more (measured)."""
     layout = make_layout(kind, geometry)
     admission = DepotAdmission(layout)
     cells = {line: admission.cells(line) for line in admission.lines()}
-    return layout, cells, {line: [tuple(xy) for xy in points.tolist()] for line, points in cells.items()}
+    slots = {line: [tuple(xy) for xy in points.tolist()] for line, points in cells.items()}
+    return layout, cells, slots, admission.dock_slots()
 
 
 class QueueBehaviour:
@@ -138,7 +139,7 @@ class QueueBehaviour:
     # Slots, not a __dict__: see `CpfaBehaviour`.
     __slots__ = (
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
-        "_center", "_cpfa", "_cpfa_step", "_entry", "_entry_angles", "_entry_lines",
+        "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
         "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
@@ -164,7 +165,8 @@ class QueueBehaviour:
         self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, drive=self._drive)
         self._cpfa_step = self._cpfa.step
         self._avoid = self._drive.avoidance(0.1)
-        self._layout, self._cells, self._slots = _queues(DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
+        self._layout, self._cells, self._slots, self._docks = _queues(
+            DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
         self._entry_lines = tuple(line.name for line in self._layout.entry_lines)
         self._entry_angles = np.array(
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
@@ -235,7 +237,7 @@ class QueueBehaviour:
                 return self._forage(obs, r, out)
             self._begin_delivery(obs, r, out)
             phase = self._phase
-        if dropped and phase is _QUEUED:
+        if dropped and phase is _QUEUED and (self._line, self._cell) in self._docks:
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, self._line, self._cell))
         if phase is _TO_ENTRY:
             linear, angular = self._to_entry(obs, r, out)
@@ -249,16 +251,15 @@ class QueueBehaviour:
             linear, angular = self._leaving(obs, r)
             if self._phase is _FORAGING:
                 return self._forage(obs, r, out)
-        stop = self._drive.path_stop(obs.ranges, PATH_CONE) if phase is _QUEUED or phase is _LEAVING else None
-        if stop is not None:  # the robot model's own rule on a path (the authors' foot-bot: stop, never swerve)
-            if stop:
-                linear = angular = 0.0
-        elif phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= BRAKE_PATIENCE:
+        if phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= BRAKE_PATIENCE:
             override = self._avoid.update(obs.ranges)
             if override is not None:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
                 self._braked_since = math.inf  # swerved for a second: try the line again
+        elif (phase is _QUEUED or phase is _LEAVING) and self._drive.path_stop(obs.ranges, PATH_CONE):
+            linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())
+            self._braked_since = min(self._braked_since, obs.t)
         elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:
             linear = 0.0
             self._braked_since = min(self._braked_since, obs.t)
@@ -451,6 +452,10 @@ class QueueBehaviour:
         if math.hypot(tx - x, ty - y) <= SLOT_TOLERANCE:
             self._line, self._cell = line, cell
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.AT, line, cell))
+            if not self._carrying and (line, cell) in self._docks:
+                # Its resource was dropped on the way (it stood in a dock's zone for T_unload): there
+                # is nothing left to unload, so its dock is done with it (else the dock waits forever).
+                out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, line, cell))
             if line in self._exit_lines and cell == len(self._cells[line]) - 1:
                 cx, cy = self._center
                 r = math.hypot(x - cx, y - cy)
