@@ -529,3 +529,24 @@ def test_reports_of_runs_cut_by_duration_say_so(tmp_path):
     assert main([*argv, "--overwrite", "--duration", "60"], run=FakeRunner()) == 0
     for name in ("table.md", "ttests.md"):
         assert (tmp_path / name).read_text().startswith("> **Runs cut short**: every run here was limited to 60 s")
+
+
+def test_factor_tables_put_each_factor_beside_the_baseline(tmp_path):
+    """`python -m swarm_sim.compare.factors ROOT`: per group, per headline measure, a row per factor
+    (the baseline first) and a column per strategy and cell."""
+    from swarm_sim.compare.factors import main as factors_main
+
+    group = tmp_path / "queue48"
+    for factor, values in (("turn_fast", [50.0, 54.0]), ("baseline", [30.0, 34.0])):
+        (group / factor).mkdir(parents=True)
+        rows = [{"strategy": "queue_qmt", "cell": 48, "seed": i, "resources_collected_pct": v}
+                for i, v in enumerate(values)]
+        (group / factor / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (group / "README").write_text("- `turn_fast`: a faster turn")
+    assert factors_main([str(tmp_path)]) == 0
+    text = (tmp_path / "FACTORS.md").read_text()
+    assert "## queue48" in text and "- `turn_fast`: a faster turn" in text
+    table = text[text.index("(`resources_collected_pct`)"):].splitlines()
+    assert table[2] == "| factor | queue_qmt 48 |"
+    assert table[4:6] == ["| baseline | 32.00 ± 2.83 (2) |", "| turn_fast | 52.00 ± 2.83 (2) |"]
+    assert factors_main([str(tmp_path / "nothing")]) == 2
