@@ -475,6 +475,11 @@ def test_all_without_a_robot_model_runs_both_and_puts_the_claims_side_by_side(tm
     assert "authors' robots: " in report and "generic robot: " in report and "claims hold" in report
     assert "## Why claims do not hold" in report and "measured: the motion rule" in report
     assert "![collected](authors/queue/collected.png)" in report and "![collected](generic/queue/collected.png)" in report
+    again = FakeRunner()  # the report alone, from what the results hold: nothing runs
+    assert main(["all", "--report-only", "--seeds", "1", "--duration", "5", "--out", str(tmp_path)], run=again,
+                comparisons=found) == 0
+    assert again.calls == [] and "`swarm-compare all --report-only" in (tmp_path / "REPORT.md").read_text()
+    assert "(n=2)" in (tmp_path / "authors" / "queue" / "table.md").read_text()  # both seeds held, though --seeds 1
 
 
 def test_headlines_follow_the_means_and_the_tests():

@@ -68,6 +68,8 @@ def sweep_argv(name: str, options: Sequence[str], args: argparse.Namespace, out:
         argv.append("--resume")
     if args.overwrite:
         argv.append("--overwrite")
+    if getattr(args, "report_only", False):
+        argv.append("--report-only")
     return argv
 
 
@@ -142,17 +144,20 @@ def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.N
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     models = list(by_model)
-    command = f"swarm-compare all --seeds {args.seeds} --out {out}"
+    report_only = getattr(args, "report_only", False)
+    command = f"swarm-compare all --report-only --out {out}" if report_only else \
+        f"swarm-compare all --seeds {args.seeds} --out {out}"
     if args.duration is not None:
         command += f" --duration {args.duration:g}"
     command += "".join(f" --set {s}" for s in args.overrides)
     if getattr(args, "robot_model", None):
         command += f" --robot-model {args.robot_model}"
     lines = ["# The papers' results, reproduced", "",
-             f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, seeds "
-             f"0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held: each "
-             "section gives its run count). Every number labelled *paper* is the paper's, hard-coded from its "
-             "text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
+             f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, "
+             + ("every run each sweep's results file holds, whatever its seeds" if report_only else
+                f"seeds 0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held")
+             + ": each section gives its run count). Every number labelled *paper* is the paper's, hard-coded from "
+             "its text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
     if len(models) > 1:
         lines += ["Every sweep ran on two robot models (`swarm_sim.robots`, README *Robot models*): "
                   + "; ".join(f"*{MODEL_TITLES.get(m, m)}* (`--robot-model {m}`, in `{m}/`)" for m in models)
