@@ -39,10 +39,12 @@ Phases of a delivery, and the choices the paper leaves open:
 * **Queued**. The robot drives slot to slot along its route (entry line, then for the single
   queue the inner queue the manager dispatched it to, then the exit line), reporting every slot
   it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
-  take it into a neighbouring lane); it only brakes when something is right in front, and
+  take it into a neighbouring lane); it only brakes when something is right in front (on a robot
+  model with a path rule of its own, the authors' foot-bot, that rule: `PATH_CONE`), and
   swerves round it only after `BRAKE_PATIENCE` (a deadlock breaker). At the
   dock it waits for the world to drop its resource (T_unload), reports ``unloaded``, and goes
-  on as granted. At the last exit slot (on the perimeter) it reports that slot and drives out
+  on as granted (a robot whose resource was dropped on the way, in a dock's zone it stood in for
+  T_unload, reports ``unloaded`` on reaching its dock). At the last exit slot (on the perimeter) it reports that slot and drives out
   radially, then forages again.
 """
 

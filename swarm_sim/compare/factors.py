@@ -2,8 +2,8 @@
 
 A factor sweep is an ordinary ``swarm-compare <comparison>`` run into its own directory,
 ``ROOT/<group>/<factor>/`` (``scripts/factors`` lists them: a baseline on the authors' robots and
-sweeps that each change one factor: the motion rule, body size, speed, turn rate, dock distance,
-sensor range, a rule's reading). This module reads their ``results.jsonl`` and writes, per group and
+sweeps that each change one factor of it, e.g. the motion rule, the body size, the turn rate or
+the reading of a rule). This module reads their ``results.jsonl`` and writes, per group and
 per measure the algorithms declare as their headline (`swarm_sim.registry.Algorithm.headline`), one
 table: a row per factor, a column per strategy and cell, mean ± std (n). Nothing here knows a paper.
 
