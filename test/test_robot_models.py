@@ -363,6 +363,10 @@ def test_every_algorithm_names_its_authors_robot_and_the_comparisons_can_run_on_
         ("robots.count=4", "robots.model=footbot_foraging", "robots.count=5"),
         ("robots.count=4", "robots.model=khepera3", "robots.count=5"),
     ]
+    args.overrides = ["robots.platform.diameter=0.07"]  # one platform value varied on the authors' robots
+    assert plans_of(_Fake, args, ["drtm"])[0].overrides[1:] == (
+        "robots.model=footbot_foraging", "robots.platform.diameter=0.07")
+    args.overrides = ["robots.count=5"]
     args.robot_model = "khepera3"
     assert {p.overrides[1] for p in plans_of(_Fake, args, ["queue_qmt", "drtm"])} == {"robots.model=khepera3"}
     parser = build_parser({})

@@ -90,7 +90,9 @@ def plans_of(comparison: Comparison, args: argparse.Namespace, strategies: list[
     for plan in plans:
         name = model
         if model == AUTHORS:
-            scenario = load_scenario(plan.strategy, plan.overrides, **dict(plan.fields))
+            # The algorithm decides the model; `robots.platform` values apply only once it is chosen.
+            known = [o for o in plan.overrides if not o.startswith("robots.platform.")]
+            scenario = load_scenario(plan.strategy, known, **dict(plan.fields))
             name = registry.of(scenario).authors_robot
         given = tuple(o for o in plan.overrides if o not in args.overrides)
         out.append(dataclasses.replace(plan, overrides=(*given, f"robots.model={name}", *args.overrides)))
@@ -107,7 +109,11 @@ def held_rows(plans: list[RunPlan], path: Path) -> list[dict]:
 def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies: list[str], *,
                    run: RunFunction | None, executor: Executor) -> tuple[int, list[Path]]:
     """One comparison's sweep then its report: (exit status, files written)."""
-    plans = plans_of(comparison, args, strategies)
+    try:
+        plans = plans_of(comparison, args, strategies)
+    except ScenarioError as exc:
+        print(f"swarm-compare: {exc}", file=sys.stderr)
+        return 2, []
     out = comparison.out_dir(args)
     if run is None:
         for plan in plans:
