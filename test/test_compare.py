@@ -555,3 +555,17 @@ def test_factor_tables_put_each_factor_beside_the_baseline(tmp_path):
     assert table[2] == "| factor | queue_qmt 48 |"
     assert table[4:6] == ["| baseline | 32.00 ± 2.83 (2) |", "| turn_fast | 52.00 ± 2.83 (2) |"]
     assert factors_main([str(tmp_path / "nothing")]) == 2
+
+
+def test_a_rank_test_that_cannot_reach_significance_tells_nothing():
+    """Two-sided Mann-Whitney U on 3 runs against 3 cannot give p < 0.05 (its smallest p is 0.1), so
+    a spiral claim of a difference is not "no" and one of similarity is not "yes" at 3 seeds."""
+    from swarm_controllers.spiral.comparison import spiral_headlines
+    from swarm_sim.compare.stats import u_can_reject
+
+    assert not u_can_reject(3, 3) and u_can_reject(4, 4) and not u_can_reject(0, 9) and u_can_reject(3, 6)
+    assert pair_test([1.0, 2.0, 3.0], [7.0, 8.0, 9.0], "u")[1] == pytest.approx(0.1)
+    few = (rows_for("ddsa", None, [10, 11, 12], SPIRAL_KEYS) + rows_for("mdbsa_c", 4, [10, 12, 11], SPIRAL_KEYS)
+           + rows_for("mdbsa_d", 4, [20, 21, 22], SPIRAL_KEYS))
+    claims = spiral_headlines(few, 1, [4], SPIRAL_STRATEGIES)
+    assert {h.holds for h in claims if "4:" in h.ours} == {None}
