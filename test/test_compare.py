@@ -554,6 +554,11 @@ def test_factor_tables_put_each_factor_beside_the_baseline(tmp_path):
     table = text[text.index("(`resources_collected_pct`)"):].splitlines()
     assert table[2] == "| factor | queue_qmt 48 |"
     assert table[4:6] == ["| baseline | 32.00 ± 2.83 (2) |", "| turn_fast | 52.00 ± 2.83 (2) |"]
+    extra = {"strategy": "queue_qmt", "cell": 48, "seed": 2, "resources_collected_pct": 90.0}
+    with (group / "baseline" / "results.jsonl").open("a") as f:  # a seed the other factor did not run
+        f.write(json.dumps(extra) + "\n")
+    assert factors_main([str(tmp_path)]) == 0
+    assert "| baseline | 32.00 ± 2.83 (2) |" in (tmp_path / "FACTORS.md").read_text()  # compared on common seeds
     assert factors_main([str(tmp_path / "nothing")]) == 2
 
 

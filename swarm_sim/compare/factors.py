@@ -6,7 +6,8 @@ A factor sweep is an ordinary ``swarm-compare <comparison>`` run into its own di
 sweeps that each change one factor of it, e.g. the motion rule, the body size, the turn rate or
 the reading of a rule). This module reads their ``results.jsonl`` and writes, per group and
 per measure the algorithms declare as their headline (`swarm_sim.registry.Algorithm.headline`), one
-table: a row per factor, a column per strategy and cell, mean ± std (n). Nothing here knows a paper.
+table: a row per factor, a column per strategy and cell, mean ± std (n), over the seeds every
+factor of the group ran. Nothing here knows a paper.
 
     python -m swarm_sim.compare.factors ROOT
 """
@@ -58,9 +59,12 @@ def group_tables(group: Path) -> list[str]:
     factors = sorted((d for d in group.iterdir() if d.is_dir() and any(d.rglob(RESULTS))),
                      key=lambda d: (d.name != BASELINE, d.name))
     rows = {d.name: [r for path in sorted(d.rglob(RESULTS)) for r in read_results(path)] for d in factors}
+    # Only the seeds every factor ran: a seed's layout moves a cell's mean more than some factors do.
+    seeds = set.intersection(*({r.get("seed") for r in rs} for rs in rows.values())) if rows else set()
+    rows = {name: [r for r in rs if r.get("seed") in seeds] for name, rs in rows.items()}
     keys = sorted({(r["strategy"], r.get("cell")) for rs in rows.values() for r in rs},
                   key=lambda k: (k[0], -1 if k[1] is None else k[1]))
-    lines = [f"## {group.name}", ""]
+    lines = [f"## {group.name}", "", f"Seeds every factor ran (the only ones counted): {sorted(seeds)}.", ""]
     note = group / "README"
     if note.is_file():
         lines += [note.read_text().strip(), ""]
