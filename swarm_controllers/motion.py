@@ -10,7 +10,10 @@ behaviour gets its robot's `Drive` from `drive_for` and asks it for
 - ``avoidance(escape_distance, keep_right=...)``: the robot's collision avoidance, with priority
   over the behaviour's motion (`swarm_controllers.avoidance.AvoidThenEscape`'s interface);
 - ``begin(stamp_ns)``, once at the start of every tick (models with a state of their own advance
-  it once a tick, whatever the behaviour asks in between).
+  it once a tick, whatever the behaviour asks in between);
+- ``path_stop(ranges, cone)``: the model's own rule for a robot that keeps to a path (a queue
+  lane): True when it stopped for something within `cone` [deg] ahead, False when nothing stopped
+  it, None when the model has no such rule (the behaviour keeps its own).
 
 The models' drives: `ContinuousDrive` (the generic robot and the Khepera III: steered continuously,
 re-aimed every tick, `steer`), `swarm_controllers.robots.stop_turn_go.StopTurnGo` (the CPFA
@@ -151,6 +154,8 @@ class Drive(Protocol):
 
     def avoidance(self, escape_distance: float, *, keep_right: bool = False) -> Avoidance: ...
 
+    def path_stop(self, ranges: np.ndarray, cone: float) -> bool | None: ...
+
 
 class ContinuousDrive:
     """The generic robot's motion (and the Khepera III's): `go_to_point_twist` and `steer` within
@@ -174,6 +179,9 @@ class ContinuousDrive:
 
     def avoidance(self, escape_distance: float, *, keep_right: bool = False) -> AvoidThenEscape:
         return AvoidThenEscape(self.scenario, escape_distance, keep_right=keep_right)
+
+    def path_stop(self, ranges: np.ndarray, cone: float) -> None:
+        return None
 
 
 def drive_for(scenario: Scenario, rng: np.random.Generator | None = None) -> Drive:

@@ -436,7 +436,7 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
     )
     found = {**comparisons(), "toy": toy}
     runner = FakeRunner()
-    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
+    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path), "--robot-model", "generic"]
     assert main(argv, run=runner, comparisons=found) == 0
     assert {c[0] for c in runner.calls} == {s for c in found.values() for s in c.strategies}
     assert all(c[2]["sim__duration"] == 5 for c in runner.calls if c[2])  # the toy plans set no fields
@@ -454,6 +454,32 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
     # a finished reproduction resumes to nothing new
     again = FakeRunner()
     assert main([*argv, "--resume"], run=again, comparisons=found) == 0 and again.calls == []
+
+
+def test_all_without_a_robot_model_runs_both_and_puts_the_claims_side_by_side(tmp_path):
+    """`swarm-compare all` on the authors' robots (OUT/authors/) and today's (OUT/generic/): one row
+    per claim with both results, a count per model, and OUT/CAUSES.md included."""
+    found = {"queue": comparisons()["queue"]}
+    (tmp_path / "CAUSES.md").write_text("# Why claims do not hold\n\nmeasured: the motion rule\n")
+    runner = FakeRunner()
+    argv = ["all", "--seeds", "2", "--duration", "5", "--out", str(tmp_path)]
+    assert main(argv, run=runner, comparisons=found) == 0
+    models = {next((o for o in c[1] if o.startswith("robots.model=")), None) for c in runner.calls}
+    assert models == {"robots.model=footbot_cpfa", "robots.model=generic"}  # queue runs on the foot-bot
+    for model in ("authors", "generic"):
+        assert (tmp_path / model / "queue" / "table.md").exists()
+    report = (tmp_path / "REPORT.md").read_text()
+    assert "| # | sweep | claim | paper | ours (authors' robots) | holds (authors' robots) | ours (generic robot) |" in report
+    row = next(line for line in report.splitlines() if "| Q_MT collects the most resources of all strategies |" in line)
+    assert row.startswith("| 1 | queue |") and row.count("|") == 9
+    assert "authors' robots: " in report and "generic robot: " in report and "claims hold" in report
+    assert "## Why claims do not hold" in report and "measured: the motion rule" in report
+    assert "![collected](authors/queue/collected.png)" in report and "![collected](generic/queue/collected.png)" in report
+    again = FakeRunner()  # the report alone, from what the results hold: nothing runs
+    assert main(["all", "--report-only", "--seeds", "1", "--duration", "5", "--out", str(tmp_path)], run=again,
+                comparisons=found) == 0
+    assert again.calls == [] and "`swarm-compare all --report-only" in (tmp_path / "REPORT.md").read_text()
+    assert "(n=2)" in (tmp_path / "authors" / "queue" / "table.md").read_text()  # both seeds held, though --seeds 1
 
 
 def test_headlines_follow_the_means_and_the_tests():
@@ -508,3 +534,43 @@ def test_reports_of_runs_cut_by_duration_say_so(tmp_path):
     assert main([*argv, "--overwrite", "--duration", "60"], run=FakeRunner()) == 0
     for name in ("table.md", "ttests.md"):
         assert (tmp_path / name).read_text().startswith("> **Runs cut short**: every run here was limited to 60 s")
+
+
+def test_factor_tables_put_each_factor_beside_the_baseline(tmp_path):
+    """`python -m swarm_sim.compare.factors ROOT`: per group, per headline measure, a row per factor
+    (the baseline first) and a column per strategy and cell."""
+    from swarm_sim.compare.factors import main as factors_main
+
+    group = tmp_path / "queue48"
+    for factor, values in (("turn_fast", [50.0, 54.0]), ("baseline", [30.0, 34.0])):
+        (group / factor).mkdir(parents=True)
+        rows = [{"strategy": "queue_qmt", "cell": 48, "seed": i, "resources_collected_pct": v}
+                for i, v in enumerate(values)]
+        (group / factor / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (group / "README").write_text("- `turn_fast`: a faster turn")
+    assert factors_main([str(tmp_path)]) == 0
+    text = (tmp_path / "FACTORS.md").read_text()
+    assert "## queue48" in text and "- `turn_fast`: a faster turn" in text
+    table = text[text.index("(`resources_collected_pct`)"):].splitlines()
+    assert table[2] == "| factor | queue_qmt 48 |"
+    assert table[4:6] == ["| baseline | 32.00 ± 2.83 (2) |", "| turn_fast | 52.00 ± 2.83 (2) |"]
+    extra = {"strategy": "queue_qmt", "cell": 48, "seed": 2, "resources_collected_pct": 90.0}
+    with (group / "baseline" / "results.jsonl").open("a") as f:  # a seed the other factor did not run
+        f.write(json.dumps(extra) + "\n")
+    assert factors_main([str(tmp_path)]) == 0
+    assert "| baseline | 32.00 ± 2.83 (2) |" in (tmp_path / "FACTORS.md").read_text()  # compared on common seeds
+    assert factors_main([str(tmp_path / "nothing")]) == 2
+
+
+def test_a_rank_test_that_cannot_reach_significance_tells_nothing():
+    """Two-sided Mann-Whitney U on 3 runs against 3 cannot give p < 0.05 (its smallest p is 0.1), so
+    a spiral claim of a difference is not "no" and one of similarity is not "yes" at 3 seeds."""
+    from swarm_controllers.spiral.comparison import spiral_headlines
+    from swarm_sim.compare.stats import u_can_reject
+
+    assert not u_can_reject(3, 3) and u_can_reject(4, 4) and not u_can_reject(0, 9) and u_can_reject(3, 6)
+    assert pair_test([1.0, 2.0, 3.0], [7.0, 8.0, 9.0], "u")[1] == pytest.approx(0.1)
+    few = (rows_for("ddsa", None, [10, 11, 12], SPIRAL_KEYS) + rows_for("mdbsa_c", 4, [10, 12, 11], SPIRAL_KEYS)
+           + rows_for("mdbsa_d", 4, [20, 21, 22], SPIRAL_KEYS))
+    claims = spiral_headlines(few, 1, [4], SPIRAL_STRATEGIES)
+    assert {h.holds for h in claims if "4:" in h.ours} == {None}

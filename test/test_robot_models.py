@@ -180,6 +180,43 @@ def test_an_idle_robot_only_turns_on_a_collision():
     assert d._next[0] == ()
 
 
+def test_on_a_queue_path_the_foot_bot_stops_for_what_is_ahead_and_drops_its_move():
+    """The queue authors' FOLLOWING_ENTRY_PATH rule: a reading within +-30 deg stops the robot and
+    drops the move under way (Stop()); once clear it plans anew toward the target of that time."""
+    s = _scenario("footbot_cpfa", name="queue_qmt")
+    d = StopTurnGo(s, np.random.default_rng(1))
+    d.begin(0)
+    d.to_point(0.0, 0.0, 0.0, 1.0, 0.0)  # a blind 1 m leg planned
+    d.begin(DT_NS)
+    assert d.to_point(0.0, 0.0, 0.0, 1.0, 0.0) == (pytest.approx(0.16), 0.0)
+    assert d.path_stop(_ranges(s, {52.5: 0.02}), 30.0) is False  # beside, not ahead: goes on
+    assert d.path_stop(_ranges(s, {22.5: 0.05}), 30.0) is True  # ahead within the ring: Stop()
+    assert d._next[0] == ()
+    d.begin(2 * DT_NS)
+    assert d.to_point(0.016, 0.0, 0.0, 0.016, 1.0)[0] == 0.0  # the new target is read: it turns first
+    assert ContinuousDrive(s).path_stop(_ranges(s, {0.0: 0.01}), 30.0) is None  # generic: the queue's own brake
+    assert WheelTurning(_scenario("footbot_foraging"), np.random.default_rng(1)).path_stop(
+        _ranges(s, {0.0: 0.01}), 30.0) is None
+
+
+def test_argos_robots_start_with_their_centres_in_the_nest():
+    """ARGoS's <distribute> only keeps bodies apart (the foraging example counts a robot in the nest
+    by its position): 20 foot-bots fit the DRTM paper's 1 m nest; the generic robot keeps its whole
+    body inside, as before."""
+    from swarm_sim.robots import depot_start_room
+    from swarm_sim.world.start import start_positions
+
+    s = load_scenario("drtm_l3", ["robots.model=footbot_foraging"])
+    assert depot_start_room(s) == s.depot.radius
+    for seed in range(5):
+        p = start_positions(s, np.random.default_rng(seed))
+        assert np.all(np.hypot(*p.T) <= s.depot.radius)
+        gaps = np.hypot(*(p[:, None] - p[None]).transpose(2, 0, 1))[np.triu_indices(len(p), 1)]
+        assert gaps.min() >= s.robots.diameter
+    g = load_scenario("drtm_l3")
+    assert depot_start_room(g) == g.depot.radius - g.robots.diameter / 2
+
+
 # ---------------------------------------------------------------------- wheel_turning
 
 
@@ -326,6 +363,10 @@ def test_every_algorithm_names_its_authors_robot_and_the_comparisons_can_run_on_
         ("robots.count=4", "robots.model=footbot_foraging", "robots.count=5"),
         ("robots.count=4", "robots.model=khepera3", "robots.count=5"),
     ]
+    args.overrides = ["robots.platform.diameter=0.07"]  # one platform value varied on the authors' robots
+    assert plans_of(_Fake, args, ["drtm"])[0].overrides[1:] == (
+        "robots.model=footbot_foraging", "robots.platform.diameter=0.07")
+    args.overrides = ["robots.count=5"]
     args.robot_model = "khepera3"
     assert {p.overrides[1] for p in plans_of(_Fake, args, ["queue_qmt", "drtm"])} == {"robots.model=khepera3"}
     parser = build_parser({})

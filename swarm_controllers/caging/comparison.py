@@ -17,7 +17,7 @@ from pathlib import Path
 
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, md_table
-from swarm_sim.compare.stats import Stats, describe, pair_test, values_of
+from swarm_sim.compare.stats import Stats, describe, pair_test, u_can_reject, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 
 STRATEGY = "caging"
@@ -180,7 +180,7 @@ def caging_headlines(rows: Sequence[dict]) -> list[Headline]:
     _, p = pair_test(fine, coarse, "u")
     out.append(Headline("recruitment time does not depend on the landmark step (Table 1)", "164.5 s for both",
                         f"medians {_median(fine)} / {_median(coarse)} s, Mann-Whitney p = {fmt_p(p)}",
-                        None if math.isnan(p) else p >= 0.05))
+                        None if math.isnan(p) or not u_can_reject(len(fine), len(coarse)) else p >= 0.05))
     fine, coarse = describe(times(0, "search_time_s")).mean, describe(times(1, "search_time_s")).mean
     known = math.isfinite(fine) and math.isfinite(coarse)
     out.append(Headline("a 1 m landmark step makes the search faster than 0.5 m (Table 1)", "197.5 < 222.2 s",

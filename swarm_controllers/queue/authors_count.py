@@ -27,12 +27,10 @@ from typing import Any
 from depot_manager.admission import DepotAdmission
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, make_layout
-from swarm_controllers.queue.behaviour import Phase
+from swarm_controllers.queue.behaviour import PATH_CONE, Phase
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus
 
-PATH_CONE = 30.0
-"""``GoStraightAngleRangeInDegreesInRegion`` [deg]."""
 FOLLOWING = frozenset({Phase.QUEUED.name, Phase.LEAVING.name})
 """The states the authors call FOLLOWING_ENTRY_PATH and EXITING."""
 

@@ -39,10 +39,12 @@ Phases of a delivery, and the choices the paper leaves open:
 * **Queued**. The robot drives slot to slot along its route (entry line, then for the single
   queue the inner queue the manager dispatched it to, then the exit line), reporting every slot
   it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
-  take it into a neighbouring lane); it only brakes when something is right in front, and
+  take it into a neighbouring lane); it only brakes when something is right in front (on a robot
+  model with a path rule of its own, the authors' foot-bot, that rule: `PATH_CONE`), and
   swerves round it only after `BRAKE_PATIENCE` (a deadlock breaker). At the
   dock it waits for the world to drop its resource (T_unload), reports ``unloaded``, and goes
-  on as granted. At the last exit slot (on the perimeter) it reports that slot and drives out
+  on as granted (a robot whose resource was dropped on the way, in a dock's zone it stood in for
+  T_unload, reports ``unloaded`` on reaching its dock). At the last exit slot (on the perimeter) it reports that slot and drives out
   radially, then forages again.
 """
 
@@ -87,6 +89,11 @@ BRAKE_RANGE = 0.08
 not trigger it."""
 BRAKE_CONE = math.radians(25.0)
 """Half-angle of the braking cone about the heading [rad]."""
+PATH_CONE = 30.0
+"""[deg] a robot on a queue's path stops for what its proximity ring reads within this angle of its
+heading, on a robot model with a path rule of its own (`swarm_controllers.motion.Drive.path_stop`):
+the queue authors' ``GoStraightAngleRangeInDegreesInRegion`` (Artglz and Tameem786/
+Collision_Free_CPFA, ``CPFA_controller::CollisionDetection``)."""
 BRAKE_PATIENCE = 3.0
 """A robot braked this long [s] swerves round what blocks it (two robots braking face to face,
 e.g. one pushed off its line, would otherwise wait for each other forever)."""
@@ -101,8 +108,8 @@ class Phase(Enum):
     LEAVING = "leaving"
 
 
-_FORAGING, _TO_ENTRY, _SEEKING, _JOINING, _QUEUED = (
-    Phase.FORAGING, Phase.TO_ENTRY, Phase.SEEKING, Phase.JOINING, Phase.QUEUED
+_FORAGING, _TO_ENTRY, _SEEKING, _JOINING, _QUEUED, _LEAVING = (
+    Phase.FORAGING, Phase.TO_ENTRY, Phase.SEEKING, Phase.JOINING, Phase.QUEUED, Phase.LEAVING
 )
 """The phases every tick compares against, as module constants (a member looked up on its Enum
 class costs ~0.1 us in Python 3.11; see `swarm_controllers.cpfa.behaviour`)."""
@@ -117,14 +124,15 @@ def _granted(messages: tuple[object, ...]) -> frozenset[str]:
 @lru_cache(maxsize=8)
 def _queues(
     geometry: DepotGeometryConfig, kind: str
-) -> tuple[QueueLayout, dict[str, np.ndarray], dict[str, list[tuple[float, float]]]]:
-    """The layout and every line's slots, computed once per process (the manager's cells), also
-    as (x, y) float pairs: a queued robot looks one or two up every tick, and a row of an array
-    unpacked into numpy scalars and computed with cost ~0.5 us more (measured)."""
+) -> tuple[QueueLayout, dict[str, np.ndarray], dict[str, list[tuple[float, float]]], frozenset[tuple[str, int]]]:
+    """The layout, every line's slots and the docks' slots, computed once per process (the manager's
+    cells), the slots also as (x, y) float pairs: a queued robot looks one or two up every tick,
+    and a row of an array unpacked into numpy scalars and computed with cost ~0.5 us more (measured)."""
     layout = make_layout(kind, geometry)
     admission = DepotAdmission(layout)
     cells = {line: admission.cells(line) for line in admission.lines()}
-    return layout, cells, {line: [tuple(xy) for xy in points.tolist()] for line, points in cells.items()}
+    slots = {line: [tuple(xy) for xy in points.tolist()] for line, points in cells.items()}
+    return layout, cells, slots, admission.dock_slots()
 
 
 class QueueBehaviour:
@@ -133,7 +141,7 @@ class QueueBehaviour:
     # Slots, not a __dict__: see `CpfaBehaviour`.
     __slots__ = (
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
-        "_center", "_cpfa", "_cpfa_step", "_entry", "_entry_angles", "_entry_lines",
+        "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
         "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
@@ -159,7 +167,8 @@ class QueueBehaviour:
         self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, drive=self._drive)
         self._cpfa_step = self._cpfa.step
         self._avoid = self._drive.avoidance(0.1)
-        self._layout, self._cells, self._slots = _queues(DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
+        self._layout, self._cells, self._slots, self._docks = _queues(
+            DepotGeometryConfig.from_scenario(scenario), queue.wrapping)
         self._entry_lines = tuple(line.name for line in self._layout.entry_lines)
         self._entry_angles = np.array(
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
@@ -230,7 +239,7 @@ class QueueBehaviour:
                 return self._forage(obs, r, out)
             self._begin_delivery(obs, r, out)
             phase = self._phase
-        if dropped and phase is _QUEUED:
+        if dropped and phase is _QUEUED and (self._line, self._cell) in self._docks:
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, self._line, self._cell))
         if phase is _TO_ENTRY:
             linear, angular = self._to_entry(obs, r, out)
@@ -250,6 +259,9 @@ class QueueBehaviour:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
                 self._braked_since = math.inf  # swerved for a second: try the line again
+        elif (phase is _QUEUED or phase is _LEAVING) and self._drive.path_stop(obs.ranges, PATH_CONE):
+            linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())
+            self._braked_since = min(self._braked_since, obs.t)
         elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:
             linear = 0.0
             self._braked_since = min(self._braked_since, obs.t)
@@ -442,6 +454,10 @@ class QueueBehaviour:
         if math.hypot(tx - x, ty - y) <= SLOT_TOLERANCE:
             self._line, self._cell = line, cell
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.AT, line, cell))
+            if not self._carrying and (line, cell) in self._docks:
+                # Its resource was dropped on the way (it stood in a dock's zone for T_unload): there
+                # is nothing left to unload, so its dock is done with it (else the dock waits forever).
+                out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.UNLOADED, line, cell))
             if line in self._exit_lines and cell == len(self._cells[line]) - 1:
                 cx, cy = self._center
                 r = math.hypot(x - cx, y - cy)

@@ -24,6 +24,12 @@ MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm (branch ``lu
   that tick (``Move``, cases LEFT and RIGHT, "qilu 10/26/2016").
 - A robot standing idle (``Stop()`` before every ``Move()``) only turns on a collision; its pushed
   step never runs (`turn_only`).
+- A robot that follows a queue's path does not avoid: the queue authors' ``CPFA_controller::
+  CollisionDetection`` (Tameem786 and Artglz/Collision_Free_CPFA, states FOLLOWING_ENTRY_PATH,
+  FOLLOWING_EXIT_PATH / EXITING) calls ``Stop()`` when the readings' vector is non-zero and within
+  ``GoStraightAngleRangeInDegreesInRegion`` (+-30 deg) of the heading: the move under way is
+  dropped (``TicksToWaitWhileMoving = 0``, state STOP) and the next one is planned toward the
+  target of that time, once nothing stops it (`path_stop`).
 
 Time runs continuously inside a tick: the robot's twist over a tick is the mean of the moves it
 made in it (a move that ends inside a tick leaves the robot standing for the rest of it), so
@@ -138,6 +144,16 @@ class StopTurnGo:
         """Itself: ``CollisionDetection`` is part of ``Move`` (the escape is its `collision_step`,
         and it always turns clockwise)."""
         return self
+
+    def path_stop(self, ranges: np.ndarray, cone: float) -> bool:
+        """The queue authors' rule on a path: something within `cone` [deg] of the heading stops the
+        robot and drops the move under way (``Stop()``); call it after the tick's motion was asked."""
+        x, y = self._ring.vector(ranges)
+        norm = hypot(x, y)
+        if not (norm > 0.0 and x >= math.cos(math.radians(cone)) * norm):
+            return False
+        self._next = (_EMPTY, max(self._state[1] - self._dt, 0.0), False)
+        return True
 
     # ------------------------------------------------------------------ Avoidance
 

@@ -98,6 +98,10 @@ class WheelTurning:
         """Itself: ``diffusion`` (no escape run: the example steers by the readings every tick)."""
         return self
 
+    def path_stop(self, ranges: np.ndarray, cone: float) -> None:
+        """The foraging example keeps to no paths: the behaviour's own rule."""
+        return None
+
     # ------------------------------------------------------------------ Avoidance
 
     def update(self, ranges: np.ndarray) -> Command | None:

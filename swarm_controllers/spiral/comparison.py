@@ -21,6 +21,7 @@ from swarm_sim.compare.stats import (
     pairwise_tests,
     pct_change,
     stars,
+    u_can_reject,
     values_of,
 )
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
@@ -369,7 +370,8 @@ def spiral_headlines(rows: Sequence[dict], experiment: int, cells: Sequence[int]
                      strategies: Sequence[str]) -> list[Headline]:
     """The paper's reported differences for `experiment`, each checked in every cell it covers
     with the paper's own test (two-sided Mann-Whitney U, p < 0.05): a claimed rise or fall holds
-    when every covered cell moves that way significantly, "similar" when no cell differs."""
+    when every covered cell moves that way significantly, "similar" when no cell differs; a cell
+    with too few runs for the test to reach p < 0.05 cannot tell (`u_can_reject`)."""
     out = []
     for c in PAPER_SPIRAL_CLAIMS:
         if c.experiment != experiment:
@@ -386,8 +388,8 @@ def spiral_headlines(rows: Sequence[dict], experiment: int, cells: Sequence[int]
             _, p = pair_test(va, vb, "u")
             diff = pct_change(describe(va).mean, describe(vb).mean)
             parts.append(f"{cell}: {fmt_pct(diff)} {stars(p, ns='-')}")
-            if not (math.isfinite(p) and math.isfinite(diff)):
-                verdicts.append(None)
+            if not (math.isfinite(p) and math.isfinite(diff)) or not u_can_reject(len(va), len(vb)):
+                verdicts.append(None)  # (too few runs for the test to tell: see u_can_reject)
             elif c.sign == 0:
                 verdicts.append(p >= 0.05)
             else:

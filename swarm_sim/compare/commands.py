@@ -13,7 +13,16 @@ from swarm_sim import compare, registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import note_cut_runs
-from swarm_sim.compare.sweep import FAILED, RESULTS, ResultsFileError, RunFunction, RunPlan, run_sweep
+from swarm_sim.compare.sweep import (
+    FAILED,
+    RESULTS,
+    ResultsFileError,
+    RunFunction,
+    RunPlan,
+    SweepResult,
+    read_results,
+    run_sweep,
+)
 from swarm_sim.executors import Executor, add_executor_arguments
 from swarm_sim.robots import known_models
 from swarm_sim.scenario import ScenarioError, load_scenario
@@ -51,6 +60,8 @@ def common_arguments(p: argparse.ArgumentParser, out: str, *, strategies: bool =
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--resume", action="store_true", help="keep results.jsonl and run only missing runs")
     mode.add_argument("--overwrite", action="store_true", help="discard an existing results.jsonl")
+    mode.add_argument("--report-only", action="store_true",
+                      help="run nothing: write the report from the runs results.jsonl holds (any seeds)")
 
 
 def build_parser(comparisons: Mapping[str, Comparison]) -> argparse.ArgumentParser:
@@ -79,17 +90,30 @@ def plans_of(comparison: Comparison, args: argparse.Namespace, strategies: list[
     for plan in plans:
         name = model
         if model == AUTHORS:
-            scenario = load_scenario(plan.strategy, plan.overrides, **dict(plan.fields))
+            # The algorithm decides the model; `robots.platform` values apply only once it is chosen.
+            known = [o for o in plan.overrides if not o.startswith("robots.platform.")]
+            scenario = load_scenario(plan.strategy, known, **dict(plan.fields))
             name = registry.of(scenario).authors_robot
         given = tuple(o for o in plan.overrides if o not in args.overrides)
         out.append(dataclasses.replace(plan, overrides=(*given, f"robots.model={name}", *args.overrides)))
     return out
 
 
+def held_rows(plans: list[RunPlan], path: Path) -> list[dict]:
+    """The runs of `plans` that the results file holds, in plan then seed order."""
+    order = {(p.strategy, p.settings): i for i, p in enumerate(plans)}
+    rows = [r for r in read_results(path) if (r.get("strategy"), r.get("settings")) in order]
+    return sorted(rows, key=lambda r: (order[(r.get("strategy"), r.get("settings"))], r.get("seed", 0)))
+
+
 def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies: list[str], *,
                    run: RunFunction | None, executor: Executor) -> tuple[int, list[Path]]:
     """One comparison's sweep then its report: (exit status, files written)."""
-    plans = plans_of(comparison, args, strategies)
+    try:
+        plans = plans_of(comparison, args, strategies)
+    except ScenarioError as exc:
+        print(f"swarm-compare: {exc}", file=sys.stderr)
+        return 2, []
     out = comparison.out_dir(args)
     if run is None:
         for plan in plans:
@@ -102,15 +126,21 @@ def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies:
     if args.overwrite:
         for old in (path, out / FAILED):
             old.unlink(missing_ok=True)
-    try:
-        result = run_sweep(plans, list(range(args.seeds)), path, executor=executor, run=run, resume=args.resume)
-    except (FileExistsError, ResultsFileError) as exc:
-        print(f"swarm-compare: {exc}", file=sys.stderr)
-        return 2, []
-    except KeyboardInterrupt:
-        print(f"\nswarm-compare: interrupted; finished runs are in {path} (continue with --resume)",
-              file=sys.stderr)
-        return 130, []
+    if getattr(args, "report_only", False):
+        result = SweepResult(held_rows(plans, path))
+        if not result.rows:
+            print(f"swarm-compare: {path} holds no runs of this sweep", file=sys.stderr)
+            return 2, []
+    else:
+        try:
+            result = run_sweep(plans, list(range(args.seeds)), path, executor=executor, run=run, resume=args.resume)
+        except (FileExistsError, ResultsFileError) as exc:
+            print(f"swarm-compare: {exc}", file=sys.stderr)
+            return 2, []
+        except KeyboardInterrupt:
+            print(f"\nswarm-compare: interrupted; finished runs are in {path} (continue with --resume)",
+                  file=sys.stderr)
+            return 130, []
     written = comparison.write_report(result.rows, out, args, strategies)
     note_cut_runs(written, args.duration)
     print(f"{len(result.rows)} runs in {path}; wrote {', '.join(p.name for p in written)} in {out}")

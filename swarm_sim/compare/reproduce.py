@@ -7,25 +7,37 @@ algorithm registers a `Comparison` is picked up without a change here. Each comp
 gathers, per comparison and sweep, the markdown files it wrote (its tables next to the paper's
 numbers and its statistics) and its plots, after a summary table of the papers' headline claims
 and whether our runs bear them out.
+
+Without ``--robot-model``, every sweep runs twice: on each algorithm's authors' robot
+(``--robot-model authors``, into ``OUT/authors/``) and on today's generic robot (``OUT/generic/``),
+and REPORT.md puts each claim's result on both side by side, with the count of claims holding for
+each, then includes ``OUT/CAUSES.md`` (the measured causes of the claims that do not hold, written
+from the one-factor-at-a-time sweeps) when there is one.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-from contextlib import nullcontext
 from collections.abc import Mapping, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
 
+from swarm_sim.compare.commands import AUTHORS, build_parser, plans_of, run_comparison
 from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.commands import build_parser, plans_of, run_comparison
 from swarm_sim.compare.report import md_table
 from swarm_sim.compare.sweep import RESULTS, RunFunction, read_results
 from swarm_sim.executors import Executor, executor_from_args
+from swarm_sim.robots import GENERIC
 
 REPORT = "REPORT.md"
+CAUSES = "CAUSES.md"
+"""In OUT, written by hand from the factor sweeps: REPORT.md includes it after the claims."""
+MODELS = (AUTHORS, GENERIC)
+"""What ``all`` runs without ``--robot-model``: the authors' robots, then today's robot."""
+MODEL_TITLES = {AUTHORS: "authors' robots", GENERIC: "generic robot"}
 
 
 @dataclass
@@ -42,59 +54,73 @@ class SweepReport:
     error: str = ""
 
 
-def sweep_argv(name: str, options: Sequence[str], args: argparse.Namespace, out: Path) -> list[str]:
-    """The single-comparison command line that one sweep of ``all`` amounts to."""
+def sweep_argv(name: str, options: Sequence[str], args: argparse.Namespace, out: Path,
+               model: str | None = None) -> list[str]:
+    """The single-comparison command line that one sweep of ``all`` amounts to (on robot `model`)."""
     argv = [name, *options, "--seeds", str(args.seeds), "--out", str(out)]
     if args.duration is not None:
         argv += ["--duration", repr(args.duration)]
     for text in args.overrides:
         argv += ["--set", text]
-    if getattr(args, "robot_model", None):
-        argv += ["--robot-model", args.robot_model]
+    if model:
+        argv += ["--robot-model", model]
     if args.resume:
         argv.append("--resume")
     if args.overwrite:
         argv.append("--overwrite")
+    if getattr(args, "report_only", False):
+        argv.append("--report-only")
     return argv
 
 
 def reproduce_all(args: argparse.Namespace, comparisons: Mapping[str, Comparison], *,
                   run: RunFunction | None = None, executor: Executor | None = None) -> int:
     parser = build_parser(comparisons)
-    reports: list[SweepReport] = []
+    models = (args.robot_model,) if getattr(args, "robot_model", None) else MODELS
+    by_model: dict[str, list[SweepReport]] = {}
     try:
         with nullcontext(executor) if executor else executor_from_args(args) as ex:
-            for name, comparison in comparisons.items():
-                out = args.out / Path(comparison.default_out).name
-                for options in comparison.reproduce:
-                    argv = sweep_argv(name, options, args, out)
-                    print(f"[swarm-compare all] swarm-compare {' '.join(argv)}", flush=True)
-                    sub = parser.parse_args(argv)
-                    strategies = list(comparison.strategies)
-                    report = SweepReport(comparison, tuple(options), comparison.out_dir(sub), 0)
-                    try:
-                        report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
-                                                                       executor=ex)
-                        rows = _rows(report.out, comparison, sub, strategies)
-                        report.runs = len(rows)
-                        report.headlines = comparison.headlines(rows, sub, strategies)
-                    except KeyboardInterrupt:
-                        raise
-                    except Exception as exc:  # one paper's broken report must not lose the others
-                        report.status, report.error = 1, f"{type(exc).__name__}: {exc}"
-                        print(f"swarm-compare all: {name} {' '.join(options)}: {report.error}", file=sys.stderr)
-                    reports.append(report)
-                    if report.status == 130:
-                        raise KeyboardInterrupt
+            for model in models:
+                by_model[model] = _reproduce(args, comparisons, parser, model, len(models) > 1, run, ex)
     except (RuntimeError, OSError) as exc:
         print(f"swarm-compare: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("swarm-compare all: interrupted; continue with --resume", file=sys.stderr)
         return 130
-    path = write_report(reports, args)
+    path = write_report(by_model, args)
     print(f"[swarm-compare all] wrote {path}")
-    return max((r.status for r in reports), default=0)
+    return max((r.status for reports in by_model.values() for r in reports), default=0)
+
+
+def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], parser: argparse.ArgumentParser,
+               model: str, own_dir: bool, run: RunFunction | None, ex: Executor) -> list[SweepReport]:
+    """Every comparison's sweeps on robot `model`, into OUT/<model>/ when `own_dir`, else OUT."""
+    reports: list[SweepReport] = []
+    base = args.out / model if own_dir else args.out
+    for name, comparison in comparisons.items():
+        out = base / Path(comparison.default_out).name
+        for options in comparison.reproduce:
+            argv = sweep_argv(name, options, args, out, model)
+            print(f"[swarm-compare all] swarm-compare {' '.join(argv)}", flush=True)
+            sub = parser.parse_args(argv)
+            strategies = list(comparison.strategies)
+            report = SweepReport(comparison, tuple(options), comparison.out_dir(sub), 0)
+            try:
+                report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
+                                                               executor=ex)
+                rows = _rows(report.out, comparison, sub, strategies)
+                report.runs = len(rows)
+                report.headlines = comparison.headlines(rows, sub, strategies)
+            except KeyboardInterrupt:
+                raise
+            except Exception as exc:  # one paper's broken report must not lose the others
+                report.status, report.error = 1, f"{type(exc).__name__}: {exc}"
+                print(f"swarm-compare all: {name} {' '.join(options)}: {report.error}", file=sys.stderr)
+            reports.append(report)
+            if report.status == 130:
+                raise KeyboardInterrupt
+    return reports
 
 
 def _rows(out: Path, comparison: Comparison, args: argparse.Namespace, strategies: list[str]) -> list[dict]:
@@ -112,54 +138,91 @@ def _demote(text: str, levels: int) -> list[str]:
     return [("#" * levels + line) if line.startswith("#") else line for line in text.splitlines()]
 
 
-def write_report(reports: Sequence[SweepReport], args: argparse.Namespace) -> Path:
+def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.Namespace) -> Path:
+    """REPORT.md: the headline claims (on each robot model side by side when there are two), the
+    causes of the failing ones (``OUT/CAUSES.md``), then every sweep's tables and plots."""
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    command = f"swarm-compare all --seeds {args.seeds} --out {out}"
+    models = list(by_model)
+    report_only = getattr(args, "report_only", False)
+    command = f"swarm-compare all --report-only --out {out}" if report_only else \
+        f"swarm-compare all --seeds {args.seeds} --out {out}"
     if args.duration is not None:
         command += f" --duration {args.duration:g}"
     command += "".join(f" --set {s}" for s in args.overrides)
     if getattr(args, "robot_model", None):
         command += f" --robot-model {args.robot_model}"
     lines = ["# The papers' results, reproduced", "",
-             f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, seeds "
-             f"0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held: each "
-             "section gives its run count). Every number labelled *paper* is the paper's, hard-coded from its "
-             "text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
+             f"Generated {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC by `{command}` (batch runner, "
+             + ("every run each sweep's results file holds, whatever its seeds" if report_only else
+                f"seeds 0..{args.seeds - 1} per cell, and every further seed a sweep's results file already held")
+             + ": each section gives its run count). Every number labelled *paper* is the paper's, hard-coded from "
+             "its text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
+    if len(models) > 1:
+        lines += ["Every sweep ran on two robot models (`swarm_sim.robots`, README *Robot models*): "
+                  + "; ".join(f"*{MODEL_TITLES.get(m, m)}* (`--robot-model {m}`, in `{m}/`)" for m in models)
+                  + ".", ""]
     if args.duration is not None:
         lines += [f"> **Rehearsal:** every run was cut to {args.duration:g} s of sim time, so these numbers "
                   "are not comparable with the papers'.", ""]
     lines += ["## Headline claims", "",
               "Each claim checked on our runs (means per cell; the tests behind them are in each section). "
               "*holds*: yes / **no** / n/a (our runs cannot tell).", ""]
-    body = []
-    for r in reports:
-        where = f"{r.comparison.name} {' '.join(r.options)}".strip()
-        for h in r.headlines:
-            body.append([where, h.claim, h.paper, h.ours, _holds(h.holds)])
-        if not r.headlines:
-            body.append([where, "(no headline claims declared)" if not r.error else f"failed: {r.error}",
-                         "", "", "n/a"])
-    lines += md_table(["sweep", "claim", "paper", "ours", "holds"], body) + [""]
-    held = [h.holds for r in reports for h in r.headlines]
-    lines += [f"{held.count(True)} of {len(held)} claims hold, {held.count(False)} do not, "
-              f"{held.count(None)} cannot be told.", ""]
-    for r in reports:
-        title = f"{r.comparison.name} {' '.join(r.options)}".strip()
-        lines += [f"## {title}: {r.comparison.help}", "",
-                  f"{r.runs} runs in `{_rel(r.out / RESULTS, out)}`" + (f"; exit status {r.status}" if r.status else ""),
-                  ""]
-        if r.error:
-            lines += [f"The report of this sweep failed: `{r.error}`", ""]
-        for path in r.written:
-            if path.suffix == ".md":
-                lines += _demote(path.read_text(), 2) + [""]
-        for path in r.written:
-            if path.suffix == ".png":
-                lines += [f"![{path.stem}]({_rel(path, out)})", ""]
+    rows = _claim_rows(by_model)
+    header = ["#", "sweep", "claim", "paper"]
+    for m in models:
+        title = MODEL_TITLES.get(m, m)
+        header += [f"ours ({title})" if len(models) > 1 else "ours", f"holds ({title})" if len(models) > 1 else "holds"]
+    lines += md_table(header, ([str(i + 1), *row] for i, row in enumerate(rows))) + [""]
+    for m in models:
+        held = [h.holds for r in by_model[m] for h in r.headlines]
+        who = f"{MODEL_TITLES.get(m, m)}: " if len(models) > 1 else ""
+        lines += [f"{who}{held.count(True)} of {len(held)} claims hold, {held.count(False)} do not, "
+                  f"{held.count(None)} cannot be told.", ""]
+    causes = out / CAUSES
+    if causes.is_file():
+        lines += _demote(causes.read_text(), 1) + [""]
+    for m in models:
+        for r in by_model[m]:
+            title = f"{r.comparison.name} {' '.join(r.options)}".strip()
+            on = f" ({MODEL_TITLES.get(m, m)})" if len(models) > 1 else ""
+            lines += [f"## {title}{on}: {r.comparison.help}", "",
+                      f"{r.runs} runs in `{_rel(r.out / RESULTS, out)}`" + (f"; exit status {r.status}" if r.status else ""),
+                      ""]
+            if r.error:
+                lines += [f"The report of this sweep failed: `{r.error}`", ""]
+            for path in r.written:
+                if path.suffix == ".md":
+                    lines += _demote(path.read_text(), 2) + [""]
+            for path in r.written:
+                if path.suffix == ".png":
+                    lines += [f"![{path.stem}]({_rel(path, out)})", ""]
     path = out / REPORT
     path.write_text("\n".join(lines))
     return path
+
+
+def _claim_rows(by_model: Mapping[str, Sequence[SweepReport]]) -> list[list[str]]:
+    """One row per claim: sweep, claim, paper, then (ours, holds) per model; a claim is matched
+    across models by its sweep and its words (a sweep that failed on one model shows its error)."""
+    models = list(by_model)
+    first = by_model[models[0]]
+    rows = []
+    for i, r in enumerate(first):
+        where = f"{r.comparison.name} {' '.join(r.options)}".strip()
+        others = [by_model[m][i] if i < len(by_model[m]) else None for m in models[1:]]
+        if not r.headlines:
+            rows.append([where, "(no headline claims declared)" if not r.error else f"failed: {r.error}", "",
+                         *["", "n/a"] * len(models)])
+            continue
+        for h in r.headlines:
+            row = [where, h.claim, h.paper, h.ours, _holds(h.holds)]
+            for o in others:
+                match = next((g for g in (o.headlines if o else ()) if (g.claim, g.paper) == (h.claim, h.paper)), None)
+                row += [match.ours, _holds(match.holds)] if match else [f"failed: {o.error}" if o and o.error else "—",
+                                                                         "n/a"]
+            rows.append(row)
+    return rows
 
 
 def _rel(path: Path, root: Path) -> str:

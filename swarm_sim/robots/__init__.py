@@ -90,6 +90,12 @@ class RobotModel:
     """Food is seen when it lies under a ground sensor: ``sensors.resource_detection_radius`` =
     the food's radius (``sensors.pickup_radius``, within which it is taken) + the sensor's
     distance from the centre."""
+    centre_in_depot: bool = False
+    """A start in the depot (``robots.start_layout`` depot_random, depot_ring) puts the robots'
+    centres in it, their bodies may reach over its edge: ARGoS's ``<distribute>`` only keeps the
+    bodies from overlapping, and its loop functions count a robot in the nest by its position
+    (the foraging example's ``CForagingLoopFunctions::PreStep``: ``cPos.GetX() < -1.5f``). The
+    generic robot starts with its whole body inside."""
 
 
 GENERIC = "generic"
@@ -110,7 +116,7 @@ MODELS: dict[str, RobotModel] = {m.name: m for m in (
         diameter=2 * footbot.BODY_RADIUS, height=footbot.BODY_HEIGHT, mass=footbot.MASS,
         max_linear_speed=0.16, max_angular_speed=footbot.wheel_speed_to_turn_rate(0.08),
         ring_rays=footbot.RING_SENSORS, ring_fov=footbot.RING_FOV, ring_range=footbot.RING_RANGE,
-        ring_reading=footbot.ring_reading, ring_value=footbot.ring_value,
+        ring_reading=footbot.ring_reading, ring_value=footbot.ring_value, centre_in_depot=True,
     ),
     RobotModel(
         name="footbot_foraging",
@@ -122,7 +128,7 @@ MODELS: dict[str, RobotModel] = {m.name: m for m in (
         max_linear_speed=0.1, max_angular_speed=footbot.wheel_speed_to_turn_rate(0.1),
         ring_rays=footbot.RING_SENSORS, ring_fov=footbot.RING_FOV, ring_range=footbot.RING_RANGE,
         ring_reading=footbot.ring_reading, ring_value=footbot.ring_value, light_everywhere=True,
-        ground_food=True,
+        ground_food=True, centre_in_depot=True,
     ),
     RobotModel(
         name="khepera3",
@@ -153,6 +159,12 @@ def robot_model(name: str) -> RobotModel:
 def model_of(scenario: Any) -> RobotModel:
     """The model of a (loaded) scenario."""
     return robot_model(scenario.robots.model)
+
+
+def depot_start_room(scenario: Any) -> float:
+    """[m] how far from the depot's centre a robot's centre may start (`RobotModel.centre_in_depot`)."""
+    inside = 0.0 if model_of(scenario).centre_in_depot else scenario.robots.diameter / 2
+    return scenario.depot.radius - inside
 
 
 def apply_model(scenario: Any) -> Any:

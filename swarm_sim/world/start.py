@@ -11,9 +11,10 @@ import math
 
 import numpy as np
 
+from swarm_sim.robots import depot_start_room
 from swarm_sim.scenario.schema import Scenario, ScenarioError
 
-START_ATTEMPTS = 10_000
+START_ATTEMPTS = 100_000
 """Candidate positions drawn per robot before a `depot_random` start gives up."""
 
 
@@ -29,7 +30,7 @@ def start_positions(scenario: Scenario, rng: np.random.Generator) -> np.ndarray:
                                 cy + (i // side - (side - 1) / 2) * r.start_spacing])
     if r.start_layout == "groups":
         return _groups(scenario)
-    room = scenario.depot.radius - r.diameter / 2
+    room = depot_start_room(scenario)
     if r.start_layout == "depot_ring":
         phi = 2 * math.pi * np.arange(n) / n
         return np.column_stack([cx + room * np.cos(phi), cy + room * np.sin(phi)])

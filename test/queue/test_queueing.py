@@ -272,3 +272,25 @@ def test_a_ray_at_the_float32_brake_range_does_not_brake_and_one_below_does():
     assert b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True))).linear > 0.0
     scan[12] = np.nextafter(np.float32(BRAKE_RANGE), np.float32(0.0))
     assert b.step(Observation("robot_0", 2 * 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True))).linear == 0.0
+
+
+def test_a_robot_that_lost_its_resource_on_the_way_reports_unloaded_at_its_dock():
+    """A carrier that stood T_unload in a dock's zone on the way lost its resource there: at its own
+    dock it says unloaded at once (the manager refuses an unload anywhere but the dock, and the
+    dock would wait for it forever); one that drops on the way reports nothing there."""
+    from depot_manager.protocol import DepotReport, ReportKind
+
+    b = QueueBehaviour(load_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
+    (dock_line, dock_cell), = [d for d in b._docks if d[0] == "entry_line_0"]
+    b._phase, b._line, b._cell, b._grant = Phase.QUEUED, dock_line, dock_cell - 2, (dock_line, dock_cell)
+    b._carrying = True
+    x, y = b._slots[dock_line][dock_cell - 2]
+    dropped = b.step(Observation("robot_0", 10**9, Pose2D(x, y, 0.0), 0.0, 0.0, np.full(24, np.inf, np.float32),
+                                 ForagingSense((), False)))
+    assert not [m for m in dropped.messages if isinstance(m, DepotReport) and m.kind is ReportKind.UNLOADED]
+    b._cell = dock_cell - 1
+    x, y = b._slots[dock_line][dock_cell]
+    at = b.step(Observation("robot_0", 2 * 10**9, Pose2D(x, y, 0.0), 0.0, 0.0, np.full(24, np.inf, np.float32),
+                            ForagingSense((), False)))
+    kinds = [(m.kind, m.line, m.cell) for m in at.messages if isinstance(m, DepotReport)]
+    assert kinds == [(ReportKind.AT, dock_line, dock_cell), (ReportKind.UNLOADED, dock_line, dock_cell)]
