@@ -95,13 +95,7 @@ class Launch:
         return out
 
     def sim_time(self) -> float:
-        """The last /clock recorded so far [s] (0 before the bag exists)."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BagTruncatedWarning)
-                return bag_info(self.bag).end_ns / NS_PER_S
-        except Exception:  # noqa: BLE001 - not there yet, or mid-write
-            return 0.0
+        return recorded_sim_time(self.bag)
 
     def wait_until(self, predicate, timeout: float = 90.0, what: str = "") -> None:
         deadline = time.monotonic() + timeout
@@ -136,3 +130,13 @@ def launch(tmp_path):
     yield start
     for run in started:
         run.stop()
+
+
+def recorded_sim_time(bag: Path) -> float:
+    """The last /clock a run's bag has recorded so far [s] (0 before the bag exists)."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", BagTruncatedWarning)
+            return bag_info(bag).end_ns / NS_PER_S
+    except Exception:  # noqa: BLE001 - not there yet, or mid-write
+        return 0.0

@@ -11,18 +11,16 @@ import subprocess
 import sys
 import threading
 import time
-import warnings
 from pathlib import Path
 
 import numpy as np
+from graph_helpers import recorded_sim_time
 from netns import Testbed
 
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch
-from swarm_sim.recording import BagTruncatedWarning, bag_info
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NS_PER_S
 
 REPO = Path(__file__).resolve().parents[2]
 HOSTS = ("world", "hosta", "hostb", "cli")
@@ -140,13 +138,7 @@ class MultiHostRun:
         return start_echo(self.tb, self.server, topic, count, timeout, self.bag.parent)
 
     def sim_time(self) -> float:
-        """The last /clock recorded so far [s] (0 before the bag exists)."""
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", BagTruncatedWarning)
-                return bag_info(self.bag).end_ns / NS_PER_S
-        except Exception:  # noqa: BLE001 - not there yet, or mid-write
-            return 0.0
+        return recorded_sim_time(self.bag)
 
     def wait_sim(self, seconds: float, timeout: float) -> None:
         """Until the run has recorded `seconds` of sim time, noting every host's sockets meanwhile."""
