@@ -99,13 +99,7 @@ from swarm_controllers.motion import Avoidance, Drive, drive_for
 from swarm_sim.messaging import per_inbox
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import (
-    NS_PER_S,
-    BehaviourStatus,
-    Command,
-    Observation,
-    RobotId,
-)
+from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, slot_constructor
 
 _TWO_PI = 2.0 * math.pi
 _IDLE = (0.0, 0.0)
@@ -133,6 +127,11 @@ class SearchMode(Enum):
     SITE_FIDELITY = "site_fidelity"
     PHEROMONE = "pheromone"
 
+
+_new_status = slot_constructor(BehaviourStatus)
+"""A status, built for a third of the dataclass's cost. `status` reads a member's text as
+``_name_`` / ``_value_`` (Enum's documented sunder attributes): ``name`` and ``value`` are
+properties, and an Enum's hash is Python code, ~0.15 us each in Python 3.11, on every status."""
 
 _DEPARTING, _SEARCHING, _RETURNING, _UNINFORMED = (
     CpfaState.DEPARTING, CpfaState.SEARCHING, CpfaState.RETURNING, SearchMode.UNINFORMED
@@ -328,14 +327,8 @@ class CpfaBehaviour:
         return self._p_return
 
     def status(self, stamp_ns: int | None = None) -> BehaviourStatus:
-        return BehaviourStatus(
-            robot=self.robot,
-            stamp_ns=self._stamp_ns if stamp_ns is None else stamp_ns,
-            state=self._state.name,
-            obstacle_avoidance_events=self._avoidance.events,
-            trips=self._trips,
-            extra=(("search", self._mode.value),),
-        )
+        return _new_status(self.robot, self._stamp_ns if stamp_ns is None else stamp_ns, self._state._name_,
+                           self._avoidance.events, self._trips, (("search", self._mode._value_),))
 
     # ------------------------------------------------------------------ the tick
 

@@ -208,14 +208,15 @@ class QueueBehaviour:
 
     def status(self, stamp_ns: int | None = None) -> BehaviourStatus:
         """The CPFA's status with the phase, line and cell: built here from the CPFA's fields (the
-        controller node asks every tick, the batch runner for the state rules: ~2.8 -> ~1 us)."""
+        controller node asks every tick, the batch runner for the state rules: ~2.8 -> ~1 us; members' text
+        as in `CpfaBehaviour.status`)."""
         cpfa = self._cpfa
         phase = self._phase
         own = 0 if self._avoid is cpfa.avoidance else self._avoid.events  # a model's one avoidance
         return _new_status(
             self.robot, self._stamp_ns if stamp_ns is None else stamp_ns,
-            cpfa.state.name if phase is _FORAGING else phase.name, cpfa.obstacle_avoidance_events + own,
-            cpfa.trips, (("search", cpfa.search_mode.value), ("line", self._line), ("cell", str(self._cell))),
+            (cpfa.state if phase is _FORAGING else phase)._name_, cpfa.obstacle_avoidance_events + own,
+            cpfa.trips, (("search", cpfa.search_mode._value_), ("line", self._line), ("cell", str(self._cell))),
         )
 
     # ------------------------------------------------------------------ the tick
