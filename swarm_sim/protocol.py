@@ -23,7 +23,6 @@ from typing import Protocol
 
 import numpy as np
 
-
 ROBOTS = "robots"
 """The channel every robot controller receives."""
 

@@ -62,8 +62,8 @@ def test_series_and_tables_stay_in_json():
 def test_a_measure_reads_in_the_papers_units():
     """E_e is a fraction in the JSON and a percentage in the text; a stage the run did not reach
     says so."""
-    from swarm_sim.registry import Measure
     from swarm_sim.analysis import text
+    from swarm_sim.registry import Measure
 
     assert text._value(0.1199, Measure("energy_efficiency", "%", "E_e", scale=100.0)) == "11.99 %"
     assert text._value(None, Measure("search_time_s", "s", missing="not reached")) == "not reached"

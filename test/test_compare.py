@@ -11,10 +11,6 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from swarm_sim.compare import comparisons
-from swarm_sim.compare.cli import main
-from swarm_sim.compare.commands import build_parser
-from swarm_sim.compare.comparison import Comparison
 from swarm_controllers.queue.comparison import (
     PAPER_TABLE_II,
     QUEUE_STRATEGIES,
@@ -22,7 +18,6 @@ from swarm_controllers.queue.comparison import (
     queue_ttests_md,
     write_queue_report,
 )
-from swarm_controllers.spiral.regions import RegionConfig
 from swarm_controllers.spiral.comparison import (
     PAPER_SPIRAL_CLAIMS,
     SPIRAL_EXPERIMENTS,
@@ -32,6 +27,11 @@ from swarm_controllers.spiral.comparison import (
     spiral_plans,
     write_spiral_report,
 )
+from swarm_controllers.spiral.regions import RegionConfig
+from swarm_sim.compare import comparisons
+from swarm_sim.compare.cli import main
+from swarm_sim.compare.commands import build_parser
+from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import fmt_p
 from swarm_sim.compare.stats import pair_test, pairwise_tests, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, read_results, run_sweep, slim

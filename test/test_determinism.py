@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-
 from graph_helpers import SMALL_ARENA, overrides, run_graph
+
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch

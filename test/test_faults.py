@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 import rclpy
 from graph_helpers import launch, overrides  # noqa: F401 - launch: a fixture
-from launch_py.dds import discovery_port
 from rclpy.node import Node
 
 from depot_manager.codec import DEPOT, DEPOT_REPORTS, DEPOT_STATE, RADIO, RADIO_TOPIC
 from depot_manager.protocol import DepotReport, RadioReply, ReportKind
+from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, server_state, topics, twist
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.analysis.replay import load_odometry

@@ -12,8 +12,8 @@ import time
 from pathlib import Path
 
 import pytest
-
 from graph_helpers import SMALL_ARENA, overrides, run_graph
+
 from swarm_msgs_py import topics
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.recording import bag_info, read_bag

@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 import rclpy
 import yaml
+from graph_helpers import REPO, launch, overrides  # noqa: F401 - launch: a fixture
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
 from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_REPORTS, RADIO, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKind
-from graph_helpers import REPO, launch, overrides  # noqa: F401 - launch: a fixture
 from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, odometry, topics, twist
 from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED

@@ -28,13 +28,12 @@ import yaml
 from rosbags.typesys import Stores, get_typestore
 from websockets.sync.client import connect
 
-from swarm_msgs_py import odometry, scan
-from swarm_sim.recording import read_bag
-from swarm_sim.recording.metadata import _msgdef
-
 from swarm_msgs_py import clock as clock_codec
+from swarm_msgs_py import odometry, scan
 from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.nodes.ws_proxy import CLASSIC, SDK, check_port
+from swarm_sim.recording import read_bag
+from swarm_sim.recording.metadata import _msgdef
 from swarm_sim.types import Pose2D
 
 WANTED = ("/clock", "/robot_0/odom", "/robot_1/scan", "/world/markers", "/center/markers")
@@ -235,9 +234,9 @@ def test_a_busy_port_is_named_before_anything_starts(tmp_path):
 
 def test_the_shipped_layouts_are_the_ones_the_code_builds():
     from swarm_sim.nodes.foxglove_layout import (
+        FOXGLOVE_SCRIPTS,
         LAYOUT_FILE,
         LICHTBLICK_FILE,
-        FOXGLOVE_SCRIPTS,
         STUDIO_SCRIPTS,
         TOTALS,
         build_layout,

@@ -8,10 +8,10 @@ import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter_client import AsyncParameterClient
+from test_nodes import SMALL
 
 from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig
-from test_nodes import SMALL
 
 
 def _spin_until(executor, future, timeout=20.0):

@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from depot_manager.server import DOCK_COLOUR
-from swarm_sim.analysis.cli import main as analyze
 from swarm_sim.analysis import video_canvas
+from swarm_sim.analysis.cli import main as analyze
 from swarm_sim.analysis.video import SIZE_PX, WIDTH_PX, render_video, save_frame
 from swarm_sim.scenario import load_scenario
 

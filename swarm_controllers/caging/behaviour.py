@@ -42,13 +42,13 @@ import numpy as np
 
 from swarm_controllers.caging import geometry
 from swarm_controllers.caging.config import CagingConfig
+from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.motion import Formation, GoTo, Limits, Motion, Neighbour, Spin
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
-from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
-from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.task import OBJECT
 from swarm_controllers.caging.world_config import TransportConfig
+from swarm_sim.scenario import Scenario
+from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
 
 Point = tuple[float, float]
 

@@ -16,11 +16,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from swarm_controllers.caging.task import CagingSense
 from swarm_msgs_py.cdr import Reader, Writer, codec
 from swarm_msgs_py.diagnostics import OK, decode_diagnostics, encode_diagnostics
 from swarm_msgs_py.diagnostics import TYPE_NAME as DIAGNOSTICS
 from swarm_msgs_py.sensing import SenseTopic, Sensing, StateTopic
-from swarm_controllers.caging.task import CagingSense
 
 PROXIMITY = "proximity"
 BODIES = "bodies"

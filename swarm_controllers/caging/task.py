@@ -37,13 +37,13 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-from swarm_sim.world.bullet import pybullet as p
 
+from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.world_config import TransportConfig
 from swarm_sim.geometry import yaw_to_quaternion
 from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import Pose2D
-from swarm_controllers.caging.landmarks import landmarks
-from swarm_controllers.caging.world_config import TransportConfig
+from swarm_sim.world.bullet import pybullet as p
 
 if TYPE_CHECKING:
     from swarm_sim.world.core import World

@@ -92,9 +92,9 @@ from math import remainder
 
 import numpy as np
 
-from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.cpfa.config import CpfaConfig
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.motion import Avoidance, Drive, drive_for
 from swarm_sim.messaging import per_inbox
 from swarm_sim.registry import delivery_zones

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import struct
 
+from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_msgs_py.cdr import (
     ENCAPSULATION,
     align,
@@ -16,7 +17,6 @@ from swarm_msgs_py.cdr import (
     skip_header,
     split_stamp,
 )
-from swarm_controllers.cpfa.messages import PheromoneMessage
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
 PHEROMONES_TOPIC = "/nest/pheromones"

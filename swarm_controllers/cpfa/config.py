@@ -10,7 +10,6 @@ from typing import ClassVar, Literal
 
 from swarm_sim.scenario import ScenarioError, Section
 
-
 CPFA_PARAMETER_SETS: dict[str, dict[str, float]] = {
     "beyond_pheromones": {
         "probability_of_switching_to_searching": 0.045,

@@ -37,7 +37,6 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.avoidance import ray_angles, ray_window
-from swarm_controllers.motion import drive_for
 from swarm_controllers.drtm.config import NestConfig, ThresholdConfig
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_controllers.drtm.response_threshold import (
@@ -48,6 +47,7 @@ from swarm_controllers.drtm.response_threshold import (
     stimulus,
     traffic_flow_density,
 )
+from swarm_controllers.motion import drive_for
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
 

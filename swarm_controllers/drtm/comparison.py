@@ -18,7 +18,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-
 from swarm_controllers.drtm.config import NestConfig
 from swarm_sim.compare.comparison import Comparison, Headline
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table

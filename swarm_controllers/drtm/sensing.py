@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import struct
 
+from swarm_controllers.drtm.task import NestSense
 from swarm_msgs_py import gripper, resources, topics
 from swarm_msgs_py.cdr import CATCH, ENCAPSULATION, align, failure, frames_fragment, skip_header, split_stamp
 from swarm_msgs_py.sensing import SenseTopic, Sensing
-from swarm_controllers.drtm.task import NestSense
 
 LIGHT = "light"
 """Relative topic name of the light sense."""

@@ -57,11 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
-from swarm_controllers.spiral.state import RegionView
-from swarm_sim.inbound import Reason, Rejections
-from swarm_sim.protocol import Drawing, Lines
 from swarm_controllers.spiral.geometry import (
     SpiralPath,
     mdbsa_leg_steps,
@@ -69,7 +65,11 @@ from swarm_controllers.spiral.geometry import (
     region_side,
     segments_overlap_collinear,
 )
+from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.regions import RegionConfig
+from swarm_controllers.spiral.state import RegionView
+from swarm_sim.inbound import Reason, Rejections
+from swarm_sim.protocol import Drawing, Lines
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, RobotId, robot_index
 

@@ -14,10 +14,10 @@ Besides its messages the center publishes (`OUTPUTS`) the regions' walkers and p
 
 from swarm_controllers.spiral.center import draw
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
+from swarm_controllers.spiral.state import decode_center_state, encode_center_state
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState
-from swarm_controllers.spiral.state import decode_center_state, encode_center_state
 
 CENTER_REPORTS = "/center/reports"
 CENTER_ASSIGNMENTS = "/center/assignments"

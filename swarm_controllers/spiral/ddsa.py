@@ -89,8 +89,8 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.avoidance import ray_angles
-from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.motion import Drive, drive_for
+from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.geometry import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
 from swarm_sim.types import (

@@ -78,12 +78,12 @@ from enum import Enum
 
 import numpy as np
 
+from swarm_controllers.motion import drive_for
 from swarm_controllers.spiral.center import region_paths
-from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.ddsa import LaneAvoidance
-from swarm_controllers.motion import drive_for
 from swarm_controllers.spiral.geometry import SpiralPath
+from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones

@@ -17,11 +17,11 @@ from typing import Any
 
 import numpy as np
 
+from swarm_msgs_py import topics
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.analysis.video import resource_points
-from swarm_msgs_py import topics
 from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.registry import Panel
 from swarm_sim.scenario import Scenario, scenario_from_dict

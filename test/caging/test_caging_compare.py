@@ -3,8 +3,14 @@ paper's numbers (synthetic rows; the sweep itself is the batch runner's)."""
 
 from __future__ import annotations
 
+from swarm_controllers.caging.comparison import (
+    CELLS,
+    caging_headlines,
+    caging_plans,
+    caging_tables_md,
+    write_caging_report,
+)
 from swarm_sim.compare import comparisons
-from swarm_controllers.caging.comparison import CELLS, caging_headlines, caging_plans, caging_tables_md, write_caging_report
 from swarm_sim.scenario import load_scenario
 
 

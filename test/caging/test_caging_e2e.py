@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 from graph_helpers import overrides, run_graph
 
+from swarm_controllers.caging.codec import CAGING
 from swarm_controllers.caging.metrics import polyline_length
 from swarm_controllers.caging.protocol import MESSAGE_TYPES, Oriented, Positioned, Reached, Recruitment, Summon
-from swarm_controllers.caging.codec import CAGING
 from swarm_msgs_py.diagnostics import decode_diagnostics
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run

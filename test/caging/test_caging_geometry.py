@@ -10,8 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from swarm_controllers.caging import geometry
-from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_controllers.caging.landmarks import landmarks
+from swarm_sim.scenario import ScenarioError, load_scenario
 
 W, R, C, EPS = 0.13, 0.3, 0.01, 0.01
 """Khepera III width, the paper's object radius, c of Table 1, our epsilon."""

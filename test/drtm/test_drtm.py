@@ -18,9 +18,9 @@ from swarm_controllers.drtm.response_threshold import (
     stimulus,
     traffic_flow_density,
 )
+from swarm_controllers.drtm.task import NestSense
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.types import Observation, Pose2D
-from swarm_controllers.drtm.task import NestSense
 
 # ------------------------------------------------------------------ eqs. (2)-(7) by hand
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from swarm_sim.compare.cli import main
 from swarm_controllers.drtm.comparison import (
     DRTM_CONDITIONS,
     PAPER,
@@ -14,6 +13,7 @@ from swarm_controllers.drtm.comparison import (
     drtm_plans,
     write_drtm_report,
 )
+from swarm_sim.compare.cli import main
 from swarm_sim.compare.stats import mean_series
 from swarm_sim.scenario import load_scenario, scenario_to_dict
 

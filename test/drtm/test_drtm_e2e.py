@@ -5,8 +5,8 @@ bag gives the same DRTM measures as the in-process batch run of the same seed.""
 from __future__ import annotations
 
 import yaml
-
 from graph_helpers import overrides, run_graph
+
 from swarm_controllers.drtm.codec import NEST, NEST_REPORTS, NEST_STATE
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_sim.analysis.metrics import summarize

@@ -4,10 +4,11 @@ bag gives the same metrics as the in-process batch run of the same seed."""
 
 from __future__ import annotations
 
+from graph_helpers import run_graph
+
 from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_MARKERS, DEPOT_REPORTS, DEPOT_STATE, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
 from depot_manager.state import queue_lengths
-from graph_helpers import run_graph
 from swarm_msgs_py import server_state, topics
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run

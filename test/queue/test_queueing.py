@@ -15,7 +15,14 @@ from hypothesis import strategies as st
 from depot_manager.config import QueueConfig
 from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
 from swarm_controllers.avoidance import ray_angles
-from swarm_controllers.queue.behaviour import BRAKE_CONE, BRAKE_RANGE, KEEP_OUT_BAND, Phase, QueueBehaviour, _segment_hits_disc
+from swarm_controllers.queue.behaviour import (
+    BRAKE_CONE,
+    BRAKE_RANGE,
+    KEEP_OUT_BAND,
+    Phase,
+    QueueBehaviour,
+    _segment_hits_disc,
+)
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
@@ -128,8 +135,8 @@ def test_perimeter_delay_covers_the_drop_off(run):
 
 def test_replies_and_grants_naming_slots_that_do_not_exist_are_dropped():
     from depot_manager.protocol import DepotGrant, RadioReply
-    from swarm_sim.scenario import load_scenario
     from swarm_sim.registry import make_behaviour
+    from swarm_sim.scenario import load_scenario
 
     s = load_scenario("queue_qmt", ["robots.count=2"])
     b = make_behaviour(s, "robot_0", np.random.default_rng(0))

@@ -8,8 +8,8 @@ issue 11: pick-up at the 0.13 m detection range)."""
 from __future__ import annotations
 
 import numpy as np
-
 from graph_helpers import run_graph
+
 from swarm_controllers.spiral.codec import CENTER, CENTER_ASSIGNMENTS, CENTER_MARKERS, CENTER_REPORTS, CENTER_STATE
 from swarm_controllers.spiral.geometry import region_centers, region_side
 from swarm_controllers.spiral.protocol import RegionAssignment
