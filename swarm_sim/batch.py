@@ -123,7 +123,7 @@ def _run_batch(scenario: Scenario, record_poses: bool) -> BatchRun:
             # Each behaviour's inbox: every message stamped before this tick has been posted (the
             # robots' and servers' of the last tick); every robot gets the same tuple.
             inbox = router.take_before(ROBOTS, world.t_ns)
-            seen = with_messages(obs.values(), inbox) if inbox else obs.values()
+            seen = obs.values() if not inbox else [with_messages(o, inbox) for o in obs.values()]
             answers = list(map(call, steps, seen))  # the world's dict is in robot order
             if rule_log is not None:
                 t_ns = world.t_ns
