@@ -146,6 +146,11 @@ class Avoidance(Protocol):
 class Drive(Protocol):
     """A robot model's motion layer (see the module docstring)."""
 
+    blind_legs: bool
+    """A move, once started, runs to its end whatever the behaviour asks meanwhile (the CPFA
+    lineage's stop-turn-go): a behaviour that must keep its path off an area decides so before
+    the move starts, from any distance, as the queue authors' ``IsPathThroughRedCircle`` does."""
+
     def begin(self, stamp_ns: int) -> None: ...
 
     def to_point(self, x: float, y: float, yaw: float, tx: float, ty: float) -> tuple[float, float]: ...
@@ -163,6 +168,7 @@ class ContinuousDrive:
     so `begin` does nothing and `hold` drives on whatever `ahead` says."""
 
     __slots__ = ("limits", "scenario")
+    blind_legs = False
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator | None = None) -> None:
         self.scenario = scenario

@@ -105,6 +105,10 @@ _TWO_PI = 2.0 * math.pi
 _IDLE = (0.0, 0.0)
 """A state's twist when it stands still, or when the avoidance drives and nobody reads it."""
 _FOUR_PI = 4.0 * math.pi
+RIM_MARGIN = 0.1
+"""[m] outside the perimeter, where a non-carrier's give-up return ends on a robot whose legs run
+blind (`swarm_controllers.motion.Drive.blind_legs`): the queue authors' ``safeDistance =
+redCircleRadius + 0.1`` (Tameem786/Collision_Free_CPFA, ``CPFA_controller::Searching``)."""
 _LEG_REDRAWS = 8
 _SITE_REDRAWS = 16
 
@@ -191,7 +195,7 @@ class CpfaBehaviour:
         "_heading", "_hold", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
         "_leg_x", "_leg_y", "_mode", "_nest", "_nest_r2", "_omega", "_to_point",
         "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
-        "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
+        "_rim", "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
         "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
         "_threshold", "_trips", "_update_avoidance", "robot",
     )
@@ -241,6 +245,10 @@ class CpfaBehaviour:
         self._bound = half - margin if half > margin else half / 2.0
         self._site_clearance2 = (nest_radius + margin) ** 2
         self._keep_out2 = -1.0 if keep_out is None else keep_out**2
+        self._rim = scenario.depot.perimeter_radius + RIM_MARGIN if keep_out is not None and self._drive.blind_legs \
+            else 0.0
+        """[m] where a give-up return's blind leg ends (0: it aims at the centre and arrives at the
+        keep-out radius, re-aiming on the way)."""
         docks_mode = keep_out is None and scenario.depot.delivery == "docks"
         self._docks = [z.center for z in delivery_zones(scenario)] if docks_mode else []
         """Dock stops a carrier returns to: the zones the docks delivery implies [m, world frame]
@@ -454,6 +462,9 @@ class CpfaBehaviour:
             return self._departing(obs, steering)
         if d2 < self._arrival2 or not steering:
             return _IDLE  # at the centre, waiting for the drop (or the avoidance drives)
+        if self._rim and not self._carrying:  # a blind leg to the centre would cross the perimeter
+            k = self._rim / math.sqrt(d2)
+            return self._to_point(x, y, pose.yaw, nx + (x - nx) * k, ny + (y - ny) * k)
         return self._to_point(x, y, pose.yaw, nx, ny)
 
     # ------------------------------------------------------------------ events

@@ -142,7 +142,7 @@ class QueueBehaviour:
     __slots__ = (
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
-        "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
+        "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
         "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
@@ -164,6 +164,9 @@ class QueueBehaviour:
         self._tail = queue.joining == "tail"
         self._keep_out = self._R + KEEP_OUT_BAND
         """Non-carriers stay outside this radius about the depot centre [m]."""
+        self._detour_far = self._drive.blind_legs
+        """Check a non-carrier's path against the disc from any distance, not only near it: a
+        blind leg started far out would cross the perimeter (``_forage``)."""
         self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, drive=self._drive)
         self._cpfa_step = self._cpfa.step
         self._avoid = self._drive.avoidance(0.1)
@@ -349,7 +352,7 @@ class QueueBehaviour:
         command = self._cpfa_step(obs)
         if out:  # radio replies of this tick go out first
             command = new_command(command.linear, command.angular, (*out, *command.messages))
-        if self._carrying or r > self._keep_out:
+        if self._carrying or (r > self._keep_out and not self._detour_far):
             return command
         messages = command.messages
         cx, cy = self._center

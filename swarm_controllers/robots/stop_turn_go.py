@@ -80,6 +80,8 @@ class StopTurnGo:
         "_next", "_request", "_ring", "_rng", "_stamp", "_state", "_step", "_v", "_w", "_wheel_cm",
         "active", "events",
     )
+    blind_legs = True
+    """A FORWARD move runs its whole distance (see the module docstring)."""
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator | None = None) -> None:
         r = scenario.robots

@@ -47,6 +47,8 @@ class WheelTurning:
         "_collided", "_delta", "_dt", "_hard", "_looked", "_max", "_mech", "_next", "_none", "_override",
         "_ring", "_soft", "_stamp", "_straight", "active", "events",
     )
+    blind_legs = False
+    """The example's robots re-aim at every step."""
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator | None = None) -> None:
         cfg = scenario.robots.wheel_turning

@@ -9,6 +9,7 @@ from unittest import mock
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -25,7 +26,6 @@ from swarm_controllers.queue.behaviour import (
 )
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
-from swarm_sim.scenario import load_scenario
 from swarm_sim.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
@@ -33,9 +33,15 @@ ROBOTS = 16
 DURATION = 150.0
 
 
-@pytest.fixture(scope="module", params=["queue_qse", "queue_qst", "queue_qme", "queue_qmt"])
+@pytest.fixture(scope="module", params=[(name, model) for name in ("queue_qse", "queue_qst", "queue_qme", "queue_qmt")
+                                         for model in ("footbot_cpfa", "generic")], ids="-".join)
 def run(request):
-    scenario = load_scenario(request.param, [f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])
+    """Each queue scenario on the authors' foot-bot (as shipped) and on the generic robot; the
+    foot-bot's stop-turn-go legs deliver later (150 s: 1, 1 and 6 resources for Q_ST, Q_ME and
+    Q_MT), so it runs twice as long."""
+    name, model = request.param
+    duration = DURATION if model == "generic" else 2 * DURATION
+    scenario = generic_scenario(name, [f"robots.model={model}", f"robots.count={ROBOTS}", f"sim.duration={duration}"])
     return scenario, run_batch(scenario, record_poses=True)
 
 
@@ -49,7 +55,7 @@ def test_deliveries_happen_at_docks_only(run):
     assert summary["deliveries_outside_docks"] == 0
     assert all(d.zone.startswith("dock_") for d in result.trace.drops)
     for d in summary["dropoff_times_s"]:
-        assert 0.0 <= d < DURATION  # perimeter entry to dock arrival (before T_unload)
+        assert 0.0 <= d < scenario.sim.duration  # perimeter entry to dock arrival (before T_unload)
 
 
 def test_only_carriers_enter_the_perimeter(run):
@@ -86,7 +92,7 @@ def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
     from depot_manager.protocol import RadioQuery
 
     for name, expect in (("queue_qmt", True), ("queue_qme", False)):
-        scenario = load_scenario(name, [f"robots.count={ROBOTS}", "sim.duration=120"])
+        scenario = generic_scenario(name, [f"robots.count={ROBOTS}", "sim.duration=120"])
         seen = []
         import swarm_sim.batch as batch
 
@@ -106,7 +112,7 @@ def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
 
 
 def test_a_non_carrier_is_steered_out_of_the_perimeter():
-    scenario = load_scenario("queue_qmt", ["robots.count=1"])
+    scenario = generic_scenario("queue_qmt", ["robots.count=1"])
     b = QueueBehaviour(scenario, "robot_0", np.random.default_rng(0))
     from swarm_sim.types import Observation, Pose2D
 
@@ -136,9 +142,8 @@ def test_perimeter_delay_covers_the_drop_off(run):
 def test_replies_and_grants_naming_slots_that_do_not_exist_are_dropped():
     from depot_manager.protocol import DepotGrant, RadioReply
     from swarm_sim.registry import make_behaviour
-    from swarm_sim.scenario import load_scenario
 
-    s = load_scenario("queue_qmt", ["robots.count=2"])
+    s = generic_scenario("queue_qmt", ["robots.count=2"])
     b = make_behaviour(s, "robot_0", np.random.default_rng(0))
     b._phase = Phase.SEEKING
     ranges = np.full(24, np.inf, dtype=np.float32)
@@ -154,9 +159,8 @@ def test_replies_and_grants_naming_slots_that_do_not_exist_are_dropped():
 def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
     from depot_manager.protocol import DepotReport, ReportKind
     from depot_manager.server import DepotServer
-    from swarm_sim.scenario import load_scenario
 
-    server = DepotServer(load_scenario("queue_qmt", ["robots.count=4"]))
+    server = DepotServer(generic_scenario("queue_qmt", ["robots.count=4"]))
     out = server.step(10**9, [DepotReport(0, f"robot_{900 + k}", ReportKind.JOIN, "entry_line_0", k) for k in range(4)])
     assert out == () and server.admission.robots_inside == ()
     assert server.rejections.counts == {("DepotReport", "unknown robot"): 4}
@@ -167,7 +171,7 @@ def test_dropoff_time_stops_at_the_dock_before_t_unload():
     from swarm_sim.analysis.metrics import RunTrace
     from swarm_sim.types import DropEvent
 
-    s = load_scenario("queue_qmt")
+    s = generic_scenario("queue_qmt")
     drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)
     trace = RunTrace("queue_qmt", 0, ("robot_0",), 120.0, 1.0, 320, "batch", drops=[drop], config=s,
                      probes={PROBE: Crossings(entries={"robot_0": [10.0, 40.0]})})
@@ -196,7 +200,7 @@ _queue_messages = st.lists(st.one_of(
 def _handled(phase, messages, join, line, cell, *, read_all: bool):
     """Command and state of robot_0 at (1, 0) after a step with `messages` (or, read_all, after
     the reference: every message read)."""
-    s = load_scenario("queue_qmt", ["robots.count=3"])
+    s = generic_scenario("queue_qmt", ["robots.count=3"])
     b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
     b._phase, b._join, b._line, b._cell = phase, join, line, cell
     ranges = np.full(24, np.inf, dtype=np.float32)
@@ -241,7 +245,7 @@ def test_message_handling_skips_only_what_cannot_matter_for_any_inbox(phase, mes
 
 @pytest.mark.parametrize("name", ["queue_qse", "queue_qmt"])
 def test_the_slots_looked_up_every_tick_are_the_managers_cells(name):
-    b = QueueBehaviour(load_scenario(name), "robot_0", np.random.default_rng(0))
+    b = QueueBehaviour(generic_scenario(name), "robot_0", np.random.default_rng(0))
     assert b._slots.keys() == b._cells.keys()
     for line, cells in b._cells.items():
         assert b._slots[line] == [(float(x), float(y)) for x, y in cells]
@@ -251,7 +255,7 @@ def test_the_slots_looked_up_every_tick_are_the_managers_cells(name):
 def _queued_robot() -> tuple[QueueBehaviour, Pose2D]:
     """robot_0 queued at slot 1 of entry_line_0, granted slot 3, facing slot 2 from 5 cm short
     of it: it drives on unless it brakes."""
-    b = QueueBehaviour(load_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
+    b = QueueBehaviour(generic_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
     b._phase, b._line, b._cell, b._grant = Phase.QUEUED, "entry_line_0", 1, ("entry_line_0", 3)
     (x1, y1), (x2, y2) = b._slots["entry_line_0"][1:3]
     yaw = math.atan2(y2 - y1, x2 - x1)
@@ -266,7 +270,7 @@ def test_a_queued_robot_brakes_as_the_float32_scan_compares(ranges):
     compared with BRAKE_RANGE did (numpy compares a float32 with a Python float in float32)."""
     b, pose = _queued_robot()
     scan = np.asarray(ranges, dtype=np.float32)
-    cone = [i for i, a in enumerate(ray_angles(load_scenario("queue_qmt").sensors.scan)) if abs(a) <= BRAKE_CONE]
+    cone = [i for i, a in enumerate(ray_angles(generic_scenario("queue_qmt").sensors.scan)) if abs(a) <= BRAKE_CONE]
     brakes = bool(min(scan[i] for i in cone) < BRAKE_RANGE)  # the reference: numpy's comparison
     command = b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True)))
     assert (command.linear == 0.0) == brakes
@@ -287,7 +291,7 @@ def test_a_robot_that_lost_its_resource_on_the_way_reports_unloaded_at_its_dock(
     dock would wait for it forever); one that drops on the way reports nothing there."""
     from depot_manager.protocol import DepotReport, ReportKind
 
-    b = QueueBehaviour(load_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
+    b = QueueBehaviour(generic_scenario("queue_qmt"), "robot_0", np.random.default_rng(0))
     (dock_line, dock_cell), = [d for d in b._docks if d[0] == "entry_line_0"]
     b._phase, b._line, b._cell, b._grant = Phase.QUEUED, dock_line, dock_cell - 2, (dock_line, dock_cell)
     b._carrying = True
