@@ -3,14 +3,14 @@
 import math
 
 import numpy as np
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from swarm_sim.scenario import load_scenario
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import scan_angles
 
-SCENARIO = load_scenario("queue_cpfa")
+SCENARIO = generic_scenario("queue_cpfa")
 RING = ProximityRing(SCENARIO)
 BODY = SCENARIO.robots.diameter / 2
 RAYS = SCENARIO.sensors.scan.rays

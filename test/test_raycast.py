@@ -7,11 +7,12 @@ import math
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_sim.registry import task_factory
-from swarm_sim.scenario import ObstacleConfig, ScanConfig, load_scenario
+from swarm_sim.scenario import ObstacleConfig, ScanConfig
 from swarm_sim.types import Pose2D
 from swarm_sim.world import World
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, nearest_hits, scan_angles
@@ -343,7 +344,7 @@ def _world_with(scene: StaticScene, n: int, rays: int, backend: str = "analytic"
     cylinders = [ObstacleConfig("cylinder", (x, y), (2 * r, 2 * r)) for x, y, r in scene.circles]
     boxes = [ObstacleConfig("box", (x, y), (2 * hx, 2 * hy), yaw) for x, y, hx, hy, yaw in scene.boxes]
     obstacles = (*cylinders, *boxes)
-    s = load_scenario("cpfa", robots__count=n, sensors__scan__rays=rays, sensors__scan__backend=backend)
+    s = generic_scenario("cpfa", robots__count=n, sensors__scan__rays=rays, sensors__scan__backend=backend)
     s = dataclasses.replace(s, obstacles=obstacles)
     return World(s, task_factory(s))
 
@@ -387,7 +388,7 @@ def test_world_observations_use_the_configured_backend():
     """The world's own tick-0 scans with either backend (same seed, so the same start)."""
     out, poses = {}, None
     for backend in ("analytic", "pybullet"):
-        s = load_scenario("cpfa", robots__count=9, sensors__scan__backend=backend)
+        s = generic_scenario("cpfa", robots__count=9, sensors__scan__backend=backend)
         with World(s, task_factory(s)) as w:
             out[backend] = np.stack([o.ranges for o in w.reset().values()])
             poses = list(w.true_poses().values())
@@ -404,7 +405,7 @@ def test_world_observations_use_the_configured_backend():
 
 
 def test_pybullet_threads_do_not_change_the_scan():
-    s = load_scenario("cpfa", robots__count=16, sensors__scan__backend="pybullet")
+    s = generic_scenario("cpfa", robots__count=16, sensors__scan__backend="pybullet")
     one, two = World(s, task_factory(s), scan_threads=1), World(s, task_factory(s), scan_threads=2)
     try:
         a, b = one.reset(), two.reset()

@@ -18,6 +18,7 @@ import pytest
 from swarm_controllers.motion import ContinuousDrive, drive_for
 from swarm_controllers.robots.stop_turn_go import PLAN_TIME, StopTurnGo
 from swarm_controllers.robots.wheel_turning import WheelTurning
+from swarm_sim import registry
 from swarm_sim.registry import task_factory
 from swarm_sim.robots import footbot
 from swarm_sim.scenario import ScenarioError, load_scenario, scenario_from_dict, scenario_to_dict
@@ -58,7 +59,7 @@ def test_a_platform_model_writes_its_body_speeds_and_ring_into_the_scenario():
 
     degrees = sorted(round(math.degrees(a) % 360, 6) for a in ray_angles(s.sensors.scan))
     assert degrees == [7.5 + 15 * k for k in range(24)]  # the foot-bot's sensor directions
-    generic = load_scenario("cpfa")
+    generic = load_scenario("cpfa", ["robots.model=generic"])
     assert (generic.robots.model, generic.robots.diameter, generic.robots.planar) == ("generic", 0.17, False)
     assert scenario_from_dict(scenario_to_dict(s)) == s  # bag metadata reads back the same robot
 
@@ -81,13 +82,23 @@ def test_the_foraging_foot_bot_sees_the_light_everywhere_and_food_under_its_grou
 ])
 def test_bad_robot_keys_are_refused_naming_the_key(overrides, message):
     with pytest.raises(ScenarioError) as error:
-        load_scenario("cpfa", overrides)
+        load_scenario("cpfa", ["robots.model=generic", *overrides])
     assert str(error.value).startswith(message)
 
 
 def test_a_platform_value_can_be_varied_alone():
     s = _scenario("footbot_cpfa", "robots.platform.max_linear_speed=0.3", "robots.planar=false")
     assert (s.robots.max_linear_speed, s.robots.diameter, s.robots.planar) == (0.3, 2 * 0.085036758, False)
+
+
+def test_the_papers_scenarios_run_on_their_authors_robots():
+    """Every shipped scenario's robot is its algorithm's authors' robot, but for the DRTM paper's
+    real-robot experiment (the e-puck scenarios), and each one also runs on the generic robot."""
+    for name in registry.scenario_files():
+        s = load_scenario(name)
+        want = "generic" if name.startswith("drtm_epuck") else registry.of(s).authors_robot
+        assert s.robots.model == want, name
+        assert load_scenario(name, ["robots.model=generic"]).robots.model == "generic"
 
 
 def test_drive_for_gives_each_model_its_motion_layer():
@@ -213,7 +224,7 @@ def test_argos_robots_start_with_their_centres_in_the_nest():
         assert np.all(np.hypot(*p.T) <= s.depot.radius)
         gaps = np.hypot(*(p[:, None] - p[None]).transpose(2, 0, 1))[np.triu_indices(len(p), 1)]
         assert gaps.min() >= s.robots.diameter
-    g = load_scenario("drtm_l3")
+    g = load_scenario("drtm_l3", ["robots.model=generic"])
     assert depot_start_room(g) == g.depot.radius - g.robots.diameter / 2
 
 

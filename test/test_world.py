@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -19,7 +20,6 @@ from swarm_sim.scenario import (
     ObstacleConfig,
     Scenario,
     ScenarioError,
-    load_scenario,
 )
 from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
 from swarm_sim.world import World
@@ -28,7 +28,7 @@ from swarm_sim.world.observations import with_messages
 
 
 def scenario(robots: int = 4, **fields) -> Scenario:
-    return load_scenario("cpfa", robots__count=robots, **fields)
+    return generic_scenario("cpfa", robots__count=robots, **fields)
 
 
 @pytest.fixture
@@ -189,7 +189,7 @@ def test_odometry_poses_are_the_unrounded_observation_poses(make_world):
 
 
 def test_robots_start_on_a_grid_around_the_depot(make_world):
-    s = load_scenario("cpfa", robots__count=9, robots__start_spacing=0.4, depot__center=[1.0, -2.0])
+    s = generic_scenario("cpfa", robots__count=9, robots__start_spacing=0.4, depot__center=[1.0, -2.0])
     w = make_world(s)
     xy = sorted((round(q.x, 6), round(q.y, 6)) for q in w.true_poses().values())
     want = sorted((1.0 + 0.4 * a, -2.0 + 0.4 * b) for a in (-1, 0, 1) for b in (-1, 0, 1))
@@ -300,7 +300,7 @@ def test_resources_in_reach_by_cells_are_those_of_testing_every_pair(seed, robot
     import swarm_sim.world.tasks.foraging as foraging
 
     rng = np.random.default_rng(seed)
-    s = load_scenario("cpfa", robots__count=robots, arena__size=6.0, depot__radius=0.3,
+    s = generic_scenario("cpfa", robots__count=robots, arena__size=6.0, depot__radius=0.3,
                       resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
     with World(s, task_factory(s)) as w:
         w.teleport({r: Pose2D(*rng.uniform(-3.5, 3.5, 2), 0.0) for r in w.robots})  # the arena: +-3 m
@@ -500,7 +500,7 @@ def test_a_missing_robot_keeps_its_previous_command(make_world):
 
 
 def test_an_impossible_layout_raises_naming_the_key():
-    s = load_scenario("cpfa", robots__count=1, arena__size=3.0)  # five 8 x 8 clusters do not fit
+    s = generic_scenario("cpfa", robots__count=1, arena__size=3.0)  # five 8 x 8 clusters do not fit
     with pytest.raises(ScenarioError, match="resources.clusters"):
         World(s, task_factory(s))
 
@@ -518,7 +518,7 @@ def test_unknown_robot_id_raises_naming_it(make_world):
 
 
 def test_noisy_odometry_drifts_from_the_truth_deterministically(make_world):
-    s = load_scenario("cpfa", robots__count=2)
+    s = generic_scenario("cpfa", robots__count=2)
     s = dataclasses.replace(s, robots=dataclasses.replace(s.robots, odometry_noise=NoiseConfig(0.1, 0.1)))
     runs = []
     for _ in range(2):
@@ -551,7 +551,7 @@ def run(w: World, ticks: int, seed: int):
 
 
 def test_same_seed_same_commands_identical_observations(make_world):
-    s = load_scenario("cpfa", robots__count=12)
+    s = generic_scenario("cpfa", robots__count=12)
     noise = NoiseConfig(linear_std=0.05, angular_std=0.05)
     s = dataclasses.replace(
         s,
@@ -573,7 +573,7 @@ def test_robots_stay_in_the_arena_and_apart(seed, robots):
     """Random driving in a small arena. A body moves up to one substep's travel into another
     before pybullet sees the contact and pushes it back: 0.16 m/s x 0.05 s = 8 mm into a wall,
     twice that between two robots closing head-on (or a robot pushed into a wall)."""
-    s = load_scenario(
+    s = generic_scenario(
         "cpfa", robots__count=robots, arena__size=2.0, depot__radius=0.3,
         resources__distribution="uniform", resources__count=10, resources__min_depot_clearance=0.1,
     )
@@ -590,7 +590,7 @@ def test_robots_stay_in_the_arena_and_apart(seed, robots):
 
 
 def test_reset_replays_the_run(make_world):
-    w = make_world(load_scenario("cpfa", robots__count=6))
+    w = make_world(generic_scenario("cpfa", robots__count=6))
     first = run(w, 50, seed=2)
     second = run(w, 50, seed=2)
     assert first == second
@@ -640,7 +640,7 @@ def trajectory(s: Scenario, seed: int, ticks: int, always_set: bool) -> list:
 @given(seed=st.integers(0, 2**31), robots=st.integers(8, 25), arena=st.sampled_from([2.5, 3.0]))
 def test_skipping_velocities_pybullet_keeps_changes_nothing(seed, robots, arena):
     """A crowded swarm pushing, turning and stopping: bit for bit the run that sets every velocity."""
-    s = load_scenario("cpfa", robots__count=robots, arena__size=arena, depot__radius=0.3,
+    s = generic_scenario("cpfa", robots__count=robots, arena__size=arena, depot__radius=0.3,
                       resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
     skipping = trajectory(s, seed, 120, always_set=False)
     assert skipping == trajectory(s, seed, 120, always_set=True)
@@ -655,7 +655,7 @@ def _holds_what_was_set(w: World, i: int) -> bool:
 def test_pybullet_holds_exactly_the_velocities_taken_as_kept(make_world):
     """What `_velocities_kept` rests on: a robot it selects reads back, bit for bit, the velocity
     last set (and some robots it does not select do not)."""
-    s = load_scenario("cpfa", robots__count=25, arena__size=3.0, depot__radius=0.3,
+    s = generic_scenario("cpfa", robots__count=25, arena__size=3.0, depot__radius=0.3,
                       resources__distribution="uniform", resources__count=5, resources__min_depot_clearance=0.1)
     w = make_world(s)
     rng = np.random.default_rng(0)

@@ -104,14 +104,16 @@ SERIES: dict[str, str] = {
 
 def condition_overrides(condition: Condition) -> tuple[str, ...]:
     """``key=value`` overrides that turn ``drtm.yaml`` into the condition's scenario (every leaf
-    in which the two differ, but the name and the behaviour)."""
+    in which the two files differ, but the name and the behaviour). Both are compared on the
+    generic robot, whose values are the files' own: a platform model derives some (the foot-bot's
+    light range is the arena's diagonal), and those must not become overrides of another model."""
     def leaves(data: Any, prefix: str = "") -> dict[str, Any]:
         if isinstance(data, dict):
             return {k: v for key, value in data.items() for k, v in leaves(value, f"{prefix}{key}.").items()}
         return {prefix[:-1]: data}
 
-    base = leaves(scenario_to_dict(load_scenario("drtm")))
-    mine = leaves(scenario_to_dict(load_scenario(condition.scenario)))
+    base = leaves(scenario_to_dict(load_scenario("drtm", ["robots.model=generic"])))
+    mine = leaves(scenario_to_dict(load_scenario(condition.scenario, ["robots.model=generic"])))
     skip = {"name", "controller.behaviour"}
     return tuple(f"{k}={json.dumps(v)}" for k, v in sorted(mine.items()) if k not in skip and base.get(k) != v)
 

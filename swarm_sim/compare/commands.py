@@ -54,7 +54,8 @@ def common_arguments(p: argparse.ArgumentParser, out: str, *, strategies: bool =
                    help="override any scenario field for every run")
     p.add_argument("--robot-model", choices=(*known_models(), AUTHORS), metavar="NAME",
                    help=f"the robot model of every run ({', '.join(known_models())}; {AUTHORS}: each "
-                        "algorithm's authors' robot); default: each scenario's own (generic)")
+                        "algorithm's authors' robot); default: each scenario's own (the authors' robot, but for the "
+                        "DRTM paper's e-puck experiments)")
     if strategies:
         p.add_argument("--strategies", nargs="+", metavar="NAME", help="a subset of the strategies")
     mode = p.add_mutually_exclusive_group()

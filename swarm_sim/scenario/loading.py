@@ -228,7 +228,10 @@ def load_scenario(
 
 
 def _finish(scenario: Scenario) -> Scenario:
-    """The robot model's values written in (`swarm_sim.robots.apply_model`), then validated."""
+    """Validated as written, then with the robot model's values written in
+    (`swarm_sim.robots.apply_model`) and validated again: a platform model replaces some values
+    (the foot-bot's ring, say), and a bad one the file or ``--set`` gave is refused all the same."""
+    validate(scenario)
     try:
         scenario = apply_model(scenario)
     except ValueError as exc:

@@ -11,6 +11,7 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -27,11 +28,11 @@ from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.scenario import Scenario
 from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
-BASE = load_scenario("cpfa")
+BASE = generic_scenario("cpfa")
 DT_NS = BASE.dt_ns
 CLEAR = np.full(BASE.sensors.scan.rays, np.inf, dtype=np.float32)
 MAX_V = BASE.robots.max_linear_speed
@@ -593,7 +594,7 @@ def test_pheromone_fields_are_plain_python_numbers():
 
 # --------------------------------------------------------------------------- the queue paper's set-up
 
-QUEUE_CPFA = load_scenario("queue_cpfa")
+QUEUE_CPFA = generic_scenario("queue_cpfa")
 
 
 def test_queue_cpfa_carrier_heads_for_the_nearest_dock_and_stands_still_there():
@@ -614,10 +615,10 @@ def test_queue_paper_parameter_set():
     assert c.parameter_set == "queue_paper" and c.informed_search_time == "steps"
     assert c.probability_of_returning_to_nest == pytest.approx(0.0189370369448)
     assert c.uninformed_search_variation == pytest.approx(math.radians(3.67372660634))
-    bp = load_scenario("queue_cpfa", ["controller.cpfa.parameter_set=beyond_pheromones"])
+    bp = generic_scenario("queue_cpfa", ["controller.cpfa.parameter_set=beyond_pheromones"])
     assert CpfaConfig.of(bp).rate_of_site_fidelity == CpfaConfig().rate_of_site_fidelity
     with pytest.raises(ValueError, match="controller.cpfa.rate_of_site_fidelity"):
-        load_scenario("queue_cpfa", ["controller.cpfa.rate_of_site_fidelity=2.0"])
+        generic_scenario("queue_cpfa", ["controller.cpfa.rate_of_site_fidelity=2.0"])
 
 
 class _AlwaysSteering(CpfaBehaviour):
@@ -642,7 +643,7 @@ def _inner_state(b: CpfaBehaviour) -> tuple:
             b._heading, b._leg_x, b._leg_y, b._rng.bit_generator.state["state"]["state"])
 
 
-QUEUE_QMT = load_scenario("queue_qmt")
+QUEUE_QMT = generic_scenario("queue_qmt")
 
 
 @pytest.mark.parametrize(("s", "keep_out"), [(BASE, None), (QUEUE_CPFA, None), (QUEUE_QMT, QUEUE_QMT.depot.perimeter_radius + 0.25)],

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -26,7 +27,7 @@ from swarm_msgs_py.server_outputs import SeriesLog
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
 from swarm_sim.registry import task_factory
-from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import BehaviourStatus, DropEvent
 from swarm_sim.world import World
 
@@ -34,7 +35,7 @@ DT_NS = 100_000_000
 
 
 def _scenario(*extra: str):
-    return load_scenario("drtm", ["robots.count=3", *extra])
+    return generic_scenario("drtm", ["robots.count=3", *extra])
 
 
 def _report(k: int, robot: int, event: NestEvent) -> NestReport:
@@ -133,7 +134,7 @@ def test_the_light_points_at_the_nest_centre_within_its_range():
 
 @pytest.mark.parametrize("layout", ["depot_random", "depot_ring"])
 def test_start_layouts_put_every_robot_inside_the_nest(layout):
-    s = load_scenario("drtm", [f"robots.start_layout={layout}", "robots.count=30"])
+    s = generic_scenario("drtm", [f"robots.start_layout={layout}", "robots.count=30"])
     with World(s, task_factory(s)) as world:
         xy = world.positions.copy()
     room = s.depot.radius - s.robots.diameter / 2
@@ -144,13 +145,13 @@ def test_start_layouts_put_every_robot_inside_the_nest(layout):
 
 def test_impossible_start_layouts_are_refused_naming_the_key():
     with pytest.raises(ScenarioError, match="robots.count: 200 robots"):
-        load_scenario("drtm", ["robots.count=200"])
+        generic_scenario("drtm", ["robots.count=200"])
     with pytest.raises(ScenarioError, match="robots.count: 60 robots"):
-        load_scenario("drtm", ["robots.count=60", "robots.start_layout=depot_ring", "depot.radius=0.3"])
+        generic_scenario("drtm", ["robots.count=60", "robots.start_layout=depot_ring", "depot.radius=0.3"])
 
 
 def _trace(foods: list[float], drops: int, oaes: tuple[int, ...] = (4, 6)) -> RunTrace:
-    s = load_scenario("drtm", ["robots.count=2"])
+    s = generic_scenario("drtm", ["robots.count=2"])
     trace = RunTrace("drtm", 0, ("robot_0", "robot_1"), sim_seconds=0.1 * (len(foods) - 1), wall_seconds=1.0,
                      total_resources=20, mode="batch", config=s)
     trace.series["nest_food"] = [(0.1 * k, f) for k, f in enumerate(foods)]

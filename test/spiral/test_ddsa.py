@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -19,11 +20,11 @@ from swarm_sim.analysis.metrics import resources_delivered
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
-from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import STOP, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
-BASE = load_scenario("ddsa", robots__count=4)
+BASE = generic_scenario("ddsa", robots__count=4)
 DT = BASE.sim.dt
 DT_NS = BASE.dt_ns
 CLEAR = np.full(BASE.sensors.scan.rays, np.inf, dtype=np.float32)
@@ -69,9 +70,9 @@ def test_registered_and_config_defaults():
     assert "ddsa" in known_behaviours()
     assert BASE.controller.behaviour == "ddsa"
     assert SpiralConfig.of(BASE) == SpiralConfig(gap=0.18, arena_margin=0.2)
-    assert SpiralConfig.of(load_scenario("cpfa")) == SpiralConfig()
+    assert SpiralConfig.of(generic_scenario("cpfa")) == SpiralConfig()
     with pytest.raises(ScenarioError, match="controller.spiral.gap"):
-        load_scenario("ddsa", ["controller.spiral.gap=0"])
+        generic_scenario("ddsa", ["controller.spiral.gap=0"])
 
 
 def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():
@@ -130,7 +131,7 @@ def test_steers_to_a_seen_resource_then_returns_when_carrying_and_resumes_at_the
 def test_done_at_the_end_stops_there_and_keeps_avoiding_in_place():
     """The authors' DDSA stops where its pattern ends (IDLE; Stop()) and still runs its
     collision avoidance every tick: it turns in place, never drives off (issue 11)."""
-    small = load_scenario("ddsa", robots__count=1, arena__size=2.4,
+    small = generic_scenario("ddsa", robots__count=1, arena__size=2.4,
                           resources__clusters=1, resources__count=16)
     b = behaviour(small, "robot_0")
     u = Unicycle(0.0, 0.0, 0.0)
@@ -156,7 +157,7 @@ def test_done_at_the_end_stops_there_and_keeps_avoiding_in_place():
 
 
 def test_done_robot_that_picks_something_up_delivers_it_and_returns_to_its_path_end():
-    small = load_scenario("ddsa", robots__count=1, arena__size=2.4,
+    small = generic_scenario("ddsa", robots__count=1, arena__size=2.4,
                           resources__clusters=1, resources__count=16)
     b = behaviour(small, "robot_0")
     u = Unicycle(0.0, 0.0, 0.0)
@@ -260,7 +261,7 @@ def test_batch_run_delivers_and_searchers_keep_to_their_own_lanes(monkeypatch):
     max 0.33 m off the path (0.002, 0.015, 0.04 m with only the depot and clearance reverted)."""
     import swarm_sim.batch as batch
 
-    full = load_scenario("ddsa", ["depot.radius=0.5", "resources.min_depot_clearance=1.0",
+    full = generic_scenario("ddsa", ["depot.radius=0.5", "resources.min_depot_clearance=1.0",
                                   "sensors.pickup_radius=0.05", "resources.distribution=clustered",
                                   "resources.clusters=10", "resources.cluster_side=4",
                                   "resources.spacing=0.1"])

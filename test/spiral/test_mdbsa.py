@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -36,16 +37,16 @@ from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour
-from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.scenario import ScenarioError
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.world.tasks.foraging import ForagingSense
 
-C = load_scenario("mdbsa_c")
-D = load_scenario("mdbsa_d")
+C = generic_scenario("mdbsa_c")
+D = generic_scenario("mdbsa_d")
 DT, DT_NS = C.sim.dt, C.dt_ns
 CLEAR = np.full(C.sensors.scan.rays, np.inf, dtype=np.float32)
-SMALL = load_scenario(  # 2.4 m arena, 4 regions of 1.2 m: spirals of ~8 m, walked in ~1 min
+SMALL = generic_scenario(  # 2.4 m arena, 4 regions of 1.2 m: spirals of ~8 m, walked in ~1 min
     "mdbsa_c", ["regions.count=4"], robots__count=3, arena__size=2.4,
     resources__clusters=1, resources__count=16,
 )
@@ -65,7 +66,7 @@ def dist_to_polyline(p: np.ndarray, pts: np.ndarray) -> np.ndarray:
 
 
 def test_scenarios_are_experiment_1_with_16_regions():
-    ddsa = load_scenario("ddsa")
+    ddsa = generic_scenario("ddsa")
     for s, name in ((C, "mdbsa_c"), (D, "mdbsa_d")):
         assert s.controller.behaviour == name
         assert RegionConfig.of(s).count == 16
@@ -83,9 +84,9 @@ def test_scenarios_are_experiment_1_with_16_regions():
 
 def test_a_scenario_with_the_wrong_drop_zones_is_refused():
     with pytest.raises(ScenarioError, match="depot.delivery: mdbsa_d delivers to region_centers"):
-        load_scenario("mdbsa_d", ["depot.delivery=depot"])
+        generic_scenario("mdbsa_d", ["depot.delivery=depot"])
     with pytest.raises(ScenarioError, match="depot.delivery: mdbsa_c delivers to depot"):
-        load_scenario("mdbsa_c", ["depot.delivery=region_centers"])
+        generic_scenario("mdbsa_c", ["depot.delivery=region_centers"])
     with pytest.raises(ValueError, match="robot_8"):
         MdbsaBehaviour(C, "robot_8", None)
     assert not MdbsaBehaviour(C, "robot_0", None).distributed and MdbsaBehaviour(D, "robot_0", None).distributed
@@ -107,7 +108,7 @@ def test_region_spiral_in_a_centred_box_is_mdbsa_path(side, margin, cx, cy):
 
 @pytest.mark.parametrize("regions", [4, 16, 64])
 def test_region_paths_stay_in_their_boxes_and_cover_the_resource_area(regions):
-    s = load_scenario("mdbsa_d", [f"regions.count={regions}"])
+    s = generic_scenario("mdbsa_d", [f"regions.count={regions}"])
     paths = region_paths(s)
     bounds = region_bounds(s)
     side = region_side(regions, s.arena.size)
@@ -172,7 +173,7 @@ def test_server_ignores_reports_from_out_of_range_and_other_messages():
 
 
 def test_server_idles_robots_beyond_two_per_region_and_again_when_they_ask():
-    one = load_scenario("mdbsa_c", ["regions.count=1"], robots__count=3)
+    one = generic_scenario("mdbsa_c", ["regions.count=1"], robots__count=3)
     server = CenterServer(one)
     out = server.step(DT_NS, [report(robot_name(k)) for k in range(3)])
     length = server.paths[0].length
@@ -184,7 +185,7 @@ def test_server_idles_robots_beyond_two_per_region_and_again_when_they_ask():
 
 
 def test_server_shares_the_partners_frontier_and_reassigns_when_done():
-    s4 = load_scenario("mdbsa_c", ["regions.count=4"], robots__count=5)
+    s4 = generic_scenario("mdbsa_c", ["regions.count=4"], robots__count=5)
     server = CenterServer(s4)
     first = server.step(DT_NS, [report(robot_name(k)) for k in range(5)])
     assert [(m.region, m.direction) for m in first] == [
@@ -460,7 +461,7 @@ def test_mdbsa_d_robots_stay_in_their_regions_and_deliver_to_their_region_center
     """8 robots, 4 regions, 180 s: robots 0-3 walk regions 0-3 from the center, robots 4-7 the
     same regions from the far end. Tolerance: while a robot works its walk (searching, carrying
     a find to the region center, resuming) it stays within its region's square + 0.3 m."""
-    s = load_scenario("mdbsa_d", ["regions.count=4", "sim.duration=180"])
+    s = generic_scenario("mdbsa_d", ["regions.count=4", "sim.duration=180"])
     run, built, log, server = _recorded_batch(monkeypatch, s)
     assert server.ignored == 0
     centers, half = region_centers(4, s.arena.size), region_side(4, s.arena.size) / 2
