@@ -137,7 +137,8 @@ def summary_figure(trace: RunTrace):
         ax.set_visible(False)
     algorithm = registry.of(trace.config).name if trace.config is not None else "?"
     ran = trace.scenario if algorithm == trace.scenario else f"{trace.scenario} ({algorithm})"
-    fig.suptitle(f"{ran}: {len(trace.robots)} robots, seed {trace.seed}, {trace.sim_seconds:.0f} s of sim time")
+    model = f" ({trace.config.robots.model})" if trace.config is not None else ""
+    fig.suptitle(f"{ran}: {len(trace.robots)} robots{model}, seed {trace.seed}, {trace.sim_seconds:.0f} s of sim time")
     fig.tight_layout()
     return fig
 
@@ -207,7 +208,7 @@ def trajectories_figure(path: Path | str, *, start: float = 0.0, end: float | No
     half = scenario.arena.size / 2
     ax.set(aspect="equal", xlabel="x [m]", ylabel="y [m]", xlim=(-half * 1.02, half * 1.02),
            ylim=(-half * 1.02, half * 1.02),
-           title=f"{scenario.name}: {len(robots)} robots' trajectories"
+           title=f"{scenario.name}: {len(robots)} robots' trajectories ({scenario.robots.model})"
                  + (" over the planned paths" if paths else "")
                  + f", {start:g}-{end if end is not None else _end(odometry_rows):g} s")
     _legend_outside(ax, len(robots))
