@@ -29,11 +29,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from swarm_sim.registry import task_factory  # noqa: E402
 from swarm_sim.scenario import load_scenario  # noqa: E402
 from swarm_sim.types import Command  # noqa: E402
 from swarm_sim.world import World  # noqa: E402
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet  # noqa: E402
-from swarm_sim.registry import task_factory
 
 BLOCK = 20
 """Ticks per timing block."""

@@ -15,9 +15,9 @@ import argparse
 import sys
 
 import numpy as np
+from profile_batch import scaled_fields
 
 import swarm_sim.world.core as core
-from profile_batch import scaled_fields
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
 
