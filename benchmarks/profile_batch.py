@@ -50,7 +50,7 @@ from swarm_controllers.avoidance import AvoidThenEscape, ObstacleAvoidance
 from swarm_controllers.robots.stop_turn_go import StopTurnGo
 from swarm_controllers.robots.wheel_turning import WheelTurning
 from swarm_sim.behaviour import behaviour_rng
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 
 GROUPS = ("world", "behaviours", "routing", "servers", "bookkeeping", "gc")
 """Phase names start with one of these (then ':'); the table prints a subtotal per group."""
@@ -409,9 +409,13 @@ def main(argv: list[str] | None = None) -> int:
     for name in args.scenario:
         for n in sorted(args.robots):
             duration = args.duration or (60.0 if n < 500 else 10.0)
-            fields = scaled_fields(name, n, dict(args.arena).get(n))
-            scenario = load_scenario(name, args.overrides, **fields, sim__duration=args.warmup + duration,
-                                     seed=args.seed)
+            try:
+                fields = scaled_fields(name, n, dict(args.arena).get(n))
+                scenario = load_scenario(name, args.overrides, **fields, sim__duration=args.warmup + duration,
+                                         seed=args.seed)
+            except ScenarioError as exc:
+                print(f"profile_batch: {exc}", file=sys.stderr)
+                return 2
             warmup = round(args.warmup / scenario.sim.dt)
             plains, profs = [], []
             for _ in range(max(1, args.repeat)):

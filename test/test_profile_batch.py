@@ -50,3 +50,11 @@ def test_scaled_arena_scales_the_resource_clusters_with_the_area():
     assert fields["arena__size"] == 38.0
     assert fields["resources__count"] == fields["resources__clusters"] * 64 == 3200
     assert profile_batch.scaled_fields("cpfa", 112, None) == {"robots__count": 112}
+
+
+def test_a_bad_scenario_or_key_is_one_line_and_exit_2(capsys):
+    for argv in (["--scenario", "nope", "--robots", "4", "--duration", "1"],
+                 ["--scenario", "cpfa", "--robots", "4", "--duration", "1", "--set", "sim.dt=-1"]):
+        assert profile_batch.main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("profile_batch: ") and "Traceback" not in err[0]
