@@ -12,7 +12,7 @@ import resource
 import time
 
 from swarm_sim.batch import run_batch
-from swarm_sim.scenario import load_scenario
+from swarm_sim.scenario import ScenarioError, load_scenario
 
 
 def main() -> None:
@@ -42,4 +42,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except ScenarioError as exc:  # a bad --scenario or --set: one line, no traceback
+        raise SystemExit(f"bench_batch: {exc}") from None

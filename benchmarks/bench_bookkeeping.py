@@ -19,7 +19,7 @@ import time
 
 import swarm_sim.batch as batch
 from swarm_sim import registry
-from swarm_sim.scenario import load_scenario
+from swarm_sim.scenario import ScenarioError, load_scenario
 
 
 def _without_rule(of):
@@ -71,4 +71,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except ScenarioError as exc:  # a bad --scenario or --set: one line, no traceback
+        raise SystemExit(f"bench_bookkeeping: {exc}") from None

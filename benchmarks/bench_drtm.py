@@ -18,7 +18,7 @@ import statistics
 import time
 
 from swarm_sim.batch import run_batch
-from swarm_sim.scenario import load_scenario
+from swarm_sim.scenario import ScenarioError, load_scenario
 
 GOAL_S = 10.0
 
@@ -57,4 +57,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except ScenarioError as exc:  # a bad --scenario or --set: one line, no traceback
+        raise SystemExit(f"bench_drtm: {exc}") from None
