@@ -154,7 +154,9 @@ def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
     written.append(boxplot_figure(
         [("trajectory_error_pct", "trajectory error [% of the planned path]"),
          ("max_path_deviation_m", "largest deviation from the planned path [m]")], rows, cells, [STRATEGY], labels,
-        "cell (see tables.md)", "Transport accuracy by cell", out / "error.png"))
+        "cell (see tables.md)", "Transport accuracy by cell", out / "error.png",
+        references={"trajectory_error_pct": (PAPER_NORMALISED_ERROR_PCT,
+                                             f"paper: around {PAPER_NORMALISED_ERROR_PCT} % (sec. 5)")}))
     return written
 
 

@@ -108,8 +108,10 @@ def boxplot_figure(
     title: str,
     path: Path,
     notch: bool = False,
+    references: dict[str, tuple[float, str]] | None = None,
 ) -> Path:
-    """A PNG at `path` with one `grouped_boxplot` per (metric, y label) panel, side by side."""
+    """A PNG at `path` with one `grouped_boxplot` per (metric, y label) panel, side by side;
+    `references`: metric -> (value, label) of a paper's single number, drawn across its panel."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -121,6 +123,11 @@ def boxplot_figure(
             warnings.simplefilter("ignore")  # notches wider than the box with few runs
             grouped_boxplot(ax, rows, metric, cells, strategies, labels, notch=notch)
         ax.set(xlabel=xlabel, ylabel=ylabel)
+        if references and metric in references:
+            value, label = references[metric]
+            line = ax.axhline(value, color="black", ls="--", lw=1.0, label=label)
+            boxes = ax.get_legend()  # grouped_boxplot's strategies, kept beside the line
+            ax.legend(handles=[*(boxes.legend_handles if boxes else []), line], fontsize="small")
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
