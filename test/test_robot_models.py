@@ -91,6 +91,27 @@ def test_a_platform_value_can_be_varied_alone():
     assert (s.robots.max_linear_speed, s.robots.diameter, s.robots.planar) == (0.3, 2 * 0.085036758, False)
 
 
+@pytest.mark.parametrize(("override", "message"), [
+    ("sensors.scan.rays=48", "sensors.scan.rays=48: the footbot_cpfa robot model sets it to 24 "
+                             "(robots.model=generic takes it as given)"),
+    ("sensors.proximity_ring.range=0.3", "sensors.proximity_ring.range=0.3: the footbot_cpfa robot model sets it to 0.1"),
+    ("robots.max_angular_speed=2", "robots.max_angular_speed=2: the footbot_cpfa robot model sets it to 1.142857"),
+    ("robots.diameter=0.3", "robots.diameter=0.3: the footbot_cpfa robot model sets it to 0.170073"),
+])
+def test_a_value_the_model_would_replace_is_refused_not_dropped(override, message):
+    """A ``--set`` of a value the platform fixes names the key and how to vary it; the model's own
+    value, and the same key on the generic robot, are taken."""
+    with pytest.raises(ScenarioError) as error:
+        load_scenario("cpfa", [override])
+    assert str(error.value).startswith(message), str(error.value)
+    if override.startswith("robots."):
+        assert "vary it with robots.platform." in str(error.value)
+    assert load_scenario("cpfa", ["sensors.scan.rays=24", "sensors.proximity_ring.range=0.1"]).sensors.scan.rays == 24
+    generic = load_scenario("cpfa", ["robots.model=generic", override])
+    key, value = override.split("=")
+    assert float(eval(f"generic.{key}", {"generic": generic})) == float(value)  # noqa: S307 - our own key
+
+
 def test_the_papers_scenarios_run_on_their_authors_robots():
     """Every shipped scenario's robot is its algorithm's authors' robot, but for the DRTM paper's
     real-robot experiment (the e-puck scenarios), and each one also runs on the generic robot."""

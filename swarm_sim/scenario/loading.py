@@ -27,7 +27,7 @@ from typing import Any, Literal, get_args, get_origin
 import yaml
 
 from swarm_sim import registry
-from swarm_sim.robots import apply_model
+from swarm_sim.robots import BODY_FIELDS, apply_model
 from swarm_sim.scenario.schema import ControllerConfig, Scenario, ScenarioError
 from swarm_sim.scenario.validation import validate
 
@@ -219,25 +219,60 @@ def load_scenario(
     """
     path = resolve_path(name_or_path or registry.default_scenario())
     data = read_yaml(path)
-    for text in overrides:
-        _set_path(data, *parse_override(text))
-    for key, value in fields.items():
-        if value is not None:
-            _set_path(data, key.replace("__", "."), value)
-    return _finish(_build(Scenario, data, ""))
+    given = [parse_override(text) for text in overrides]
+    given += [(key.replace("__", "."), value) for key, value in fields.items() if value is not None]
+    for key, value in given:
+        _set_path(data, key, value)
+    return _finish(_build(Scenario, data, ""), given)
 
 
-def _finish(scenario: Scenario) -> Scenario:
+def _leaves(key: str, value: Any) -> Iterable[tuple[str, Any]]:
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from _leaves(f"{key}.{k}", v)
+    else:
+        yield key, value
+
+
+def _at(scenario: Scenario, key: str) -> Any:
+    node: Any = scenario
+    for part in key.split("."):
+        node = getattr(node, part, _MISSING)
+        if node is _MISSING:
+            break
+    return node
+
+
+def _refuse_replaced(before: Scenario, after: Scenario, given: Iterable[tuple[str, Any]]) -> None:
+    """ScenarioError for a value the user set that the robot model then replaced (the foot-bot's
+    ring fixes ``sensors.scan.rays``, say): a ``--set`` must not be dropped in silence."""
+    for key, value in (leaf for pair in given for leaf in _leaves(*pair)):
+        was, now = _at(before, key), _at(after, key)
+        if was is _MISSING or was == now:
+            continue
+        field = key.rsplit(".", 1)[-1]
+        hint = (f"vary it with robots.platform.{field}" if key in {f"robots.{f}" for f in BODY_FIELDS}
+                else "robots.model=generic takes it as given")
+        raise ScenarioError(f"{key}={_short(value)}: the {after.robots.model} robot model sets it to "
+                            f"{_short(now)} ({hint})")
+
+
+_MISSING = object()
+
+
+def _finish(scenario: Scenario, given: Iterable[tuple[str, Any]] = ()) -> Scenario:
     """Validated as written, then with the robot model's values written in
     (`swarm_sim.robots.apply_model`) and validated again: a platform model replaces some values
-    (the foot-bot's ring, say), and a bad one the file or ``--set`` gave is refused all the same."""
+    (the foot-bot's ring, say), and a bad one the file or ``--set`` gave is refused all the same,
+    as is a good one the user `given` that the model would replace."""
     validate(scenario)
     try:
-        scenario = apply_model(scenario)
+        modelled = apply_model(scenario)
     except ValueError as exc:
         raise ScenarioError(str(exc)) from None
-    validate(scenario)
-    return scenario
+    _refuse_replaced(scenario, modelled, given)
+    validate(modelled)
+    return modelled
 
 
 class _StrictLoader(yaml.SafeLoader):
