@@ -76,6 +76,10 @@ def test_the_foraging_foot_bot_sees_the_light_everywhere_and_food_under_its_grou
     (["robots.model=roomba"], "robots.model: unknown robot model 'roomba' (known: footbot_cpfa, footbot_foraging, "
                               "generic, khepera3)"),
     (["robots.platform.diameter=0.2"], "robots.platform.diameter: the generic robot takes robots.diameter itself"),
+    (["robots.platform.light_range=2"], "robots.platform.light_range: the generic robot takes sensors.light_range itself"),
+    (["robots.model=khepera3", "robots.platform.ring_range=0.2"],
+     "robots.platform.ring_range: the khepera3 robot model has no proximity ring"),
+    (["robots.model=footbot_cpfa", "robots.platform.ring_range=0"], "robots.platform.ring_range: must be positive"),
     (["robots.model=khepera3", "robots.platform.max_linear_speed=-1"], "robots.platform.max_linear_speed: must be positive"),
     (["robots.wheel_turning.soft_turn_angle=95"], "robots.wheel_turning: need 0 <= no_turn_angle <= soft_turn_angle"),
     (["robots.stop_turn_go.angle_tolerance=0"], "robots.stop_turn_go.angle_tolerance: must be positive"),
@@ -91,6 +95,20 @@ def test_a_platform_value_can_be_varied_alone():
     assert (s.robots.max_linear_speed, s.robots.diameter, s.robots.planar) == (0.3, 2 * 0.085036758, False)
 
 
+def test_a_platform_sensor_range_can_be_varied_alone():
+    """The sensor-range factor: the foraging foot-bot's light and food sensing at the e-puck
+    scenario's ranges, and a longer ring, each leaving the rest of the model as it is."""
+    base = load_scenario("drtm")
+    s = load_scenario("drtm", ["robots.platform.light_range=2.0"])
+    assert (s.sensors.light_range, s.sensors.resource_detection_radius) == (2.0, base.sensors.resource_detection_radius)
+    s = load_scenario("drtm", ["robots.platform.resource_detection_radius=0.2"])
+    assert (s.sensors.resource_detection_radius, s.sensors.light_range) == (0.2, base.sensors.light_range)
+    s = load_scenario("drtm", ["robots.platform.ring_range=0.15"])
+    assert (s.sensors.proximity_ring.range, s.robots.diameter) == (0.15, base.robots.diameter)
+    with pytest.raises(ScenarioError, match="vary it with robots.platform.light_range"):
+        load_scenario("drtm", ["sensors.light_range=3.0"])
+
+
 @pytest.mark.parametrize(("override", "message"), [
     ("sensors.scan.rays=48", "sensors.scan.rays=48: the footbot_cpfa robot model sets it to 24 "
                              "(robots.model=generic takes it as given)"),
@@ -104,7 +122,7 @@ def test_a_value_the_model_would_replace_is_refused_not_dropped(override, messag
     with pytest.raises(ScenarioError) as error:
         load_scenario("cpfa", [override])
     assert str(error.value).startswith(message), str(error.value)
-    if override.startswith("robots."):
+    if override.startswith(("robots.", "sensors.proximity_ring.range")):
         assert "vary it with robots.platform." in str(error.value)
     assert load_scenario("cpfa", ["sensors.scan.rays=24", "sensors.proximity_ring.range=0.1"]).sensors.scan.rays == 24
     generic = load_scenario("cpfa", ["robots.model=generic", override])

@@ -25,8 +25,8 @@ robot moves there, so every algorithm runs on every model by configuration.
 Applying a model (`apply_model`, when a scenario is loaded) writes its values into the scenario,
 so every reader of ``robots.diameter`` or ``sensors.scan`` sees the platform's; the values a
 platform fixes replace the file's (the files describe the generic robot). ``robots.platform``
-overrides single values of a platform model (to vary one factor), ``robots.planar`` the model's
-choice. This package imports nothing of the project: the loader hands it the scenario.
+overrides single values of a platform model (to vary one factor: its body, speed limits and
+sensor ranges), ``robots.planar`` the model's choice. This package imports nothing of the project: the loader hands it the scenario.
 """
 
 from __future__ import annotations
@@ -142,6 +142,9 @@ MODELS: dict[str, RobotModel] = {m.name: m for m in (
 
 BODY_FIELDS = ("diameter", "height", "mass", "max_linear_speed", "max_angular_speed")
 """The ``robots`` fields a platform fixes and ``robots.platform`` may override."""
+SENSOR_FIELDS = {"ring_range": "proximity_ring.range", "light_range": "light_range",
+                 "resource_detection_radius": "resource_detection_radius"}
+"""The sensor ranges ``robots.platform`` may override -> the ``sensors`` key each replaces."""
 
 
 def known_models() -> tuple[str, ...]:
@@ -173,16 +176,20 @@ def apply_model(scenario: Any) -> Any:
     Idempotent: a scenario read back from a bag's metadata comes out the same."""
     r = scenario.robots
     model = robot_model(r.model)
-    overrides = {f: getattr(r.platform, f) for f in BODY_FIELDS if getattr(r.platform, f) is not None}
+    overrides = {f: getattr(r.platform, f) for f in (*BODY_FIELDS, *SENSOR_FIELDS) if getattr(r.platform, f) is not None}
     for key, value in overrides.items():
         if not value > 0:
             raise ValueError(f"robots.platform.{key}: must be positive")
     planar = model.planar if r.planar is None else r.planar
     if model.name == GENERIC:
         if overrides:
-            raise ValueError(f"robots.platform.{next(iter(overrides))}: the generic robot takes robots."
-                             f"{next(iter(overrides))} itself (robots.platform overrides a platform model)")
+            key = next(iter(overrides))
+            own = f"sensors.{SENSOR_FIELDS[key]}" if key in SENSOR_FIELDS else f"robots.{key}"
+            raise ValueError(f"robots.platform.{key}: the generic robot takes {own} itself "
+                             f"(robots.platform overrides a platform model)")
         return dataclasses.replace(scenario, robots=dataclasses.replace(r, planar=planar))
+    if "ring_range" in overrides and model.ring_range is None:
+        raise ValueError(f"robots.platform.ring_range: the {model.name} robot model has no proximity ring")
     body = {f: overrides.get(f, getattr(model, f)) for f in BODY_FIELDS}
     # Robots start at least one body apart: the files' spacing is the generic robot's.
     robots = dataclasses.replace(r, **body, planar=planar, start_spacing=max(r.start_spacing, body["diameter"]))
@@ -198,4 +205,10 @@ def apply_model(scenario: Any) -> Any:
     if model.ground_food:
         sensors = dataclasses.replace(
             sensors, resource_detection_radius=s.pickup_radius + footbot.GROUND_SENSOR_OFFSET)
+    if "ring_range" in overrides:
+        sensors = dataclasses.replace(
+            sensors, proximity_ring=dataclasses.replace(sensors.proximity_ring, range=overrides["ring_range"]))
+    for key in ("light_range", "resource_detection_radius"):
+        if key in overrides:
+            sensors = dataclasses.replace(sensors, **{key: overrides[key]})
     return dataclasses.replace(scenario, robots=robots, sensors=sensors)

@@ -27,7 +27,7 @@ from typing import Any, Literal, get_args, get_origin
 import yaml
 
 from swarm_sim import registry
-from swarm_sim.robots import BODY_FIELDS, apply_model
+from swarm_sim.robots import BODY_FIELDS, SENSOR_FIELDS, apply_model
 from swarm_sim.scenario.schema import ControllerConfig, Scenario, ScenarioError
 from swarm_sim.scenario.validation import validate
 
@@ -250,8 +250,8 @@ def _refuse_replaced(before: Scenario, after: Scenario, given: Iterable[tuple[st
         was, now = _at(before, key), _at(after, key)
         if was is _MISSING or was == now:
             continue
-        field = key.rsplit(".", 1)[-1]
-        hint = (f"vary it with robots.platform.{field}" if key in {f"robots.{f}" for f in BODY_FIELDS}
+        platform = {f"robots.{f}": f for f in BODY_FIELDS} | {f"sensors.{k}": f for f, k in SENSOR_FIELDS.items()}
+        hint = (f"vary it with robots.platform.{platform[key]}" if key in platform
                 else "robots.model=generic takes it as given")
         raise ScenarioError(f"{key}={_short(value)}: the {after.robots.model} robot model sets it to "
                             f"{_short(now)} ({hint})")

@@ -84,6 +84,15 @@ class PlatformConfig:
     """[m/s]"""
     max_angular_speed: float | None = None
     """[rad/s]"""
+    ring_range: float | None = None
+    """[m] beyond the body: the proximity ring's reach (``sensors.proximity_ring.range``), on a
+    model with a ring."""
+    light_range: float | None = None
+    """[m] how far the light is seen (``sensors.light_range``), instead of the model's (the
+    foraging foot-bot's: everywhere in the arena)."""
+    resource_detection_radius: float | None = None
+    """[m] how far food is seen (``sensors.resource_detection_radius``), instead of the model's
+    (the foraging foot-bot's: under its ground sensors)."""
 
 
 @dataclass(frozen=True)
