@@ -574,3 +574,28 @@ def test_a_rank_test_that_cannot_reach_significance_tells_nothing():
            + rows_for("mdbsa_d", 4, [20, 21, 22], SPIRAL_KEYS))
     claims = spiral_headlines(few, 1, [4], SPIRAL_STRATEGIES)
     assert {h.holds for h in claims if "4:" in h.ours} == {None}
+
+
+def test_every_comparison_figure_says_which_robot_ran(tmp_path):
+    """The caption under a figure names each run's robot model (from its settings, else its
+    scenario's own) and the sweep's --set values; outside a `caption` block nothing is added."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from swarm_sim.compare.report import caption, runs_caption, save_figure
+
+    rows = [{"strategy": "drtm", "settings": json.dumps({"overrides": ["robots.model=footbot_foraging"]})},
+            {"strategy": "artm", "settings": json.dumps({"overrides": ["robots.model=generic", "robots.model=khepera3"]})},
+            {"strategy": "cpfa", "settings": "not json"}]
+    text = runs_caption(rows, ["robots.platform.diameter=0.07"], lambda s: f"own:{s}")
+    assert text == "robot: footbot_foraging, khepera3, own:cpfa; --set robots.platform.diameter=0.07"
+    fig = plt.figure()
+    with caption(text):
+        save_figure(fig, tmp_path / "a.png")
+    assert [t.get_text() for t in fig.texts] == [text] and (tmp_path / "a.png").stat().st_size > 0
+    plain = plt.figure()
+    save_figure(plain, tmp_path / "b.png")
+    assert plain.texts == []
+    plt.close("all")

@@ -13,6 +13,7 @@ import numpy as np
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.metrics import caging_report, distance_to_polyline, series_of, transport_stage
 from swarm_controllers.caging.world_config import TransportConfig
+from swarm_sim.compare.report import save_figure
 from swarm_sim.types import robot_index
 
 SNAPSHOTS = 6
@@ -63,7 +64,7 @@ def transport_figure(trace, directory: Path) -> list[Path]:
         note.axis("off")
         note.text(0.5, 0.5, "no transport in this run: the cage was never complete", ha="center", va="center")
     out = Path(directory) / "transport.png"
-    fig.savefig(out, dpi=100)
+    save_figure(fig, out)
     plt.close(fig)
     return [out]
 

@@ -20,7 +20,7 @@ from typing import Any
 
 from swarm_controllers.drtm.config import NestConfig
 from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table
+from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table, save_figure
 from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 from swarm_sim.scenario import load_scenario, scenario_to_dict
@@ -219,7 +219,7 @@ def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: S
         ax.legend(fontsize="small")
     axes[0][0].set_ylabel(SERIES[key])
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 

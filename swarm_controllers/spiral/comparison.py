@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table
+from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table, save_figure
 from swarm_sim.compare.stats import (
     cells_of,
     describe,
@@ -294,7 +294,7 @@ def per_minute_figure(rows: Sequence[dict], experiment: int, cells: Sequence[int
     fig.suptitle(f"Experiment {experiment}: foraging rate per minute "
                  f"(cf. MDBSA paper {PER_MINUTE_FIGURES.get(experiment, 'Fig. 10 setting')})")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 

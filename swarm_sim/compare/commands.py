@@ -12,7 +12,7 @@ from pathlib import Path
 from swarm_sim import compare, registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.compare.comparison import Comparison
-from swarm_sim.compare.report import note_cut_runs
+from swarm_sim.compare.report import caption, note_cut_runs, runs_caption
 from swarm_sim.compare.sweep import (
     FAILED,
     RESULTS,
@@ -142,7 +142,8 @@ def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies:
             print(f"\nswarm-compare: interrupted; finished runs are in {path} (continue with --resume)",
                   file=sys.stderr)
             return 130, []
-    written = comparison.write_report(result.rows, out, args, strategies)
+    with caption(runs_caption(result.rows, args.overrides, _scenario_model)):
+        written = comparison.write_report(result.rows, out, args, strategies)
     note_cut_runs(written, args.duration)
     print(f"{len(result.rows)} runs in {path}; wrote {', '.join(p.name for p in written)} in {out}")
     if result.failed:
@@ -150,3 +151,11 @@ def run_comparison(comparison: Comparison, args: argparse.Namespace, strategies:
               "tries them again)", file=sys.stderr)
         return 1, written
     return 0, written
+
+
+def _scenario_model(strategy: str | None) -> str:
+    """The robot model a shipped scenario names ("?" for one that no longer loads)."""
+    try:
+        return load_scenario(strategy).robots.model
+    except (ScenarioError, TypeError):
+        return "?"

@@ -1,11 +1,14 @@
-"""Report building blocks shared by the paper comparisons: number formatting, markdown tables and
-grouped box plots."""
+"""Report building blocks shared by the paper comparisons: number formatting, markdown tables,
+grouped box plots, and the line under every figure that says which robots ran (`caption`)."""
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
@@ -130,6 +133,46 @@ def boxplot_figure(
             ax.legend(handles=[*(boxes.legend_handles if boxes else []), line], fontsize="small")
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
+
+
+_CAPTION: ContextVar[str] = ContextVar("caption", default="")
+
+
+@contextmanager
+def caption(text: str) -> Iterator[None]:
+    """Every figure `save_figure` writes inside this block carries `text` under it."""
+    token = _CAPTION.set(text)
+    try:
+        yield
+    finally:
+        _CAPTION.reset(token)
+
+
+def save_figure(fig: Any, path: Path, dpi: int = 100) -> None:
+    """`fig` as a PNG at `path`, with the current `caption` (if any) as a small line under it: a
+    printed box plot says which robot made it."""
+    text = _CAPTION.get()
+    if text:
+        fig.text(0.005, 0.0, text, fontsize=7, color="0.3", ha="left", va="top")
+    fig.savefig(path, dpi=dpi, bbox_inches="tight" if text else None, pad_inches=0.08)
+
+
+def runs_caption(rows: Sequence[dict], overrides: Sequence[str], model_of: Any) -> str:
+    """"robot: <model>[, ...]; --set ..." for a sweep's `rows`: the model each run's settings name
+    (``robots.model=``) or else its scenario's own (`model_of(strategy)`), and the sweep's ``--set``
+    `overrides`."""
+    models = set()
+    for r in rows:
+        try:
+            given = json.loads(r.get("settings") or "{}").get("overrides", [])
+        except (ValueError, AttributeError):
+            given = []
+        named = [o.split("=", 1)[1] for o in given if isinstance(o, str) and o.startswith("robots.model=")]
+        models.add(named[-1] if named else model_of(r.get("strategy")))
+    text = "robot: " + ", ".join(sorted(str(m) for m in models))
+    if overrides:
+        text += "; --set " + " ".join(overrides)
+    return text
