@@ -372,6 +372,9 @@ def main(argv: list[str] | None = None) -> int:
     if world is None:  # interrupted before anything ran
         return 130
     world_died = world.returncode != 0 and not interrupted
+    if world_died and not bag.exists():  # it refused the scenario before opening the bag (it said why)
+        print(f"[swarm-run] the world node {_how(world.returncode)} before recording anything", file=sys.stderr)
+        return 2
     if world_died:
         print(f"[swarm-run] the world node (pid {world.pid}) {_how(world.returncode)}: the run stopped early; "
               f"repairing the bag's cut-off last file", file=sys.stderr, flush=True)

@@ -2,7 +2,7 @@
 exit, never a traceback, a hang or a write outside the output directory.
 
 The command-line cases run the real entry points in subprocesses, bounded by a timeout (a hang
-fails the test instead of stalling it); none of them starts a node: each is refused first.
+fails the test instead of stalling it); all but one are refused before a node starts.
 """
 
 from __future__ import annotations
@@ -151,3 +151,14 @@ def test_a_taken_discovery_port_is_one_line(tmp_path):
     assert_one_line(result, 2, f"domain {domain} is in use", f"port 127.0.0.1:{dds.discovery_port(domain)} is taken",
                     "--domain-id auto")
     assert "[world]" not in result.stdout
+
+
+def test_a_scenario_the_world_cannot_build_is_one_line_and_no_bag(tmp_path):
+    """Five 8 x 8 clusters cannot be placed in a 7 m arena: the file loads, the world refuses to
+    build it. One line from the world (not its traceback), exit 2, no half-made bag. (This one
+    starts the nodes: the world finds out only when it places the resources.)"""
+    result = run("launch_py.run", "--scenario", "queue_qmt", "--robots", "6", "--duration", "1",
+                 "--set", "arena.size=7.0", "--out", str(tmp_path / "bags"), cwd=tmp_path, timeout=180.0)
+    assert_one_line(result, 2, "swarm-world: resources.clusters: cannot place 5 non-overlapping groups")
+    assert "before recording anything" in result.stderr and "could not read the bag" not in result.stderr
+    assert not any((tmp_path / "bags").glob("*/metadata.yaml"))

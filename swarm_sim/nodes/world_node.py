@@ -55,7 +55,7 @@ from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
-from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 
@@ -512,7 +512,11 @@ def main(argv: list[str] | None = None) -> int:
     node = None
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
-        node = WorldNode(config)
+        try:
+            node = WorldNode(config)
+        except ScenarioError as exc:  # a scenario that loads but cannot be built (resources that do not fit)
+            print(f"swarm-world: {exc}", file=sys.stderr, flush=True)
+            return 2
 
         def request_stop(*_: object) -> None:
             node.stop_requested = True
