@@ -26,7 +26,8 @@ Applying a model (`apply_model`, when a scenario is loaded) writes its values in
 so every reader of ``robots.diameter`` or ``sensors.scan`` sees the platform's; the values a
 platform fixes replace the file's (the files describe the generic robot). ``robots.platform``
 overrides single values of a platform model (to vary one factor: its body, speed limits and
-sensor ranges), ``robots.planar`` the model's choice. This package imports nothing of the project: the loader hands it the scenario.
+sensor ranges), ``robots.planar`` the model's choice. This package imports nothing of the
+project: the loader hands it the scenario.
 """
 
 from __future__ import annotations
@@ -176,7 +177,8 @@ def apply_model(scenario: Any) -> Any:
     Idempotent: a scenario read back from a bag's metadata comes out the same."""
     r = scenario.robots
     model = robot_model(r.model)
-    overrides = {f: getattr(r.platform, f) for f in (*BODY_FIELDS, *SENSOR_FIELDS) if getattr(r.platform, f) is not None}
+    overrides = {f: getattr(r.platform, f) for f in (*BODY_FIELDS, *SENSOR_FIELDS)
+                 if getattr(r.platform, f) is not None}
     for key, value in overrides.items():
         if not value > 0:
             raise ValueError(f"robots.platform.{key}: must be positive")

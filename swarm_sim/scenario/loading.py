@@ -250,14 +250,15 @@ def _refuse_replaced(before: Scenario, after: Scenario, given: Iterable[tuple[st
         was, now = _at(before, key), _at(after, key)
         if was is _MISSING or was == now:
             continue
-        platform = {f"robots.{f}": f for f in BODY_FIELDS} | {f"sensors.{k}": f for f, k in SENSOR_FIELDS.items()}
-        hint = (f"vary it with robots.platform.{platform[key]}" if key in platform
+        hint = (f"vary it with robots.platform.{_PLATFORM[key]}" if key in _PLATFORM
                 else "robots.model=generic takes it as given")
         raise ScenarioError(f"{key}={_short(value)}: the {after.robots.model} robot model sets it to "
                             f"{_short(now)} ({hint})")
 
 
 _MISSING = object()
+_PLATFORM = {f"robots.{f}": f for f in BODY_FIELDS} | {f"sensors.{k}": f for f, k in SENSOR_FIELDS.items()}
+"""A key a platform model fixes -> the ``robots.platform`` field that varies it."""
 
 
 def _finish(scenario: Scenario, given: Iterable[tuple[str, Any]] = ()) -> Scenario:
