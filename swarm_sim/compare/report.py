@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 import warnings
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
@@ -160,7 +160,7 @@ def save_figure(fig: Any, path: Path, dpi: int = 100) -> None:
     fig.savefig(path, dpi=dpi, bbox_inches="tight" if text else None, pad_inches=0.08)
 
 
-def runs_caption(rows: Sequence[dict], overrides: Sequence[str], model_of: Any) -> str:
+def runs_caption(rows: Sequence[dict], overrides: Sequence[str], model_of: Callable[[Any], str]) -> str:
     """"robot: <model>[, ...]; --set ..." for a sweep's `rows`: the model each run's settings name
     (``robots.model=``) or else its scenario's own (`model_of(strategy)`), and the sweep's ``--set``
     `overrides`."""

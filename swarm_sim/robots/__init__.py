@@ -207,10 +207,13 @@ def apply_model(scenario: Any) -> Any:
     if model.ground_food:
         sensors = dataclasses.replace(
             sensors, resource_detection_radius=s.pickup_radius + footbot.GROUND_SENSOR_OFFSET)
-    if "ring_range" in overrides:
-        sensors = dataclasses.replace(
-            sensors, proximity_ring=dataclasses.replace(sensors.proximity_ring, range=overrides["ring_range"]))
-    for key in ("light_range", "resource_detection_radius"):
-        if key in overrides:
-            sensors = dataclasses.replace(sensors, **{key: overrides[key]})
+    for field, key in SENSOR_FIELDS.items():
+        if field in overrides:
+            sensors = _replaced(sensors, key, overrides[field])
     return dataclasses.replace(scenario, robots=robots, sensors=sensors)
+
+
+def _replaced(obj: Any, dotted: str, value: Any) -> Any:
+    """Frozen dataclass `obj` with the field at `dotted` (``proximity_ring.range``) set to `value`."""
+    head, _, rest = dotted.partition(".")
+    return dataclasses.replace(obj, **{head: _replaced(getattr(obj, head), rest, value) if rest else value})
