@@ -83,6 +83,9 @@ class NestServer:
         self._window_ns = round(config.window(scenario) * NS_PER_S)
         self.active: set[str] = set()
         """Robots in S_S or S_R, as reported."""
+        self.returning: set[str] = set()
+        """Robots in S_R (FOUND, not yet DEPOSITED), as reported."""
+        self._window_all = config.oae_window_states == "all"
         self._recent: deque[int] = deque()
         """Stamps of the OAEs of the last T_2."""
         self._last_ns: int | None = None
@@ -95,6 +98,7 @@ class NestServer:
         """`robot` was declared dead: it no longer forages, its later reports are refused."""
         self.lost.add(robot)
         self.active.discard(robot)
+        self.returning.discard(robot)
 
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[NestState, ...]:
         for m in messages:
@@ -119,9 +123,13 @@ class NestServer:
             return
         if m.event is NestEvent.LEFT:
             self.active.add(m.robot)
+        elif m.event is NestEvent.FOUND:
+            self.returning.add(m.robot)
         elif m.event is NestEvent.DEPOSITED:
             self.active.discard(m.robot)
+            self.returning.discard(m.robot)
             self.ledger.deliver()
         elif m.event is NestEvent.AVOIDED:
             self.ledger.avoid()
-            self._recent.append(m.stamp_ns)
+            if self._window_all or m.robot in self.returning:
+                self._recent.append(m.stamp_ns)

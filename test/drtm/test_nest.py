@@ -84,6 +84,26 @@ def test_recent_oaes_and_waiting_robots_from_a_hand_made_history():
     assert window == 20 * 10**9  # T_2 = L / 2v = 4 / (2 x 0.1) = 20 s
 
 
+def test_m_t2_counts_only_returning_robots_when_asked_and_the_ledger_charges_every_oae():
+    """robot_0 searches, robot_1 found a token (S_R) at tick 0 and deposits at tick 2; robot_2
+    found one at tick 1. With ``returning`` M_T2 counts robot_1's OAE (tick 1) and robot_2's
+    (tick 3), not robot_0's nor robot_1's after its deposit; the ledger counts all five."""
+    history = {0: [(0, NestEvent.LEFT), (1, NestEvent.LEFT), (2, NestEvent.LEFT), (1, NestEvent.FOUND)],
+               1: [(0, NestEvent.AVOIDED), (1, NestEvent.AVOIDED), (2, NestEvent.FOUND)],
+               2: [(1, NestEvent.DEPOSITED), (0, NestEvent.AVOIDED)],
+               3: [(1, NestEvent.AVOIDED), (2, NestEvent.AVOIDED)]}
+    for states, expected in (("all", [0, 0, 2, 3, 5]), ("returning", [0, 0, 1, 1, 2])):
+        nest = NestServer(_scenario(f"controller.nest.oae_window_states={states}"))
+        seen = [nest.step(k * DT_NS, [_report(k - 1, r, e) for r, e in history.get(k - 1, ())])[0] for k in range(5)]
+        assert [s.recent_oaes for s in seen] == expected, states
+        assert seen[-1].total_oaes == 5
+
+
+def test_an_unknown_m_t2_reading_is_refused_naming_the_key():
+    with pytest.raises(ScenarioError, match="controller.nest.oae_window_states"):
+        _scenario("controller.nest.oae_window_states=searching")
+
+
 def test_reports_from_unknown_or_dead_robots_are_refused_and_counted():
     nest = NestServer(_scenario())
     nest.step(0, [_report(-1, 0, NestEvent.LEFT)])
