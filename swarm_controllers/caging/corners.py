@@ -10,8 +10,9 @@ Table 2 plans are 3.9-4.7 m of 0.5 m and 0.5 sqrt 2 m steps: short, with at most
 between their straight and diagonal steps.
 
 This module runs the caging scenario in batch and, per run, finds the planned path's corners,
-their deflection, and how close the object came to each; then it fits the length lost per corner
-by deflection (least squares, no intercept) and writes `corners.md`::
+their deflection, and how close the object came to each; then it fits the length lost as one
+length per run (the ends: the object stops within the tolerance of the last place) plus one per
+corner by deflection (least squares) and writes `corners.md`::
 
     python -m swarm_controllers.caging.corners --cells 1 3 --seeds 10 --jobs 2 --out results/factors/caging
 """
@@ -85,8 +86,9 @@ def corners_md(rows: Sequence[dict]) -> str:
         return "# Caging path error by corner\n\nNo delivered run.\n"
     counts = np.array([corner_counts(r["corners"]) for r in runs], dtype=float)
     lost = np.array([r["planned_m"] - r["object_m"] for r in runs])
-    fit, *_ = np.linalg.lstsq(counts, lost, rcond=None)
-    rms = float(np.sqrt(np.mean((counts @ fit - lost) ** 2)))
+    design = np.column_stack([np.ones(len(runs)), counts])
+    (ends, *fit), *_ = np.linalg.lstsq(design, lost, rcond=None)
+    rms = float(np.sqrt(np.mean((design @ np.array([ends, *fit]) - lost) ** 2)))
     per_m = [c.sum() / r["planned_m"] for c, r in zip(counts, runs)]
     errors = [r["error_pct"] for r in runs]
     names = [name for name, _, _ in DEFLECTION_BINS]
@@ -100,10 +102,12 @@ def corners_md(rows: Sequence[dict]) -> str:
     approach = {n: [d for r in runs for a, d in r["corners"] if lo <= a < hi] for n, lo, hi in DEFLECTION_BINS}
     lines += md_table(["deflection [deg]", "corners", "length lost per corner [m] (fit)",
                        "closest approach to the corner [m] (mean)"],
-                      [[n, str(len(approach[n]))] + ([f"{f:.3f}", f"{np.mean(approach[n]):.3f}"] if approach[n] else ["—", "—"])
-                       for n, f in zip(names, fit)]) + [""]
+                      [["none (per run: the two ends)", str(len(runs)), f"{ends:.3f}", "—"]]
+                      + [[n, str(len(approach[n]))] + ([f"{f:.3f}", f"{np.mean(approach[n]):.3f}"] if approach[n] else ["—", "—"])
+                         for n, f in zip(names, fit)]) + [""]
     straight = [e for e, c in zip(errors, counts) if c.sum() == 0]
-    lines += [f"Fit over {len(runs)} runs: planned - object = sum of the losses above; residual rms {rms:.3f} m.",
+    lines += [f"Fit over {len(runs)} runs: planned - object = a length per run plus one per corner by deflection "
+              f"(least squares); residual rms {rms:.3f} m.",
               f"Correlation of corners per metre of plan with the error [%]: {np.corrcoef(per_m, errors)[0, 1]:.2f}."
               if len(runs) > 2 and np.std(per_m) > 0 else "",
               f"Runs whose plan has no corner: error {', '.join(f'{e:.1f}' for e in straight)} % "

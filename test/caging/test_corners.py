@@ -20,20 +20,21 @@ def test_corners_of_a_hand_made_plan_and_how_close_the_object_came():
 
 
 def test_the_report_fits_the_length_lost_per_corner():
-    """Two runs whose losses are 90 deg corners at 0.1 m and 180 deg ones at 0.3 m: the fit
-    recovers both; a straight run reports its own error."""
-    rows = [{"cell": 0, "seed": 0, "model": "khepera3", "delivered": True, "planned_m": 10.0, "object_m": 9.5,
+    """Losses of 0.1 m per run, 0.1 m per 90 deg corner and 0.3 m per 180 deg one: the fit
+    recovers all three exactly; the straight run reports its own error."""
+    rows = [{"cell": 0, "seed": 0, "model": "khepera3", "delivered": True, "planned_m": 10.0, "object_m": 9.4,
              "error_pct": 5.0, "corners": [(90.0, 0.08), (180.0, 0.1), (90.0, 0.06)]},
-            {"cell": 0, "seed": 1, "model": "khepera3", "delivered": True, "planned_m": 5.0, "object_m": 4.6,
+            {"cell": 0, "seed": 1, "model": "khepera3", "delivered": True, "planned_m": 5.0, "object_m": 4.5,
              "error_pct": 8.0, "corners": [(90.0, 0.07), (180.0, 0.12)]},
             {"cell": 0, "seed": 2, "model": "khepera3", "delivered": True, "planned_m": 3.0, "object_m": 2.9,
              "error_pct": 3.3, "corners": []},
             {"cell": 0, "seed": 3, "model": "khepera3", "delivered": False}]
     text = corners_md(rows)
+    assert "| none (per run: the two ends) | 3 | 0.100 | — |" in text
     assert "| 90 | 3 | 0.100 | 0.070 |" in text and "| 180 | 2 | 0.300 | 0.110 |" in text
     assert "Runs whose plan has no corner: error 3.3 %" in text
     assert "| 45 | 0 | — | — |" in text  # no corner of that kind: nothing fitted
-    assert "residual rms 0.058 m" in text  # the straight run's 0.1 m, which no corner explains: 0.1 / sqrt 3
+    assert "residual rms 0.000 m" in text
 
 
 @pytest.mark.parametrize("rows", [[], [{"cell": 0, "seed": 0, "model": "x", "delivered": False}]])
