@@ -135,7 +135,7 @@ def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_pa
 
 def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(launch, tmp_path):
     run = launch("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", "--controller-processes", "0",
-                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "depot.unload_time=20.0"]))
+                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "depot.unload_time=20.0", "robots.model=generic"]))
     run.wait_until(lambda: _dock_occupant(run.bag), timeout=120, what="a robot at a dock")
     victim = _dock_occupant(run.bag)
     os.kill(run.child("swarm_controllers.controller_node", victim), signal.SIGKILL)
@@ -149,8 +149,10 @@ def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(
                   for e in diagnostics.decode_events(m.data)[1]]
     (down,) = [e for e in events if isinstance(e, NodeDownEvent)]
     assert down.node == victim and down.kind == "robot"
-    # the robot does not drive from its death on (others may push it: it is a body in the way),
-    # and the depot no longer holds anything for it
+    # the robot does not drive from its death on (others may push it: it is a body in the way;
+    # the generic robot, whose steering goes round a body, because the foot-bot's blind
+    # stop-turn-go legs pushed it on 27 % of its ticks in one run), and the depot no longer holds
+    # anything for it
     track = load_odometry(run.bag)[victim]
     after = track[track[:, 0] > down.stamp_ns / NS_PER_S + 0.2]
     still = np.hypot(*np.diff(after[:, 1:3], axis=0).T) < 1e-9

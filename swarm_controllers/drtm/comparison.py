@@ -168,7 +168,30 @@ def drtm_table_md(rows: Sequence[dict], conditions: Sequence[int], strategies: S
                     row.append("yes" if (ours[0] < ours[1]) == (paper[0] < paper[1]) else "no")
             body.append(row)
         lines += md_table(header, body) + [""]
+        if set(strategies) == set(DRTM_STRATEGIES):
+            lines += [_efficiency_split(rows, cell, c.section), ""]
     return "\n".join(lines)
+
+
+def _efficiency_split(rows: Sequence[dict], cell: int, section: str) -> str:
+    """E_e = F(T) / F_t (eq. (9)), so DRTM's E_e over ARTM's is the product of two ratios of the
+    means: F(T)'s and F_t's inverse. Which of the two carries the gap says whether E_e differs
+    for the food left in the nest at T or for the energy the swarm spent (F_t = F(T) - F(0) +
+    everything consumed)."""
+    def split(final: dict[str, float], collected: dict[str, float]) -> str:
+        f, e = final["drtm"] / final["artm"], collected["artm"] / collected["drtm"]
+        text = f"F(T) x{f:.2f}, 1 / F_t x{e:.2f}"
+        if all(math.isfinite(v) and v > 0 for v in (f, e)) and (f - 1) * (e - 1) > 0:
+            text += f" (F(T) carries {100 * math.log(f) / math.log(f * e):.0f} % of it)"
+        return text
+
+    ours = {m: {s: describe(_ours(rows, s, cell, m)).mean for s in DRTM_STRATEGIES}
+            for m in ("nest_food_final", "food_collected")}
+    paper = {m: {s: _paper_value(section, s, m) for s in DRTM_STRATEGIES} for m in ("nest_food_final", "food_collected")}
+    line = f"E_e = F(T) / F_t, so DRTM's E_e over ARTM's is, on the means: ours {split(*ours.values())}"
+    if all(v for d in paper.values() for v in d.values()):
+        line += f"; paper {split(*paper.values())}"
+    return line + "."
 
 
 def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:

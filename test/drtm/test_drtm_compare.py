@@ -61,6 +61,9 @@ def test_report_puts_ours_next_to_the_papers_numbers_with_t_tests(tmp_path):
     assert "## Sec. 3.1" in table and "## Sec. 4.3" in table and "## Sec. 4.1" not in table
     assert f"{PAPER['4.3']['artm']['oae_total']:.2f}" in table  # the paper's 1612.26 next to ours
     assert "| E_e: energy efficiency [%] | 10.00 ± 0.00 (n=4) | 11.99 | 11.00 ± 0.00 (n=4) | 9.99 | no |" in table
+    # E_e = F(T) / F_t split by hand: F(T) 19 / 18, F_t 181.5 / 171.5 (the paper's 20.84 / 18.34, 183.46 / 173.76)
+    assert ("ours F(T) x1.06, 1 / F_t x1.06 (F(T) carries 49 % of it); "
+            "paper F(T) x1.14, 1 / F_t x1.06 (F(T) carries 70 % of it).") in table
     ttests = (tmp_path / "ttests.md").read_text()
     assert "| 3.1 (Table 2) | F_t |" in ttests and "| 4.3 (Table 4: 5.3) | M_T |" in ttests
     assert "3.1918" in ttests and "***" in ttests  # the paper's t, and our clearly separated groups
