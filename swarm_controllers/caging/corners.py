@@ -103,8 +103,7 @@ def corners_md(rows: Sequence[dict]) -> str:
     lines += md_table(["deflection [deg]", "corners", "length lost per corner [m] (fit)",
                        "closest approach to the corner [m] (mean)"],
                       [["none (per run: the two ends)", str(len(runs)), f"{ends:.3f}", "—"]]
-                      + [[n, str(len(approach[n]))] + ([f"{f:.3f}", f"{np.mean(approach[n]):.3f}"] if approach[n] else ["—", "—"])
-                         for n, f in zip(names, fit)]) + [""]
+                      + [[n, str(len(approach[n])), *_fitted(f, approach[n])] for n, f in zip(names, fit)]) + [""]
     straight = [e for e, c in zip(errors, counts) if c.sum() == 0]
     lines += [f"Fit over {len(runs)} runs: planned - object = a length per run plus one per corner by deflection "
               f"(least squares); residual rms {rms:.3f} m.",
@@ -115,10 +114,16 @@ def corners_md(rows: Sequence[dict]) -> str:
     return "\n".join(lines)
 
 
+def _fitted(loss: float, approaches: Sequence[float]) -> list[str]:
+    """A table row's fitted loss and mean approach; nothing is fitted for a kind no run had."""
+    return [f"{loss:.3f}", f"{np.mean(approaches):.3f}"] if approaches else ["—", "—"]
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     from swarm_controllers.caging.comparison import CELLS
 
-    parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners",
+                                     description=__doc__.split("\n")[0])
     parser.add_argument("--cells", type=int, nargs="+", default=[0, 2, 3], choices=[c.number for c in CELLS])
     parser.add_argument("--seeds", type=int, default=6, help="seeds 0..N-1 of every cell")
     parser.add_argument("--robot-model", default="khepera3")
@@ -138,9 +143,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             sink.write(json.dumps(row) + "\n")
             sink.flush()
             rows.append(row)
-            print(f"cell {row['cell']} seed {row['seed']}: " + (
-                f"error {row['error_pct']:.1f} %, {len(row['corners'])} corners" if row["delivered"] else "not delivered"),
-                flush=True)
+            outcome = f"error {row['error_pct']:.1f} %, {len(row['corners'])} corners" if row["delivered"] \
+                else "not delivered"
+            print(f"cell {row['cell']} seed {row['seed']}: {outcome}", flush=True)
     (args.out / "corners.md").write_text(corners_md(rows))
     print(f"{len(rows)} runs in {store}; wrote {args.out / 'corners.md'}")
     return 0
