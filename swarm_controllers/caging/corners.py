@@ -29,7 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm_controllers.caging.comparison import CELLS
+from swarm_controllers.caging.metrics import caging_report, polyline_length, series_of, transport_stage
+from swarm_sim.batch import run_batch
 from swarm_sim.compare.report import md_table
+from swarm_sim.scenario import load_scenario
 
 DEFLECTION_BINS: tuple[tuple[str, float, float], ...] = (
     ("45", 22.5, 67.5), ("90", 67.5, 112.5), ("135", 112.5, 157.5), ("180", 157.5, 180.01))
@@ -60,11 +64,6 @@ def corner_counts(found: Sequence[tuple[float, float]]) -> list[int]:
 
 def run_row(cell: int, seed: int, model: str) -> dict:
     """One batch run of the caging scenario's `cell` (`comparison.CELLS`), measured."""
-    from swarm_controllers.caging.comparison import CELLS
-    from swarm_controllers.caging.metrics import caging_report, polyline_length, series_of, transport_stage
-    from swarm_sim.batch import run_batch
-    from swarm_sim.scenario import load_scenario
-
     scenario = load_scenario("caging", [*CELLS[cell].overrides, f"robots.model={model}",
                                         "sim.stop_when_finished=true", "sim.duration=2400"], seed=seed)
     trace = run_batch(scenario).trace
@@ -120,8 +119,6 @@ def _fitted(loss: float, approaches: Sequence[float]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    from swarm_controllers.caging.comparison import CELLS
-
     parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("--cells", type=int, nargs="+", default=[0, 2, 3], choices=[c.number for c in CELLS])
