@@ -29,7 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm_controllers.caging.comparison import CELLS
+from swarm_controllers.caging.metrics import caging_report, polyline_length, series_of, transport_stage
+from swarm_sim.batch import run_batch
 from swarm_sim.compare.report import md_table
+from swarm_sim.scenario import load_scenario
 
 DEFLECTION_BINS: tuple[tuple[str, float, float], ...] = (
     ("45", 22.5, 67.5), ("90", 67.5, 112.5), ("135", 112.5, 157.5), ("180", 157.5, 180.01))
@@ -60,11 +64,6 @@ def corner_counts(found: Sequence[tuple[float, float]]) -> list[int]:
 
 def run_row(cell: int, seed: int, model: str) -> dict:
     """One batch run of the caging scenario's `cell` (`comparison.CELLS`), measured."""
-    from swarm_controllers.caging.comparison import CELLS
-    from swarm_controllers.caging.metrics import caging_report, polyline_length, series_of, transport_stage
-    from swarm_sim.batch import run_batch
-    from swarm_sim.scenario import load_scenario
-
     scenario = load_scenario("caging", [*CELLS[cell].overrides, f"robots.model={model}",
                                         "sim.stop_when_finished=true", "sim.duration=2400"], seed=seed)
     trace = run_batch(scenario).trace
@@ -103,8 +102,7 @@ def corners_md(rows: Sequence[dict]) -> str:
     lines += md_table(["deflection [deg]", "corners", "length lost per corner [m] (fit)",
                        "closest approach to the corner [m] (mean)"],
                       [["none (per run: the two ends)", str(len(runs)), f"{ends:.3f}", "—"]]
-                      + [[n, str(len(approach[n]))] + ([f"{f:.3f}", f"{np.mean(approach[n]):.3f}"] if approach[n] else ["—", "—"])
-                         for n, f in zip(names, fit)]) + [""]
+                      + [[n, str(len(approach[n])), *_fitted(f, approach[n])] for n, f in zip(names, fit)]) + [""]
     straight = [e for e, c in zip(errors, counts) if c.sum() == 0]
     lines += [f"Fit over {len(runs)} runs: planned - object = a length per run plus one per corner by deflection "
               f"(least squares); residual rms {rms:.3f} m.",
@@ -115,10 +113,14 @@ def corners_md(rows: Sequence[dict]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    from swarm_controllers.caging.comparison import CELLS
+def _fitted(loss: float, approaches: Sequence[float]) -> list[str]:
+    """A table row's fitted loss and mean approach; nothing is fitted for a kind no run had."""
+    return [f"{loss:.3f}", f"{np.mean(approaches):.3f}"] if approaches else ["—", "—"]
 
-    parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners", description=__doc__.split("\n")[0])
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners",
+                                     description=__doc__.split("\n")[0])
     parser.add_argument("--cells", type=int, nargs="+", default=[0, 2, 3], choices=[c.number for c in CELLS])
     parser.add_argument("--seeds", type=int, default=6, help="seeds 0..N-1 of every cell")
     parser.add_argument("--robot-model", default="khepera3")
@@ -138,9 +140,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             sink.write(json.dumps(row) + "\n")
             sink.flush()
             rows.append(row)
-            print(f"cell {row['cell']} seed {row['seed']}: " + (
-                f"error {row['error_pct']:.1f} %, {len(row['corners'])} corners" if row["delivered"] else "not delivered"),
-                flush=True)
+            outcome = f"error {row['error_pct']:.1f} %, {len(row['corners'])} corners" if row["delivered"] \
+                else "not delivered"
+            print(f"cell {row['cell']} seed {row['seed']}: {outcome}", flush=True)
     (args.out / "corners.md").write_text(corners_md(rows))
     print(f"{len(rows)} runs in {store}; wrote {args.out / 'corners.md'}")
     return 0

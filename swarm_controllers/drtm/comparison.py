@@ -185,9 +185,9 @@ def _efficiency_split(rows: Sequence[dict], cell: int, section: str) -> str:
             text += f" (F(T) carries {100 * math.log(f) / math.log(f * e):.0f} % of it)"
         return text
 
-    ours = {m: {s: describe(_ours(rows, s, cell, m)).mean for s in DRTM_STRATEGIES}
-            for m in ("nest_food_final", "food_collected")}
-    paper = {m: {s: _paper_value(section, s, m) for s in DRTM_STRATEGIES} for m in ("nest_food_final", "food_collected")}
+    measures = ("nest_food_final", "food_collected")
+    ours = {m: {s: describe(_ours(rows, s, cell, m)).mean for s in DRTM_STRATEGIES} for m in measures}
+    paper = {m: {s: _paper_value(section, s, m) for s in DRTM_STRATEGIES} for m in measures}
     line = f"E_e = F(T) / F_t, so DRTM's E_e over ARTM's is, on the means: ours {split(*ours.values())}"
     if all(v for d in paper.values() for v in d.values()):
         line += f"; paper {split(*paper.values())}"

@@ -5,8 +5,9 @@ ROS-free core of the center (its node is the generic server node, `swarm_sim.nod
 `swarm_sim.protocol` messages, with the ``/center/state`` it publishes, end of file), `draw` (its
 regions and planned spirals) and `region_paths` (the regions' spirals, shared with the MDBSA behaviours). The center is a hub
 robots talk to only while they are at it: there a robot reports how far it walked
-(`report_progress`) and, when its walk is over (or at the start), asks for a new one (`request`). Deterministic: no rng, every tie goes to the lowest
-region id; `t` [s, sim time] is only recorded, never used to decide.
+(`report_progress`) and, when its walk is over (or at the start), asks for a new one (`request`). Deterministic: no rng, every tie goes to the region
+earliest in the hand-out order (``regions.order``: region id, or nearest the centre first as the
+authors' code has it); `t` [s, sim time] is only recorded, never used to decide.
 
 Arc length s is always measured from the spiral's start (its region center, `SpiralPath.start`)
 whatever the walking direction. A region's progress is two covered intervals, one grown from each
@@ -17,18 +18,19 @@ is all the state a path needs.
 Rules (the paper's, Sec. IV) and the choices the paper leaves open:
 
 * **robots <= regions**: robot k (k-th id in the order given, the node passes robot_0..robot_n-1)
-  is allocated region k, forward. Regions k >= n_robots stay unassigned.
-* **robots > regions**: robot k < N_R gets region k forward, robot N_R <= k < 2 N_R gets region
-  k - N_R from its far end (reverse); robots k >= 2 N_R start idle.
+  is allocated the k-th region of the hand-out order, forward. The others stay unassigned.
+* **robots > regions**: robot k < N_R gets the k-th region forward, robot N_R <= k < 2 N_R the
+  (k - N_R)-th from its far end (reverse); robots k >= 2 N_R start idle.
 * The initial allocation is made at construction (t = 0; the paper's center allocates at the
   start), so a robot's initial slot counts as taken before the robot first asks; its first
   `request` returns it.
 * **Later requests** (a robot's walk is over, or it is idle), in this order, for both cases:
   1. an *unassigned* region (no walker, not finished): the one with the longest remaining path,
-     ties lowest id (fresh regions all have the same length, so this is "lowest id"); the robot
+     ties to the earliest in the hand-out order (fresh regions all have the same length, so this
+     is "the next in order"); the robot
      walks forward from the start-side frontier (a region left by an early-ending walker is
      resumed where coverage stopped);
-  2. else a region with exactly one walker and the *longest remaining path*, ties lowest id:
+  2. else a region with exactly one walker and the *longest remaining path*, ties as in 1:
      the robot walks the other way from the free end's frontier, so normally from the far end;
   3. else idle (None); an idle robot asks again later.
   The paper's "robots > regions" wording only mentions sharing; rule 1 is vacuous there unless a
@@ -66,7 +68,7 @@ from swarm_controllers.spiral.geometry import (
     segments_overlap_collinear,
 )
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
-from swarm_controllers.spiral.regions import RegionConfig
+from swarm_controllers.spiral.regions import RegionConfig, region_order
 from swarm_controllers.spiral.state import RegionView
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.protocol import Drawing, Lines
@@ -138,13 +140,19 @@ class RegionAssigner:
     """The MDBSA center's assignment and progress book-keeping (see module docstring)."""
 
     def __init__(self, paths: Sequence[SpiralPath], robots: Sequence[RobotId], *,
-                 finish_tolerance: float = 1e-6) -> None:
+                 finish_tolerance: float = 1e-6, order: Sequence[int] | None = None) -> None:
         """paths: one spiral per region, indexed by region id. robots: ids in allocation order
-        (robot k gets region k). finish_tolerance [m]: remaining length treated as nothing."""
+        (robot k gets region order[k]). finish_tolerance [m]: remaining length treated as nothing.
+        order: the region ids in hand-out order (`regions.region_order`; None: by id), which
+        also breaks ties between equally long regions later."""
         if len(paths) == 0:
             raise ValueError("need at least one region")
         if len(set(robots)) != len(robots):
             raise ValueError(f"duplicate robot ids in {list(robots)}")
+        self._order = tuple(range(len(paths))) if order is None else tuple(order)
+        if sorted(self._order) != list(range(len(paths))):
+            raise ValueError(f"order {list(self._order)} is not a permutation of the {len(paths)} region ids")
+        self._rank = {rid: k for k, rid in enumerate(self._order)}
         self._tol = float(finish_tolerance)
         self._regions = [_Region(p.length) for p in paths]
         self._robots = tuple(robots)
@@ -155,9 +163,9 @@ class RegionAssigner:
         n_regions = len(paths)
         for k, robot in enumerate(self._robots):
             if k < n_regions:
-                self._assign(robot, k, FORWARD, 0.0)
+                self._assign(robot, self._order[k], FORWARD, 0.0)
             elif k < MAX_WALKERS * n_regions:  # only reached with more robots than regions
-                self._assign(robot, k - n_regions, REVERSE, 0.0)
+                self._assign(robot, self._order[k - n_regions], REVERSE, 0.0)
             else:
                 continue
             self._pending.add(robot)
@@ -273,7 +281,8 @@ class RegionAssigner:
 
     def _choose(self) -> tuple[int, int] | None:
         """(region, direction) by the rules: unassigned first, then share; longest remaining,
-        ties (within finish_tolerance: equal spirals differ by float rounding) lowest id."""
+        ties (within finish_tolerance: equal spirals differ by float rounding) to the earliest in
+        the hand-out order."""
         open_regions = [(rid, reg) for rid, reg in enumerate(self._regions)
                         if reg.remaining > self._tol]
         unassigned = [(rid, reg) for rid, reg in open_regions if not reg.walkers]
@@ -288,7 +297,7 @@ class RegionAssigner:
 
     def _longest(self, candidates: list[tuple[int, _Region]]) -> int:
         best = max(reg.remaining for _, reg in candidates)
-        return min(rid for rid, reg in candidates if reg.remaining >= best - self._tol)
+        return min((rid for rid, reg in candidates if reg.remaining >= best - self._tol), key=self._rank.__getitem__)
 
     def _assign(self, robot: RobotId, region: int, direction: int, t: float) -> Assignment:
         reg = self._regions[region]
@@ -427,7 +436,7 @@ class CenterServer:
     def __init__(self, scenario: Scenario) -> None:
         self.paths: list[SpiralPath] = region_paths(scenario)
         """One spiral per region [m, world frame]."""
-        self.assigner = RegionAssigner(self.paths, scenario.robot_names)
+        self.assigner = RegionAssigner(self.paths, scenario.robot_names, order=region_order(scenario))
         cx, cy = scenario.depot.center
         self._center = (float(cx), float(cy))
         self._range = float(SpiralConfig.of(scenario).center_range)

@@ -17,6 +17,9 @@ import numpy as np
 
 from swarm_sim.scenario.schema import DropZoneConfig, Scenario, WorldSection
 
+REGION_ORDERS = ("row_major", "nearest_first")
+"""The values of `RegionConfig.order`."""
+
 
 @dataclass(frozen=True)
 class RegionConfig(WorldSection):
@@ -28,6 +31,15 @@ class RegionConfig(WorldSection):
     center_radius: float = 0.25
     """Radius of each region centre's drop zone [m] (MDBSA-D), within which an idle MDBSA robot
     stops (the authors' ``RegionRadius``)."""
+    order: str = "row_major"
+    """The order in which the center hands regions out (robot k's first region is the k-th; a
+    later walk goes to the longest unwalked region, ties to the earlier in this order):
+    ``row_major``, eq. (3)'s (i, j) in row-major order, region 0 the (+x, +y) corner; or
+    ``nearest_first``, by distance of the region's centre from the depot's (the nest, the arena's
+    centre in the authors' set-up), ties in row-major order, as the MDBSA authors' ``DSA_loop_functions::calRegions`` sorts them
+    (MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, luki-dev c890aa1,
+    ``Centralized/source/DSA/DSA_loop_functions.cpp``: ``sort`` of (squared distance, row-major
+    index) pairs). The paper says only "based on its ID"."""
 
     SECTION: ClassVar[str] = "regions"
 
@@ -37,6 +49,8 @@ class RegionConfig(WorldSection):
             raise ValueError(f"regions.count: {self.count} is not a power of 4")
         if not self.center_radius > 0:
             raise ValueError("regions.center_radius: must be positive")
+        if self.order not in REGION_ORDERS:
+            raise ValueError(f"regions.order: {self.order!r} is not one of {', '.join(REGION_ORDERS)}")
 
 
 def region_centers(n_regions: int, arena_size: float) -> np.ndarray:
@@ -56,6 +70,18 @@ def region_centers(n_regions: int, arena_size: float) -> np.ndarray:
     coord = arena_size / 2.0 * (1.0 - (2 * idx + 1) / n)
     ii, jj = np.meshgrid(idx, idx, indexing="ij")
     return np.stack([coord[ii.ravel()], coord[jj.ravel()]], axis=1)
+
+
+def region_order(scenario: Scenario) -> tuple[int, ...]:
+    """The region ids in the order the center hands them out (`RegionConfig.order`)."""
+    r = RegionConfig.of(scenario)
+    ids = tuple(range(r.count))
+    if r.order == "row_major":
+        return ids
+    centers = region_centers(r.count, scenario.arena.size)
+    cx, cy = scenario.depot.center
+    # squared distances, as the authors sort them: equal rings compare equal, ties by id
+    return tuple(sorted(ids, key=lambda k: ((centers[k, 0] - cx) ** 2 + (centers[k, 1] - cy) ** 2, k)))
 
 
 def region_center_zones(scenario: Scenario) -> tuple[DropZoneConfig, ...]:

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_controllers.spiral.center import FORWARD, REVERSE, Assignment, RegionAssigner
 from swarm_controllers.spiral.geometry import SpiralPath, mdbsa_path, region_centers, region_side
+from swarm_controllers.spiral.regions import region_order
+from swarm_sim.scenario import ScenarioError
 from swarm_sim.types import robot_name
 
 ARENA = 8.0
@@ -47,6 +50,30 @@ def test_fewer_robots_first_assignment_by_id():
     # one walker in each of regions 0..7, regions 8..15 unassigned
     snap = ca.snapshot()
     assert [len(r.walkers) for r in snap] == [1] * 8 + [0] * 8
+
+
+NEAREST_FIRST_16 = (5, 6, 9, 10, 1, 2, 4, 7, 8, 11, 13, 14, 0, 3, 12, 15)
+"""By hand, 16 regions of an 8 m arena (centres at +-1 and +-3 m, region id = 4 i + j with x from
+i, y from j): the four at squared distance 2, then the eight at 10, then the corners at 18, each
+ring in id order, as the authors' sort of (squared distance, row-major index) pairs gives."""
+
+
+def test_the_authors_order_hands_out_the_regions_nearest_the_centre_first():
+    scenario = generic_scenario("mdbsa_c", ["regions.order=nearest_first"])
+    assert region_order(scenario) == NEAREST_FIRST_16
+    assert region_order(generic_scenario("mdbsa_c")) == tuple(range(16))
+    ca = RegionAssigner(paths(16), robots(8), order=NEAREST_FIRST_16)
+    first = [ca.request(robot_name(k), 0.0) for k in range(8)]
+    assert [a.region for a in first] == list(NEAREST_FIRST_16[:8])
+    finish(ca, first[3], 10.0)  # robot_3 finishes region 10: the next fresh one in order is 8
+    assert ca.request(robot_name(3), 10.0).region == 8
+
+
+def test_an_unknown_order_is_refused_naming_the_key():
+    with pytest.raises(ScenarioError, match="regions.order"):
+        generic_scenario("mdbsa_c", ["regions.order=random"])
+    with pytest.raises(ValueError, match="not a permutation"):
+        RegionAssigner(paths(4), robots(2), order=(0, 1, 1, 2))
 
 
 def test_fewer_robots_finishers_take_unassigned_then_share_longest_from_far_end():
