@@ -221,6 +221,24 @@ def test_a_collision_turns_clockwise_on_either_side_then_pushes_a_blind_step():
     assert d.update(_ranges(s, {30.0: 0.2})) is None  # beyond the ring's 0.1 m
 
 
+def test_the_ddsa_authors_collision_turns_away_by_37_5_deg_more_and_keeps_turning():
+    """DDSA BaseController: readings at +37.5 deg (left) turn the robot right by 75 deg, readings
+    at -37.5 deg turn it left by 75 deg; then the step, and no forward drive in place of the turn."""
+    s = _scenario("footbot_cpfa", "robots.stop_turn_go.collision_turn=away")
+    w = s.robots.max_angular_speed
+    for side, sign in ((37.5, -1.0), (-37.5, 1.0)):
+        d = StopTurnGo(s, np.random.default_rng(1))
+        d.begin(0)
+        assert d.update(_ranges(s, {side: 0.05})) == Command(0.0, sign * w)
+        moves = d._next[0]
+        assert [m[0] for m in moves] == [1, 0, 2]
+        assert moves[0][1] == pytest.approx(0.105 * 75.0 / 8.0 - DT)  # 37.5 + 37.5 deg at 8 cm/s
+        d.begin(DT_NS)  # clear now: it goes on turning (no collisionDelay branch)
+        assert d.update(_ranges(s, {})) == Command(0.0, sign * w)
+    with pytest.raises(ScenarioError, match="robots.stop_turn_go.collision_turn"):
+        _scenario("footbot_cpfa", "robots.stop_turn_go.collision_turn=left")
+
+
 def test_an_idle_robot_only_turns_on_a_collision():
     s = _scenario("footbot_cpfa")
     d = StopTurnGo(s, np.random.default_rng(1))

@@ -21,7 +21,9 @@ MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm (branch ``lu
   vector is on (``SetLeftTurn(angle)`` for angle <= 0 and ``SetRightTurn(angle)`` for angle > 0
   both end in the RIGHT state), and sets ``collisionDelay`` = now + U(0.5, 1.0) s. Until that
   delay has passed, a turning robot drives forward at full speed instead, unless it collides on
-  that tick (``Move``, cases LEFT and RIGHT, "qilu 10/26/2016").
+  that tick (``Move``, cases LEFT and RIGHT, "qilu 10/26/2016"). The DDSA authors' BaseController
+  turns *away* instead, by 37.5 deg plus the angle, and always turns
+  (``robots.stop_turn_go.collision_turn: away``).
 - A robot standing idle (``Stop()`` before every ``Move()``) only turns on a collision; its pushed
   step never runs (`turn_only`).
 - A robot that follows a queue's path does not avoid: the queue authors' ``CPFA_controller::
@@ -66,6 +68,8 @@ TURN_CM_PER_DEGREE = 0.105
 """``SetTargetAngleDistance``: s = 0.105 x angle [deg], turned for s / ``RobotRotationSpeed`` s."""
 COLLISION_DELAY = (0.5, 1.0)
 """[s] ``collisionDelay`` after a collision: U(0.5, 1.0) s."""
+AWAY_OFFSET = 37.5
+"""[deg] the DDSA authors' turn away from a collision: 37.5 deg beyond the readings' angle."""
 
 _STOP, _TURN, _FORWARD = 0, 1, 2
 _TWO_PI = 2.0 * math.pi
@@ -76,7 +80,7 @@ class StopTurnGo:
     """One robot's ``BaseController`` (see the module docstring); a `swarm_controllers.motion.Drive`."""
 
     __slots__ = (
-        "_angle_tol", "_collided", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle", "_looked",
+        "_angle_tol", "_away", "_collided", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle", "_looked",
         "_next", "_request", "_ring", "_rng", "_stamp", "_state", "_step", "_v", "_w", "_wheel_cm",
         "active", "events",
     )
@@ -94,6 +98,7 @@ class StopTurnGo:
         self._angle_tol = cfg.angle_tolerance
         self._dist_tol = cfg.distance_tolerance
         self._step = cfg.collision_step
+        self._away = cfg.collision_turn == "away"
         self._ring = RingSensor(scenario)
         self._cos_ahead = math.cos(math.radians(scenario.sensors.proximity_ring.ahead))
         self._rng = (rng if rng is not None else np.random.default_rng(0)).spawn(1)[0]
@@ -195,9 +200,13 @@ class StopTurnGo:
         moves, delay, seq = self._state
         hit = self._hit
         if hit is not None:
-            turn = ((_TURN, TURN_CM_PER_DEGREE * abs(hit) / self._wheel_cm, -1.0),) if hit else ()
+            if self._away:  # left by 37.5 - angle for readings on the right (angle <= 0), else right
+                turn = ((_TURN, TURN_CM_PER_DEGREE * (AWAY_OFFSET + abs(hit)) / self._wheel_cm,
+                         1.0 if hit <= 0.0 else -1.0),)
+            else:
+                turn = ((_TURN, TURN_CM_PER_DEGREE * abs(hit) / self._wheel_cm, -1.0),) if hit else ()
             moves = turn if self._idle else (*turn, (_STOP, POP_TIME, 0.0), (_FORWARD, self._step / self._v, 0.0))
-            delay, seq = self._delay_draw, True
+            delay, seq = (0.0 if self._away else self._delay_draw), True
         elif self._idle:
             moves, seq = _EMPTY, False
         if not moves and self._request is not None and hit is None:

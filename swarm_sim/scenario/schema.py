@@ -108,6 +108,13 @@ class StopTurnGoConfig:
     """``TargetDistanceTolerance`` [m]: a target this close is reached (the robot stops)."""
     collision_step: float = 0.08
     """``SearchStepSize`` [m]: the blind step pushed after a collision turn."""
+    collision_turn: str = "clockwise"
+    """How ``CollisionDetection`` turns: ``clockwise``, by the readings' angle, and forward instead
+    of turning for ``collisionDelay`` (the CPFA's and the MDBSA authors' BaseController); or
+    ``away``, away from the readings by 37.5 deg plus their angle, always turning (the DDSA
+    authors' BaseController: MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-Search-Algorithm,
+    luki-dev, ``source/Base/BaseController.cpp``, ``SetLeftTurn(37.5 - collisionAngle)`` /
+    ``SetRightTurn(37.5 + collisionAngle)``, and a ``Move`` without the delay branch)."""
 
 
 @dataclass(frozen=True)
