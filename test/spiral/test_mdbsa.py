@@ -42,8 +42,10 @@ from swarm_sim.sites import drop_zones
 from swarm_sim.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.world.tasks.foraging import ForagingSense
 
-C = generic_scenario("mdbsa_c")
-D = generic_scenario("mdbsa_d")
+ROW_MAJOR = ["regions.order=row_major"]
+"""The hand-worked cases below number regions by id (the authors' nearest-first order: test_center)."""
+C = generic_scenario("mdbsa_c", ROW_MAJOR)
+D = generic_scenario("mdbsa_d", ROW_MAJOR)
 DT, DT_NS = C.sim.dt, C.dt_ns
 CLEAR = np.full(C.sensors.scan.rays, np.inf, dtype=np.float32)
 SMALL = generic_scenario(  # 2.4 m arena, 4 regions of 1.2 m: spirals of ~8 m, walked in ~1 min
@@ -70,7 +72,11 @@ def test_scenarios_are_experiment_1_with_16_regions():
     for s, name in ((C, "mdbsa_c"), (D, "mdbsa_d")):
         assert s.controller.behaviour == name
         assert RegionConfig.of(s).count == 16
-        assert (s.arena, s.robots, s.resources, s.sim) == (ddsa.arena, ddsa.robots, ddsa.resources, ddsa.sim)
+        # the same world; the robots may differ in the collision turn only (DDSA's authors turn away)
+        robots = dataclasses.replace(s.robots, stop_turn_go=ddsa.robots.stop_turn_go)
+        assert (s.arena, robots, s.resources, s.sim) == (ddsa.arena, ddsa.robots, ddsa.resources, ddsa.sim)
+        assert dataclasses.replace(s.robots.stop_turn_go, collision_turn="x") == \
+            dataclasses.replace(ddsa.robots.stop_turn_go, collision_turn="x")
     assert C.depot.delivery == "depot"
     assert [z.name for z in drop_zones(C)] == ["depot"]
     # MDBSA-D: the region centers are the drop zones and the depot disc is not one, so a
