@@ -93,7 +93,8 @@ def test_mdbsa_d_graph_run_stays_in_assigned_regions(tmp_path):
         inside = abs(p.x - cx) <= half and abs(p.y - cy) <= half
         assert inside or p.stamp_ns / NS_PER_S <= arrival[p.robot], p
 
-    batch = summarize(run_batch(load_scenario("mdbsa_d", [f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])).trace)
+    batch = summarize(run_batch(load_scenario("mdbsa_d", [f"robots.count={ROBOTS}", f"sim.duration={DURATION}",
+                                                           "regions.order=row_major"])).trace)
     for key in ("resources_delivered", "collision_time_per_robot_s", "resources_per_robot",
                 "resources_per_robot_per_min"):
         assert batch[key] == summary[key], key
