@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from swarm_controllers.caging.comparison import CELLS
-from swarm_controllers.caging.metrics import caging_report, polyline_length, series_of, transport_stage
+from swarm_controllers.caging.metrics import caging_report, series_of, transport_stage
 from swarm_sim.batch import run_batch
 from swarm_sim.compare.report import md_table
 from swarm_sim.scenario import load_scenario
@@ -74,7 +74,7 @@ def run_row(cell: int, seed: int, model: str) -> dict:
     times, positions = series_of(trace, "object")
     window = (times >= transport.start_s - 1e-9) & (times <= transport.end_s + 1e-9)
     path = np.array(positions)[window]
-    return row | {"planned_m": polyline_length(transport.planned), "object_m": polyline_length(path),
+    return row | {"planned_m": report.planned_path_m, "object_m": report.object_path_m,
                   "error_pct": report.trajectory_error_pct, "corners": corners(transport.planned, path)}
 
 
@@ -121,8 +121,8 @@ def _fitted(loss: float, approaches: Sequence[float]) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m swarm_controllers.caging.corners",
                                      description=__doc__.split("\n")[0])
-    parser.add_argument("--cells", type=int, nargs="+", default=[0, 2, 3], choices=[c.number for c in CELLS])
-    parser.add_argument("--seeds", type=int, default=6, help="seeds 0..N-1 of every cell")
+    parser.add_argument("--cells", type=int, nargs="+", default=[1, 3], choices=[c.number for c in CELLS])
+    parser.add_argument("--seeds", type=int, default=10, help="seeds 0..N-1 of every cell")
     parser.add_argument("--robot-model", default="khepera3")
     parser.add_argument("--jobs", type=int, default=1, help="runs at once (processes)")
     parser.add_argument("--out", type=Path, default=Path("results/factors/caging"))

@@ -10,16 +10,12 @@ algorithms declare both sections, so a DRTM and an ARTM run of one scenario file
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 from swarm_sim.scenario import Section
 
 if TYPE_CHECKING:
     from swarm_sim.scenario import Scenario
-
-
-OAE_WINDOW_STATES = ("all", "returning")
-"""The values of `NestConfig.oae_window_states`."""
 
 
 @dataclass(frozen=True)
@@ -42,7 +38,7 @@ class NestConfig(Section):
     oae_window: float | None = None
     """T_2 of eq. (5) [s]: OAEs this recent count as M_T2. None: L / (2 v) as in the paper
     (arena side over twice ``robots.max_linear_speed``)."""
-    oae_window_states: str = "all"
+    oae_window_states: Literal["all", "returning"] = "all"
     """Whose OAEs M_T2 counts: ``all`` (every forager's, S_S and S_R) or ``returning`` (only
     those of robots in S_R). Sec. 2.2 defines M_T2 as "the total number of OAEs over time T_2",
     then motivates T_2 with "the number of OAEs due to robots within state S_R can well reflect
@@ -115,9 +111,6 @@ def check_nest(scenario: Scenario) -> None:
             raise ValueError(f"controller.nest.{key}: must not be negative")
     if nest.oae_window is not None and not nest.oae_window > 0:
         raise ValueError("controller.nest.oae_window: must be positive (or null for L / 2v)")
-    if nest.oae_window_states not in OAE_WINDOW_STATES:
-        raise ValueError(f"controller.nest.oae_window_states: {nest.oae_window_states!r} is not one of "
-                         f"{', '.join(OAE_WINDOW_STATES)}")
     if th.min_wait_steps < 0:
         raise ValueError("controller.threshold.min_wait_steps: must not be negative")
     if th.period() < 1:

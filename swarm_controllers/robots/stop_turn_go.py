@@ -80,8 +80,8 @@ class StopTurnGo:
     """One robot's ``BaseController`` (see the module docstring); a `swarm_controllers.motion.Drive`."""
 
     __slots__ = (
-        "_angle_tol", "_away", "_collided", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle", "_looked",
-        "_next", "_request", "_ring", "_rng", "_stamp", "_state", "_step", "_v", "_w", "_wheel_cm",
+        "_angle_tol", "_away", "_collided", "_cos_ahead", "_delay_draw", "_dist_tol", "_dt", "_hit", "_idle",
+        "_looked", "_next", "_request", "_ring", "_rng", "_stamp", "_state", "_step", "_v", "_w", "_wheel_cm",
         "active", "events",
     )
     blind_legs = True

@@ -11,14 +11,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 import numpy as np
 
 from swarm_sim.scenario.schema import DropZoneConfig, Scenario, WorldSection
-
-REGION_ORDERS = ("row_major", "nearest_first")
-"""The values of `RegionConfig.order`."""
 
 
 @dataclass(frozen=True)
@@ -31,15 +28,15 @@ class RegionConfig(WorldSection):
     center_radius: float = 0.25
     """Radius of each region centre's drop zone [m] (MDBSA-D), within which an idle MDBSA robot
     stops (the authors' ``RegionRadius``)."""
-    order: str = "row_major"
+    order: Literal["row_major", "nearest_first"] = "row_major"
     """The order in which the center hands regions out (robot k's first region is the k-th; a
     later walk goes to the longest unwalked region, ties to the earlier in this order):
     ``row_major``, eq. (3)'s (i, j) in row-major order, region 0 the (+x, +y) corner; or
     ``nearest_first``, by distance of the region's centre from the depot's (the nest, the arena's
-    centre in the authors' set-up), ties in row-major order, as the MDBSA authors' ``DSA_loop_functions::calRegions`` sorts them
-    (MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm, luki-dev c890aa1,
-    ``Centralized/source/DSA/DSA_loop_functions.cpp``: ``sort`` of (squared distance, row-major
-    index) pairs). The paper says only "based on its ID"."""
+    centre in the authors' set-up), ties in row-major order, as the MDBSA authors'
+    ``DSA_loop_functions::calRegions`` sorts them (MARSLab-UTRGV/Adaptive-Multiple-Distributed-
+    Spiral-Search-Algorithm, luki-dev c890aa1, ``Centralized/source/DSA/DSA_loop_functions.cpp``:
+    ``sort`` of (squared distance, row-major index) pairs). The paper says only "based on its ID"."""
 
     SECTION: ClassVar[str] = "regions"
 
@@ -49,8 +46,6 @@ class RegionConfig(WorldSection):
             raise ValueError(f"regions.count: {self.count} is not a power of 4")
         if not self.center_radius > 0:
             raise ValueError("regions.center_radius: must be positive")
-        if self.order not in REGION_ORDERS:
-            raise ValueError(f"regions.order: {self.order!r} is not one of {', '.join(REGION_ORDERS)}")
 
 
 def region_centers(n_regions: int, arena_size: float) -> np.ndarray:

@@ -108,7 +108,7 @@ class StopTurnGoConfig:
     """``TargetDistanceTolerance`` [m]: a target this close is reached (the robot stops)."""
     collision_step: float = 0.08
     """``SearchStepSize`` [m]: the blind step pushed after a collision turn."""
-    collision_turn: str = "clockwise"
+    collision_turn: Literal["clockwise", "away"] = "clockwise"
     """How ``CollisionDetection`` turns: ``clockwise``, by the readings' angle, and forward instead
     of turning for ``collisionDelay`` (the CPFA's and the MDBSA authors' BaseController); or
     ``away``, away from the readings by 37.5 deg plus their angle, always turning (the DDSA

@@ -95,8 +95,6 @@ def check_world(s: Scenario) -> None:
     _require(stg.angle_tolerance > 0, "robots.stop_turn_go.angle_tolerance: must be positive")
     _require(stg.distance_tolerance > 0, "robots.stop_turn_go.distance_tolerance: must be positive")
     _require(stg.collision_step >= 0, "robots.stop_turn_go.collision_step: must not be negative")
-    _require(stg.collision_turn in ("clockwise", "away"),
-             f"robots.stop_turn_go.collision_turn: {stg.collision_turn!r} is not one of clockwise, away")
     wt = r.wheel_turning
     _require(0 <= wt.no_turn_angle <= wt.soft_turn_angle <= wt.hard_turn_angle <= 180,
              "robots.wheel_turning: need 0 <= no_turn_angle <= soft_turn_angle <= hard_turn_angle <= 180 deg")
