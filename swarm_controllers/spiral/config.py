@@ -4,7 +4,7 @@ registry records (`swarm_controllers.spiral.registration`), and its check."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 from swarm_sim.scenario import Section
 
@@ -24,6 +24,23 @@ class SpiralConfig(Section):
     """Spirals are clipped to the arena square shrunk by this much on every side [m]."""
     center_range: float = 0.75
     """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
+    waypoint_gaps: int = 1
+    """On a straight leg of the spiral the robot aims this many gaps g ahead of its progress (never
+    past the leg's end): with the foot-bot's stop-turn-go motion, a stop every ``waypoint_gaps * g``.
+    The DDSA authors set a waypoint every gap (``SetTargetN..W``, MARSLab-UTRGV/DDSA-Distributed-
+    Deterministic-Spiral-Search-Algorithm, luki-dev, ``source/DSA/DSA_controller.cpp``); their
+    MDBSA every 3 gaps, and the remainder at a leg's end (``generateSpiralPath``, "create a point
+    in every 3 searchGap", MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm,
+    luki-dev, ``Centralized/source/DSA/DSA_loop_functions.cpp``). The paper says nothing of it."""
+    next_walk_at: Literal["center_range", "nest"] = "center_range"
+    """MDBSA: where a robot whose walk is over asks for the next one. ``center_range``: as soon as
+    it is `mdbsa.ASK_MARGIN` inside ``center_range`` (it never enters the depot). ``nest``: it
+    first drives to within `mdbsa.NEST_HIT` of the depot centre + `mdbsa.NEST_OFFSET`, as the
+    MDBSA authors' robot does (``DSA = START; SetTarget(CVector2(0.1, 0.1))`` once its point list
+    is empty, reached when ``TargetHit``, squared distance below ``TargetDistanceTolerance`` =
+    0.01: ``DSA_controller::ReachSpiralTargets``, luki-dev, both controllers), so every walk's end
+    crosses the nest. The first walk is asked for in range either way (the authors' robots get it
+    at tick 0 where they stand)."""
 
     SECTION: ClassVar[str] = "spiral"
 
@@ -39,3 +56,5 @@ def check_spiral(scenario: Scenario) -> None:
         raise ValueError("controller.spiral.arena_margin: leaves no arena to search")
     if not sp.center_range > 0:
         raise ValueError("controller.spiral.center_range: must be positive")
+    if not sp.waypoint_gaps >= 1:
+        raise ValueError("controller.spiral.waypoint_gaps: must be at least 1")

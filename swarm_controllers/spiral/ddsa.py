@@ -13,9 +13,9 @@ Choices where the paper leaves a detail open:
 * **Path**: ``ddsa_path(depot centre, r, i, gap, arena half-side - arena_margin)`` (the
   default stem: robot i starts at centre + (0, (i-1) g), where robot i-1's first leg ends; it
   drives there from its start cell). The path is walked leg by leg with `go_to_point_twist`
-  toward the point one gap ahead of the progress on the current leg (the leg's end when
-  nearer), so a robot pushed off its lane steers back onto it instead of cutting across to a
-  far corner; a waypoint counts as reached within ``min(arrival_tolerance, gap / 4)`` so
+  toward the point ``controller.spiral.waypoint_gaps`` gaps (one, the DDSA authors' waypoint
+  spacing) ahead of the progress on the current leg (the leg's end when nearer), so a robot
+  pushed off its lane steers back onto it instead of cutting across to a far corner; a waypoint counts as reached within ``min(arrival_tolerance, gap / 4)`` so
   corners are not cut by more than a quarter of the line spacing.
 * **Finding**: the world picks a resource up only within ``pickup_radius`` (0.05 m) while the
   paper's robots detect at 0.13 m and the lines are 0.18 m apart, so a searcher that sees a
@@ -237,7 +237,7 @@ class DdsaBehaviour:
         self._avoidance = LaneAvoidance(scenario, self._drive)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
-        self._carrot = sp.gap
+        self._carrot = sp.gap * sp.waypoint_gaps
         self._arrival2 = scenario.controller.arrival_tolerance**2
         self._center = center
 
@@ -350,8 +350,8 @@ class DdsaBehaviour:
         return self._to_point(x, y, pose.yaw, tx, ty)
 
     def _lane_target(self) -> tuple[float, float]:
-        """The point one gap ahead of the progress on the current leg (the leg's end when
-        nearer): a robot pushed off its lane steers back onto it instead of cutting across
+        """The point `_carrot` (one gap by default) ahead of the progress on the current leg (the
+        leg's end when nearer): a robot pushed off its lane steers back onto it instead of cutting across
         to the far waypoint."""
         k = self._next
         bx, by = self._wp[k]

@@ -28,7 +28,8 @@ depot centre, and answers two ticks later):
   walkers of a region end together), so "idle until there is a path available" never ends
   either. Idling at the center instead walled off the drop zone (issue 11). Consequence: a
   region freed later by a robot declared dead is not taken up by idle robots.
-* **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range), report
+* **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range, or with
+  ``controller.spiral.next_walk_at: nest`` within `NEST_HIT` of the authors' nest point), report
   ``done=True`` with the arc length reached, wait for the next walk.
 * **MDBSA-C on each delivery**: the route to the depot passes the center, so the carrier
   reports its progress (``done=False``) once per trip on entering the range; if its partner's
@@ -48,7 +49,7 @@ Choices where the paper leaves a detail open:
   of the last waypoint reached plus the projection onto the current leg, never decreasing,
   clamped to the stop.
 * **Lane following, finding, resuming, avoidance**: as the DDSA behaviour (`ddsa.py`): steer
-  one gap ahead of the progress on the current leg; steer to the nearest resource seen while
+  ``controller.spiral.waypoint_gaps`` gaps ahead of the progress on the current leg; steer to the nearest resource seen while
   searching; the find position is the progress when ``obs.sensed.carrying`` turns True, and the
   robot drives back to it (TRAVELING to the walk's start is the same motion); `LaneAvoidance`
   on the lane and on the last ``approach_radius`` to it (a reverse walk starts on the outer
@@ -93,6 +94,13 @@ ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""
 ASK_MARGIN = 0.1
 """A robot heading for the center stops this far inside its range [m] before reporting."""
+NEST_OFFSET = (0.1, 0.1)
+"""``controller.spiral.next_walk_at: nest``: where a finished walker heads [m from the depot
+centre, world axes]: the authors' ``SetTarget(CVector2(0.1, 0.1))`` with the nest at (0, 0)
+("can not set it to (0,0) since the TargetHit will avoid to go to the center")."""
+NEST_HIT = 0.1
+"""... and how close it must come before asking [m]: ``TargetHit``'s squared-distance test
+against ``TargetDistanceTolerance`` = 0.01 m^2."""
 _EPS = 1e-9
 
 
@@ -164,6 +172,9 @@ class MdbsaBehaviour:
         self._center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
+        self._nest = ((self._center[0] + NEST_OFFSET[0], self._center[1] + NEST_OFFSET[1])
+                      if sp.next_walk_at == "nest" else None)
+        """Where a finished walker asks for its next walk [m, world frame]; None: in range."""
         self._idle_r2 = float(RegionConfig.of(scenario).center_radius) ** 2
         self._drive = drive_for(scenario, rng)
         self._to_point = self._drive.to_point
@@ -171,7 +182,7 @@ class MdbsaBehaviour:
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
         self._arrival2 = scenario.controller.arrival_tolerance**2
-        self._carrot = sp.gap
+        self._carrot = sp.gap * sp.waypoint_gaps
 
         self._state = MdbsaState.TO_CENTER
         self._walk: _Walk | None = None
@@ -383,10 +394,16 @@ class MdbsaBehaviour:
     # ------------------------------------------------------------------ states
 
     def _to_center(self, obs: Observation) -> tuple[float, float]:
+        pose = obs.pose
+        if self._nest is not None and self._walk is not None:  # a walk is over: via the nest
+            nx, ny = self._nest
+            if (pose.x - nx) ** 2 + (pose.y - ny) ** 2 <= NEST_HIT**2:
+                self._ask(obs)
+                return 0.0, 0.0
+            return self._to_point(pose.x, pose.y, pose.yaw, nx, ny)
         if self._d2_center(obs) <= self._ask_r2:
             self._ask(obs)
             return 0.0, 0.0
-        pose = obs.pose
         return self._to_point(pose.x, pose.y, pose.yaw, *self._center)
 
     def _walk_over(self, obs: Observation) -> tuple[float, float]:
@@ -434,7 +451,7 @@ class MdbsaBehaviour:
             w.u = u
 
     def _lane_target(self, w: _Walk) -> tuple[float, float]:
-        """One gap ahead of the progress on the current leg, never past the leg or the stop."""
+        """`_carrot` ahead of the progress on the current leg, never past the leg or the stop."""
         k = w.next
         if k == 0:
             return w.wp[0]

@@ -73,6 +73,9 @@ def test_registered_and_config_defaults():
     assert SpiralConfig.of(generic_scenario("cpfa")) == SpiralConfig()
     with pytest.raises(ScenarioError, match="controller.spiral.gap"):
         generic_scenario("ddsa", ["controller.spiral.gap=0"])
+    for bad in ("waypoint_gaps=0", "waypoint_gaps=1.5", "next_walk_at=center"):
+        with pytest.raises(ScenarioError, match=f"controller.spiral.{bad.split('=')[0]}"):
+            generic_scenario("mdbsa_c", [f"controller.spiral.{bad}"])
 
 
 def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():

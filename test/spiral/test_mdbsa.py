@@ -31,13 +31,13 @@ from swarm_controllers.spiral.geometry import (
     region_side,
     segments_overlap_collinear,
 )
-from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, MdbsaBehaviour, MdbsaState
+from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, NEST_HIT, NEST_OFFSET, MdbsaBehaviour, MdbsaState
 from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment
 from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour
-from swarm_sim.scenario import ScenarioError
+from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.sites import drop_zones
 from swarm_sim.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.world.tasks.foraging import ForagingSense
@@ -356,6 +356,76 @@ def test_reverse_walk_starts_at_the_far_end_and_reports_arc_length_from_the_star
     assert (m.region, m.s, m.done) == (2, pytest.approx(stop), True)
     st_ = b.status()
     assert st_.state == "WAITING" and ("region", "2") in st_.extra and ("direction", "-1") in st_.extra
+
+
+def _walk_to_its_end(b, u, region):
+    """Assign `region` forward, up to its point farthest from the centre, and drive until the walk
+    is over; the report after it."""
+    path = b.paths[region]
+    stop = max(np.linspace(0.0, path.length, 200), key=lambda s: math.hypot(*path.point_at(s)))
+    assert math.hypot(*path.point_at(stop)) > SpiralConfig.of(SMALL).center_range + 0.2
+    u.step()
+    u.step([RegionAssignment(DT_NS, b.robot, region, FORWARD, 0.0, float(stop), False)])
+    for _ in range(3000):
+        c = u.step()
+        if c.messages:
+            return c.messages
+    raise AssertionError("the walk never ended")
+
+
+def test_a_finished_walker_asks_in_range_by_default():
+    b = MdbsaBehaviour(SMALL, "robot_0", None)
+    (m,) = _walk_to_its_end(b, Unicycle(b, 0.3, 0.0), 1)
+    assert m.done and m.region == 1
+    r = math.hypot(m.x, m.y)
+    assert SpiralConfig.of(SMALL).center_range - ASK_MARGIN - 0.05 < r <= SpiralConfig.of(SMALL).center_range
+
+
+def test_with_next_walk_at_nest_a_finished_walker_first_drives_to_the_authors_nest_point():
+    """The MDBSA authors' robot, its point list empty, sets ``(0.1, 0.1)`` as its target and
+    asks (START) once within 0.1 m of it; its first walk it still asks for where it stands."""
+    s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=nest"], robots__count=3,
+                         arena__size=2.4, resources__clusters=1, resources__count=16)
+    assert SpiralConfig.of(s).next_walk_at == "nest"
+    b = MdbsaBehaviour(s, "robot_0", None)
+    first = b.step(obs("robot_0", 0, 0.5, 0.0)).messages  # in range: asks at once
+    assert len(first) == 1 and first[0].region == -1
+    b = MdbsaBehaviour(s, "robot_0", None)
+    (m,) = _walk_to_its_end(b, Unicycle(b, 0.3, 0.0), 1)
+    assert m.done and m.region == 1
+    assert math.hypot(m.x - NEST_OFFSET[0], m.y - NEST_OFFSET[1]) <= NEST_HIT
+    assert b.state is MdbsaState.WAITING
+
+
+@pytest.mark.parametrize("gaps", [1, 3])
+def test_waypoint_gaps_sets_how_far_apart_the_foot_bots_stops_are(gaps):
+    """On the foot-bot (stop-turn-go, blind legs) the lane target ``waypoint_gaps`` gaps ahead
+    makes one stop per ``waypoint_gaps * gap`` of a straight leg (the authors' MDBSA: 3 gaps)."""
+    s = load_scenario("mdbsa_c", [*ROW_MAJOR, "regions.count=4", f"controller.spiral.waypoint_gaps={gaps}"],
+                      robots__count=3, arena__size=4.0, resources__clusters=1, resources__count=16)
+    b = MdbsaBehaviour(s, "robot_0", None)
+    path = b.paths[1]
+    u = Unicycle(b, *path.start)
+    u.step()
+    u.step([RegionAssignment(DT_NS, "robot_0", 1, FORWARD, 0.0, path.length, False)])
+    stops, moving, start = 0, False, None
+    while b.state is not MdbsaState.SEARCHING:
+        u.step()
+    long_leg = max(range(1, len(path.waypoints)), key=lambda k: path.cumulative[k] - path.cumulative[k - 1])
+    a, e = path.cumulative[long_leg - 1], path.cumulative[long_leg]
+    for _ in range(6000):
+        c = u.step()
+        if b.progress >= e - 1e-6 or b.state is not MdbsaState.SEARCHING:
+            break
+        if b.progress > a + 1e-6:
+            start = start if start is not None else b.progress
+            full = c.linear > 0.999 * s.robots.max_linear_speed  # a stop inside a tick slows its mean twist
+            if full and not moving:
+                stops += 1
+            moving = full
+    step = gaps * SpiralConfig.of(s).gap
+    assert e - a > 2 * step  # the leg is long enough to tell
+    assert stops == pytest.approx(math.ceil((e - start) / step), abs=1)
 
 
 def test_an_update_from_the_center_moves_the_stop_toward_the_robot_only():
