@@ -24,6 +24,12 @@ class SpiralConfig(Section):
     """Spirals are clipped to the arena square shrunk by this much on every side [m]."""
     center_range: float = 0.75
     """MDBSA: robots talk to the center only within this distance of the depot centre [m]."""
+    partner_radio: bool = True
+    """MDBSA: the walkers of a region tell each other their progress (`protocol.WalkProgress`) and
+    each stops where the other has been (the paper's Sec. IV: "A robot can communicate with
+    another robot in the same region"; Fig. 5: they "meet at some point in their spiral path and
+    complete the search"). False: a walk ends at the stop the center last sent (the partner's
+    frontier as the center knew it), so the two overlap (this project's reading until 2026-11-27)."""
     waypoint_gaps: int = 1
     """On a straight leg of the spiral the robot aims this many gaps g ahead of its progress (never
     past the leg's end): with the foot-bot's stop-turn-go motion, a stop every ``waypoint_gaps * g``.

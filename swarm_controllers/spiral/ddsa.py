@@ -15,8 +15,9 @@ Choices where the paper leaves a detail open:
   drives there from its start cell). The path is walked leg by leg with `go_to_point_twist`
   toward the point ``controller.spiral.waypoint_gaps`` gaps (one, the DDSA authors' waypoint
   spacing) ahead of the progress on the current leg (the leg's end when nearer), so a robot
-  pushed off its lane steers back onto it instead of cutting across to a far corner; a waypoint counts as reached within ``min(arrival_tolerance, gap / 4)`` so
-  corners are not cut by more than a quarter of the line spacing.
+  pushed off its lane steers back onto it instead of cutting across to a far corner; a
+  waypoint counts as reached within ``min(arrival_tolerance, gap / 4)`` so corners are not cut
+  by more than a quarter of the line spacing.
 * **Finding**: the world picks a resource up only within ``pickup_radius`` (0.05 m) while the
   paper's robots detect at 0.13 m and the lines are 0.18 m apart, so a searcher that sees a
   resource (``obs.sensed.resources``, nearest first) steers to the nearest one; otherwise a resource

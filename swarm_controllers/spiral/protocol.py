@@ -1,7 +1,8 @@
 """The spiral paper's protocol between the robots and the MDBSA center (mdbsa_spiral_search.md
-sec. IV: robots report their progress near the center, the center assigns regions).
+sec. IV: robots report their progress near the center, the center assigns regions), and between
+the two walkers of a region ("A robot can communicate with another robot in the same region").
 
-ROS-free message dataclasses; on the graph they travel as the CENTER family
+ROS-free message dataclasses; on the graph they travel as the CENTER and WALKERS families
 (`swarm_controllers.spiral.codec`).
 """
 
@@ -53,3 +54,26 @@ class RegionAssignment:
     s0: float
     stop_s: float
     shared: bool
+
+
+@dataclass(frozen=True, slots=True)
+class WalkProgress:
+    """Robot -> robots (peer radio): how far the sender's walk of `region` has got.
+
+    Sec. IV: "A robot can communicate with another robot in the same region"; two walkers of a
+    shared region "will eventually meet at some point in their spiral path and complete the
+    search in the region" (Fig. 5). A walker sends it at each waypoint it reaches; the walker
+    of the same region in the other direction stops there (`mdbsa.MdbsaBehaviour`), as the
+    authors' robots read each other's next point from shared memory
+    (``firstSpiralTarget`` / ``secondSpiralTarget`` in ``DSA_controller::ReachSpiralTargets``).
+    Receivers other than that walker ignore it.
+    """
+
+    CHANNEL: ClassVar[str] = ROBOTS
+    stamp_ns: int
+    robot: RobotId
+    region: int
+    direction: int
+    """+1: walking from the spiral's start, -1: from its end."""
+    s: float
+    """The walk's frontier [m of arc length from the spiral's start]."""

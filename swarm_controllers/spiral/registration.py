@@ -58,6 +58,7 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         checks=_CHECKS,
         world=(_REGIONS,),
         servers=(_CENTER,),
+        peers=("swarm_controllers.spiral.codec:WALKERS",),
         deliveries=(_delivery,),
         metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
         paths="swarm_controllers.spiral.center:planned_paths",

@@ -32,7 +32,7 @@ from swarm_controllers.spiral.geometry import (
     segments_overlap_collinear,
 )
 from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, NEST_HIT, NEST_OFFSET, MdbsaBehaviour, MdbsaState
-from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment
+from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment, WalkProgress
 from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
@@ -49,7 +49,8 @@ D = generic_scenario("mdbsa_d", ROW_MAJOR)
 DT, DT_NS = C.sim.dt, C.dt_ns
 CLEAR = np.full(C.sensors.scan.rays, np.inf, dtype=np.float32)
 SMALL = generic_scenario(  # 2.4 m arena, 4 regions of 1.2 m: spirals of ~8 m, walked in ~1 min
-    "mdbsa_c", ["regions.count=4"], robots__count=3, arena__size=2.4,
+    # the lane bounds below are worked out for a lane target one gap ahead
+    "mdbsa_c", ["regions.count=4", "controller.spiral.waypoint_gaps=1"], robots__count=3, arena__size=2.4,
     resources__clusters=1, resources__count=16,
 )
 
@@ -233,6 +234,11 @@ def test_server_answers_a_robot_once_per_tick_and_is_deterministic():
 # ---------------------------------------------------------------- the behaviour, alone
 
 
+def reports(c):
+    """What a command says to the center (its peer messages left out)."""
+    return tuple(m for m in c.messages if isinstance(m, ProgressReport))
+
+
 def obs(robot, k, x, y, yaw=0.0, messages=(), carrying=False, resources=(), ranges=CLEAR):
     return Observation(robot, k * DT_NS, Pose2D(x, y, yaw), 0.0, 0.0, ranges, ForagingSense(resources, carrying),
                        tuple(messages))
@@ -270,10 +276,10 @@ def test_drives_into_range_before_asking():
     u = Unicycle(b, 1.5, 0.4, math.pi)
     for _ in range(300):
         c = u.step()
-        if c.messages:
+        if reports(c):
             break
     assert b.state is MdbsaState.WAITING
-    (m,) = c.messages
+    (m,) = reports(c)
     assert math.hypot(m.x, m.y) <= SpiralConfig.of(C).center_range - ASK_MARGIN + 1e-9
     assert math.hypot(m.x, m.y) > SpiralConfig.of(C).center_range - ASK_MARGIN - 0.05
 
@@ -348,11 +354,11 @@ def test_reverse_walk_starts_at_the_far_end_and_reports_arc_length_from_the_star
     assert math.hypot(u.x - path.point_at(stop)[0], u.y - path.point_at(stop)[1]) < 0.06
     # The walk is over: back into the center's range, report it done there.
     for _ in range(600):
-        if c.messages:
+        if reports(c):
             break
         assert b.state is MdbsaState.TO_CENTER
         c = u.step()
-    (m,) = c.messages
+    (m,) = reports(c)
     assert (m.region, m.s, m.done) == (2, pytest.approx(stop), True)
     st_ = b.status()
     assert st_.state == "WAITING" and ("region", "2") in st_.extra and ("direction", "-1") in st_.extra
@@ -368,13 +374,15 @@ def _walk_to_its_end(b, u, region):
     u.step([RegionAssignment(DT_NS, b.robot, region, FORWARD, 0.0, float(stop), False)])
     for _ in range(3000):
         c = u.step()
-        if c.messages:
-            return c.messages
+        if reports(c):
+            return reports(c)
     raise AssertionError("the walk never ended")
 
 
-def test_a_finished_walker_asks_in_range_by_default():
-    b = MdbsaBehaviour(SMALL, "robot_0", None)
+def test_with_next_walk_at_center_range_a_finished_walker_asks_in_range():
+    s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=center_range"], robots__count=3,
+                         arena__size=2.4, resources__clusters=1, resources__count=16)
+    b = MdbsaBehaviour(s, "robot_0", None)
     (m,) = _walk_to_its_end(b, Unicycle(b, 0.3, 0.0), 1)
     assert m.done and m.region == 1
     r = math.hypot(m.x, m.y)
@@ -465,7 +473,7 @@ def kinematic_run(s, seconds):
                 router.post(m)
             yaw = math.remainder(yaw + c.angular * DT, 2 * math.pi)
             pose[r] = [x + c.linear * math.cos(yaw) * DT, y + c.linear * math.sin(yaw) * DT, yaw]
-            log.append((k, r, b.state, b.region, b.direction))
+            log.append((k, r, b.state, b.region, b.direction, b.progress))
         for m in server.step(t_ns, router.take_before(CENTER, t_ns)):
             router.post(m)
     return bs, server, pose, log
@@ -478,20 +486,63 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
     assert server.ignored == 0
     assert all(b.state is MdbsaState.IDLE for b in bs.values())
     # Idle for good at the center of the region each walked last (the authors' IDLE).
-    last = {r: region for _, r, state, region, _ in log if state is MdbsaState.SEARCHING}
+    last = {r: region for _, r, state, region, _, _ in log if state is MdbsaState.SEARCHING}
     for r, (x, y, _) in pose.items():
         cx, cy = server.paths[last[r]].start
         assert math.hypot(x - cx, y - cy) <= RegionConfig.of(SMALL).center_radius
-    walks = {(r, region, d) for _, r, state, region, d in log
+    walks = {(r, region, d) for _, r, state, region, d, _ in log
              if state is MdbsaState.SEARCHING}
     assert {region for _, region, _ in walks} == {0, 1, 2, 3}
     assert any(d == REVERSE for _, _, d in walks), "no path was shared from its far end"
     # At any tick at most two robots search a region, in opposite directions.
     per_tick: dict[tuple[int, int], list[int]] = {}
-    for k, r, state, region, d in log:
+    for k, r, state, region, d, _ in log:
         if state is MdbsaState.SEARCHING:
             per_tick.setdefault((k, region), []).append(d)
     assert all(len(ds) <= 2 and len(set(ds)) == len(ds) for ds in per_tick.values())
+
+
+@pytest.mark.parametrize("radio", [True, False])
+def test_the_two_walkers_of_a_region_stop_where_they_meet(radio):
+    """Sec. IV / Fig. 5: the walkers of a shared region talk (`WalkProgress` at each waypoint) and
+    stop where they meet: together they cover the spiral with an overlap of at most about a leg.
+    Without the radio each walks on to the stop the center last sent it (much more overlap)."""
+    s = generic_scenario("mdbsa_d", [*ROW_MAJOR, "regions.count=4", f"controller.spiral.partner_radio={radio}"],
+                         robots__count=8, arena__size=2.4, resources__clusters=1, resources__count=16)
+    bs, server, _, log = kinematic_run(s, 150.0)
+    reach: dict[tuple[str, int, int], float] = {}
+    for _, r, _, region, d, progress in log:
+        if region >= 0:
+            reach[(r, region, d)] = progress
+    overlaps = []
+    for region in range(4):
+        fwd = [p for (r, g, d), p in reach.items() if g == region and d == FORWARD]
+        rev = [p for (r, g, d), p in reach.items() if g == region and d == REVERSE]
+        assert len(fwd) == 1 and len(rev) == 1  # 8 robots, 4 regions: two walkers each from tick 0
+        overlaps.append(fwd[0] - rev[0])  # forward covered [0, fwd], reverse [rev, L]
+    legs = np.diff(server.paths[0].cumulative)
+    assert min(overlaps) >= -1e-6  # never a gap
+    if radio:
+        assert max(overlaps) <= legs.max() + 0.1
+    else:
+        assert max(overlaps) > 2 * legs.max()
+
+
+def test_a_walker_takes_only_its_partners_progress_and_only_toward_itself():
+    b = MdbsaBehaviour(SMALL, "robot_0", None)
+    L = b.paths[1].length
+    b.step(obs("robot_0", 0, 0.0, 0.0))
+    b.step(obs("robot_0", 2, 0.0, 0.0, messages=[RegionAssignment(DT_NS, "robot_0", 1, FORWARD, 0.0, L, False)]))
+    ignored = [WalkProgress(DT_NS, "robot_1", 2, REVERSE, 3.0),      # another region
+               WalkProgress(DT_NS, "robot_1", 1, FORWARD, 3.0),      # the same direction
+               WalkProgress(DT_NS, "robot_0", 1, REVERSE, 3.0),      # its own
+               WalkProgress(DT_NS, "robot_1", 1, REVERSE, math.nan)]
+    b.step(obs("robot_0", 3, 0.0, 0.0, messages=ignored))
+    assert b.stop == pytest.approx(L)
+    b.step(obs("robot_0", 4, 0.0, 0.0, messages=[WalkProgress(3 * DT_NS, "robot_1", 1, REVERSE, L - 2.0)]))
+    assert b.stop == pytest.approx(L - 2.0)
+    b.step(obs("robot_0", 5, 0.0, 0.0, messages=[WalkProgress(4 * DT_NS, "robot_1", 1, REVERSE, L - 1.0)]))
+    assert b.stop == pytest.approx(L - 2.0)  # an older frontier never extends the walk
 
 
 # ---------------------------------------------------------------- pybullet runs
