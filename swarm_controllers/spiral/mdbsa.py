@@ -28,9 +28,10 @@ depot centre, and answers two ticks later):
   walkers of a region end together), so "idle until there is a path available" never ends
   either. Idling at the center instead walled off the drop zone (issue 11). Consequence: a
   region freed later by a robot declared dead is not taken up by idle robots.
-* **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range, or with
-  ``controller.spiral.next_walk_at: nest`` within `NEST_HIT` of the authors' nest point), report
-  ``done=True`` with the arc length reached, wait for the next walk.
+* **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range), report
+  ``done=True`` with the arc length reached, wait for the next walk; with
+  ``controller.spiral.next_walk_at: nest`` a robot given a new walk first drives to within
+  `NEST_HIT` of the authors' nest point (an idle one goes straight to its idle spot).
 * **MDBSA-C on each delivery**: the route to the depot passes the center, so the carrier
   reports its progress (``done=False``) once per trip on entering the range; if its partner's
   frontier moved meanwhile the center answers with the walk's new ``stop_s`` (same region and
@@ -179,7 +180,10 @@ class MdbsaBehaviour:
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
         self._nest = ((self._center[0] + NEST_OFFSET[0], self._center[1] + NEST_OFFSET[1])
                       if sp.next_walk_at == "nest" else None)
-        """Where a finished walker asks for its next walk [m, world frame]; None: in range."""
+        """Where a walker passes on its way from one walk to the next [m, world frame]; None: it
+        does not."""
+        self._via_nest = False
+        """On the way to a new walk, the nest point is still ahead."""
         self._idle_r2 = float(RegionConfig.of(scenario).center_radius) ** 2
         self._drive = drive_for(scenario, rng)
         self._to_point = self._drive.to_point
@@ -332,6 +336,7 @@ class MdbsaBehaviour:
             return  # an idle answer while walking is stale: keep walking
         if not 0 <= m.region < len(self.paths) or self._state is MdbsaState.IDLE:
             return
+        self._via_nest = self._nest is not None and w is not None
         self._walk = _Walk(m, self.paths[m.region])
         if self._state is MdbsaState.DELIVERING:
             self._after_delivery = MdbsaState.TRAVELING
@@ -410,16 +415,10 @@ class MdbsaBehaviour:
     # ------------------------------------------------------------------ states
 
     def _to_center(self, obs: Observation) -> tuple[float, float]:
-        pose = obs.pose
-        if self._nest is not None and self._walk is not None:  # a walk is over: via the nest
-            nx, ny = self._nest
-            if (pose.x - nx) ** 2 + (pose.y - ny) ** 2 <= NEST_HIT**2:
-                self._ask(obs)
-                return 0.0, 0.0
-            return self._to_point(pose.x, pose.y, pose.yaw, nx, ny)
         if self._d2_center(obs) <= self._ask_r2:
             self._ask(obs)
             return 0.0, 0.0
+        pose = obs.pose
         return self._to_point(pose.x, pose.y, pose.yaw, *self._center)
 
     def _walk_over(self, obs: Observation) -> tuple[float, float]:
@@ -483,11 +482,18 @@ class MdbsaBehaviour:
         return ax + t * (bx - ax), ay + t * (by - ay)
 
     def _to_walk(self, obs: Observation) -> tuple[float, float]:
-        """TRAVELING / RESUMING: to the walk's progress point, then search from there."""
+        """TRAVELING / RESUMING: to the walk's progress point (a new walk after another: by way
+        of the nest point, with ``next_walk_at: nest``), then search from there."""
         w = self._walk
         if w is None or w.over:
             return self._walk_over(obs)
         pose = obs.pose
+        if self._via_nest and self._state is MdbsaState.TRAVELING:
+            assert self._nest is not None
+            nx, ny = self._nest
+            if (pose.x - nx) ** 2 + (pose.y - ny) ** 2 > NEST_HIT**2:
+                return self._to_point(pose.x, pose.y, pose.yaw, nx, ny)
+            self._via_nest = False
         tx, ty = (float(v) for v in w.path.point_at(w.u))
         if (tx - pose.x) ** 2 + (ty - pose.y) ** 2 < self._wp_tol2:
             w.next = max(w.path.next_waypoint_index(w.u), 1)

@@ -379,30 +379,56 @@ def _walk_to_its_end(b, u, region):
     raise AssertionError("the walk never ended")
 
 
-def test_with_next_walk_at_center_range_a_finished_walker_asks_in_range():
-    s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=center_range"], robots__count=3,
+def _seg_distance(p, a, b):
+    a, b, p = np.asarray(a, float), np.asarray(b, float), np.asarray(p, float)
+    t = np.clip(np.dot(p - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+    return float(np.hypot(*(a + t * (b - a) - p)))
+
+
+@pytest.mark.parametrize("mode", ["center_range", "nest"])
+def test_with_next_walk_at_nest_a_new_walk_starts_by_way_of_the_authors_nest_point(mode):
+    """The MDBSA authors' robot, its point list empty, takes its next walk at once but first drives
+    to within 0.1 m of (0.1, 0.1) (``SetTarget(CVector2(0.1, 0.1))``, then ``TargetHit``). Ours
+    asks in the center's range either way; with ``nest`` it then goes by way of that point."""
+    s = generic_scenario("mdbsa_c", ["regions.count=4", f"controller.spiral.next_walk_at={mode}"], robots__count=3,
                          arena__size=2.4, resources__clusters=1, resources__count=16)
+    assert SpiralConfig.of(s).next_walk_at == mode
     b = MdbsaBehaviour(s, "robot_0", None)
-    (m,) = _walk_to_its_end(b, Unicycle(b, 0.3, 0.0), 1)
-    assert m.done and m.region == 1
-    r = math.hypot(m.x, m.y)
-    assert SpiralConfig.of(SMALL).center_range - ASK_MARGIN - 0.05 < r <= SpiralConfig.of(SMALL).center_range
+    u = Unicycle(b, 0.3, 0.0)
+    (m,) = _walk_to_its_end(b, u, 1)
+    assert m.done and m.region == 1 and b.state is MdbsaState.WAITING
+    rng = SpiralConfig.of(s).center_range
+    assert rng - ASK_MARGIN - 0.05 < math.hypot(m.x, m.y) <= rng
+    nxt = 3
+    straight = _seg_distance(NEST_OFFSET, (m.x, m.y), b.paths[nxt].start)
+    assert straight > NEST_HIT + 0.2  # the straight way misses the nest point
+    u.step([RegionAssignment(u.k * DT_NS, "robot_0", nxt, FORWARD, 0.0, b.paths[nxt].length, False)])
+    nearest = math.inf
+    for _ in range(600):
+        if b.state is not MdbsaState.TRAVELING:
+            break
+        u.step()
+        nearest = min(nearest, math.hypot(u.x - NEST_OFFSET[0], u.y - NEST_OFFSET[1]))
+    assert b.state is MdbsaState.SEARCHING and b.region == nxt
+    if mode == "nest":
+        assert nearest <= NEST_HIT
+    else:
+        assert nearest > straight - 0.05
 
 
-def test_with_next_walk_at_nest_a_finished_walker_first_drives_to_the_authors_nest_point():
-    """The MDBSA authors' robot, its point list empty, sets ``(0.1, 0.1)`` as its target and
-    asks (START) once within 0.1 m of it; its first walk it still asks for where it stands."""
+def test_with_next_walk_at_nest_an_idle_robot_does_not_visit_the_nest():
     s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=nest"], robots__count=3,
                          arena__size=2.4, resources__clusters=1, resources__count=16)
-    assert SpiralConfig.of(s).next_walk_at == "nest"
     b = MdbsaBehaviour(s, "robot_0", None)
-    first = b.step(obs("robot_0", 0, 0.5, 0.0)).messages  # in range: asks at once
-    assert len(first) == 1 and first[0].region == -1
-    b = MdbsaBehaviour(s, "robot_0", None)
-    (m,) = _walk_to_its_end(b, Unicycle(b, 0.3, 0.0), 1)
-    assert m.done and m.region == 1
-    assert math.hypot(m.x - NEST_OFFSET[0], m.y - NEST_OFFSET[1]) <= NEST_HIT
-    assert b.state is MdbsaState.WAITING
+    u = Unicycle(b, 0.3, 0.0)
+    _walk_to_its_end(b, u, 1)
+    u.step([RegionAssignment(u.k * DT_NS, "robot_0", -1, 0, 0.0, 0.0, False)])
+    assert b.state is MdbsaState.IDLE
+    nearest = math.inf
+    for _ in range(300):
+        u.step()
+        nearest = min(nearest, math.hypot(u.x - NEST_OFFSET[0], u.y - NEST_OFFSET[1]))
+    assert nearest > NEST_HIT + 0.2
 
 
 @pytest.mark.parametrize("gaps", [1, 3])
