@@ -48,6 +48,9 @@ Rules (the paper's) and the choices it leaves open
 - **join** (sec. V): accepted iff the line is an entry line, the robot is not inside, the cell
   and its conflicts are free, the cell is behind the tail (its index is below every owned cell
   of that line: robots queue towards higher indices), and it is not an intersection cell.
+  With ``join_order="anywhere"`` (the queue authors' Q_ST code, `depot_manager.config.QueueConfig`)
+  a free cell ahead of the tail is accepted too; the robots behind it then wait for the newcomer,
+  which is downstream of them, so the no-gridlock argument below is unchanged.
   Refusals (`depot_manager.protocol.Refusal`), checked in this order: UNKNOWN_LINE,
   ALREADY_INSIDE, UNKNOWN_CELL (index out of range; our addition), OCCUPIED, NOT_BEHIND_TAIL,
   KEEP_CLEAR (an intersection cell: a robot waiting there could close a gridlock; our addition).
@@ -83,7 +86,7 @@ Rules (the paper's) and the choices it leaves open
     between the dock (exclusive) and the inner exit point. Hence at most two robots per inner
     queue: one between the entry point and the dock (inclusive), one after the dock.
     Our inner queues share the ring, so read literally ("other robot" = any robot,
-    ``inner_rule="any"``, the default) both rules also wait for robots of other inner queues
+    ``inner_rule="any"``, this class's default; the scenario's is ``own``) both rules also wait for robots of other inner queues
     and the ring nearly serialises; ``inner_rule="own"`` counts only robots dispatched into the
     same inner queue (cell ownership and keep-clear keep the others apart), which about doubles
     the inner region's throughput in our tests and keeps the two-robot bound.
@@ -169,12 +172,16 @@ class DepotAdmission:
     queue (see the module docstring for every rule)."""
 
     def __init__(
-        self, layout: QueueLayout, *, lookahead: int = 8, inner_rule: str = "any"
+        self, layout: QueueLayout, *, lookahead: int = 8, inner_rule: str = "any", join_order: str = "behind_tail"
     ) -> None:
         if lookahead < 1:
             raise ValueError(f"lookahead must be >= 1, got {lookahead}")
         if inner_rule not in ("any", "own"):
             raise ValueError(f"inner_rule must be 'any' or 'own', got {inner_rule!r}")
+        if join_order not in ("behind_tail", "anywhere"):
+            raise ValueError(f"join_order must be 'behind_tail' or 'anywhere', got {join_order!r}")
+        self.behind_tail = join_order == "behind_tail"
+        """A join must be behind every robot on the line (else any free cell will do)."""
         self.layout = layout
         self.lookahead = lookahead
         self.inner_rule = inner_rule
@@ -264,9 +271,10 @@ class DepotAdmission:
         c = int(ids[cell])
         if not self._free(c, robot):
             return Refusal.OCCUPIED
-        owned = [i for i, cid in enumerate(ids) if self._owner[cid] is not None]
-        if owned and cell >= min(owned):
-            return Refusal.NOT_BEHIND_TAIL
+        if self.behind_tail:
+            owned = [i for i, cid in enumerate(ids) if self._owner[cid] is not None]
+            if owned and cell >= min(owned):
+                return Refusal.NOT_BEHIND_TAIL
         if m.intersection[c]:
             return Refusal.KEEP_CLEAR
         r = _Robot(robot, m.entry_names.index(line), t)

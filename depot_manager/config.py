@@ -25,5 +25,15 @@ class QueueConfig(Section):
     queues are met at intersections, FCFS, as sec. IV-D says); `any` counts every robot on its
     cells, which on our shared ring nearly serialises the docks."""
 
+    join_order: Literal["behind_tail", "anywhere"] = "behind_tail"
+    """Where the depot manager lets a robot join an entry line: ``behind_tail``, only behind every
+    robot on it (sec. V-B: "if v2 is the last robot in the queue, v1 will simply join the queue
+    behind it"; sec. V-A's entry point is the line's first cell); or ``anywhere`` free, as the
+    queue authors' tail joining does in their code: a carrier drives straight in and boards the
+    spiral at its fifth lane, or at the innermost lane it crossed once blocked, ahead of the
+    robots on the outer lanes, with no notion of a tail (Tameem786/Collision_Free_CPFA, branch
+    CPFA-2.0, their Q_ST: ``CPFA_controller::Returning``, source/CPFA/CPFA_controller.cpp). Only
+    the paper's text is the default; ``anywhere`` is what the authors ran."""
+
     SECTION: ClassVar[str] = "queue"
 

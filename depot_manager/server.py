@@ -47,7 +47,8 @@ class DepotServer:
     def __init__(self, scenario, *, lookahead: int = 8) -> None:
         self.queue = queue = QueueConfig.of(scenario)
         self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
-        self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule)
+        self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule,
+                                       join_order=queue.join_order)
         self.robots = frozenset(scenario.robot_names)
         self.rejections = Rejections()
         """Reports that could not be applied, by reason (the last one's detail kept)."""

@@ -143,11 +143,13 @@ class Run:
 
 
 def simulate(
-    kind: str, size: str, arrivals, seed: int, max_ticks: int = 6000, inner_rule: str = "any"
+    kind: str, size: str, arrivals, seed: int, max_ticks: int = 6000, inner_rule: str = "any",
+    join_order: str = "behind_tail",
 ) -> Run:
-    """arrivals: [(tick, entry line index, tail joining?)]. Checks every invariant each tick."""
+    """arrivals: [(tick, entry line index, tail joining?)]. Checks every invariant each tick.
+    With `join_order` ``anywhere`` a tail joiner asks for a random cell of the whole line."""
     lay, g = layout(kind, size), geo(kind, size)
-    adm = DepotAdmission(lay, lookahead=LOOKAHEAD, inner_rule=inner_rule)
+    adm = DepotAdmission(lay, lookahead=LOOKAHEAD, inner_rule=inner_rule, join_order=join_order)
     rng = np.random.default_rng(seed)
     n_entry = len(lay.entry_lines)
     bots = [
@@ -169,7 +171,7 @@ def simulate(
             cell = 0
             if b.tail:
                 owned = [c for ln, c, _ in adm.snapshot().occupied if ln == line]
-                tail = min(owned, default=len(adm.cells(line)))
+                tail = len(adm.cells(line)) if join_order == "anywhere" else min(owned, default=len(adm.cells(line)))
                 if tail == 0:
                     continue
                 cell = int(rng.integers(0, tail))
@@ -440,6 +442,17 @@ def test_conflicts_cover_crossings_but_not_adjacent_lanes(size):
 # ------------------------------------------------------------------ reports
 
 
+def test_join_order_anywhere_takes_a_free_cell_ahead_of_the_tail():
+    """The queue authors' Q_ST boards wherever it gets in (`QueueConfig.join_order`)."""
+    adm = DepotAdmission(layout("multi", "small"), join_order="anywhere")
+    assert adm.join("a", "entry_line_0", 5, 0.0) is Refusal.NONE
+    assert adm.join("b", "entry_line_0", 5, 0.0) is Refusal.OCCUPIED
+    assert adm.join("b", "entry_line_0", 7, 0.0) is Refusal.NONE  # ahead of a
+    assert adm.is_last("a") and not adm.is_last("b")
+    with pytest.raises(ValueError, match="join_order"):
+        DepotAdmission(layout("multi", "small"), join_order="front")
+
+
 def test_join_refusals_and_is_last():
     adm = DepotAdmission(layout("multi", "small"))
     n = len(adm.cells("entry_line_0"))
@@ -663,22 +676,22 @@ SIM_SINGLE = settings(SIM, max_examples=12)
 @SIM
 @given(arrivals=arrivals_strategy(14), seed=st.integers(0, 2**32 - 1),
        size=st.sampled_from(["default", "small", "two_docks", "six_docks"]),
-       same=st.booleans())
-def test_multi_queue_invariants(arrivals, seed, size, same):
+       same=st.booleans(), join_order=st.sampled_from(["behind_tail", "anywhere"]))
+def test_multi_queue_invariants(arrivals, seed, size, same, join_order):
     if same:  # everyone from one direction: one sector
         arrivals = [(a, 0, tail) for a, _, tail in arrivals]
-    run = simulate("multi", size, arrivals, seed)
+    run = simulate("multi", size, arrivals, seed, join_order=join_order)
     assert run.max_stay <= run.bound
 
 
 @SIM_SINGLE
 @given(arrivals=arrivals_strategy(10), seed=st.integers(0, 2**32 - 1),
        size=st.sampled_from(["small", "two_docks", "six_docks"]), same_time=st.booleans(),
-       inner_rule=st.sampled_from(["any", "own"]))
-def test_single_queue_invariants(arrivals, seed, size, same_time, inner_rule):
+       inner_rule=st.sampled_from(["any", "own"]), join_order=st.sampled_from(["behind_tail", "anywhere"]))
+def test_single_queue_invariants(arrivals, seed, size, same_time, inner_rule, join_order):
     if same_time:
         arrivals = [(0, e, tail) for _, e, tail in arrivals]
-    run = simulate("single", size, arrivals, seed, inner_rule=inner_rule)
+    run = simulate("single", size, arrivals, seed, inner_rule=inner_rule, join_order=join_order)
     assert run.max_inner <= 2 and run.max_stay <= run.bound
 
 
