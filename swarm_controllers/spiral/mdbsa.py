@@ -41,10 +41,11 @@ Choices where the paper leaves a detail open:
 
 * **Meeting the partner** (paper: "A robot can communicate with another robot in the same
   region"; the two walkers "meet at some point in their spiral path and complete the search"):
-  a walker sends its frontier (`WalkProgress`) at each waypoint it reaches, and the walker of
-  the same region in the other direction moves its stop there (never away from itself), as
-  the authors' robots compare their next point with the partner's in shared memory. Each
-  stops at the other's last waypoint: the two overlap by at most a leg, never leave a gap.
+  a walker sends its frontier (`WalkProgress`) each time it has got ``waypoint_gaps`` gaps
+  further (the authors' waypoint spacing) and when its walk ends, and the walker of the same
+  region in the other direction moves its stop there (never away from itself), as the
+  authors' robots compare their next point with the partner's in shared memory at each
+  waypoint. The two overlap by about that spacing, never leave a gap.
   With ``controller.spiral.partner_radio: false`` a walk ends at the stop the center last sent
   (the partner's frontier at assignment, or at an MDBSA-C robot's last pass); MDBSA-D robots,
   which never pass the center mid-walk, then walk most of each other's stretch. Measured
@@ -55,8 +56,8 @@ Choices where the paper leaves a detail open:
   of the last waypoint reached plus the projection onto the current leg, never decreasing,
   clamped to the stop.
 * **Lane following, finding, resuming, avoidance**: as the DDSA behaviour (`ddsa.py`): steer
-  ``controller.spiral.waypoint_gaps`` gaps ahead of the progress on the current leg; steer to the nearest resource seen while
-  searching; the find position is the progress when ``obs.sensed.carrying`` turns True, and the
+  ``controller.spiral.waypoint_gaps`` gaps ahead of the progress on the current leg; steer to
+  the nearest resource seen while searching; the find position is the progress when ``obs.sensed.carrying`` turns True, and the
   robot drives back to it (TRAVELING to the walk's start is the same motion); `LaneAvoidance`
   on the lane and on the last ``approach_radius`` to it (a reverse walk starts on the outer
   lane, 0.2 m from the wall, which the general avoidance would never let a robot reach head
@@ -101,11 +102,11 @@ ASK_RETRY = 2.0
 ASK_MARGIN = 0.1
 """A robot heading for the center stops this far inside its range [m] before reporting."""
 NEST_OFFSET = (0.1, 0.1)
-"""``controller.spiral.next_walk_at: nest``: where a finished walker heads [m from the depot
-centre, world axes]: the authors' ``SetTarget(CVector2(0.1, 0.1))`` with the nest at (0, 0)
+"""``controller.spiral.next_walk_at: nest``: the point a walker passes on its way to a new walk
+[m from the depot centre, world axes]: the authors' ``SetTarget(CVector2(0.1, 0.1))`` with the nest at (0, 0)
 ("can not set it to (0,0) since the TargetHit will avoid to go to the center")."""
 NEST_HIT = 0.1
-"""... and how close it must come before asking [m]: ``TargetHit``'s squared-distance test
+"""... and how close it must come to it before going on [m]: ``TargetHit``'s squared-distance test
 against ``TargetDistanceTolerance`` = 0.01 m^2."""
 _EPS = 1e-9
 
@@ -142,6 +143,8 @@ class _Walk:
         self.u = self.to_u(a.s0)
         self.stop_u = max(self.u, self.to_u(a.stop_s))
         self.next = self.path.next_waypoint_index(self.u)
+        self.sent_u = -math.inf
+        """The progress last told the partner (`WalkProgress`) [m along the walk]."""
 
     def to_u(self, s: float) -> float:
         """Center arc length s [m from the spiral's start] -> walk arc length u (an involution)."""
@@ -432,17 +435,17 @@ class MdbsaBehaviour:
         pose = obs.pose
         x, y = pose.x, pose.y
         wp, cum, n = w.wp, w.cum, len(w.wp)
-        reached = w.next
         while w.next < n and cum[w.next] <= w.stop_u + _EPS:
             tx, ty = wp[w.next]
             if (tx - x) ** 2 + (ty - y) ** 2 >= self._wp_tol2:
                 break
             w.u = max(w.u, cum[w.next])
             w.next += 1
-        if w.next != reached and self._radio:
-            self._outbox.append(WalkProgress(obs.stamp_ns, self.robot, w.region, w.direction, float(w.s)))
         if w.next < n:
             self._project(w, x, y)
+        if self._radio and (w.u - w.sent_u >= self._carrot - _EPS or (w.over and w.u > w.sent_u)):
+            self._outbox.append(WalkProgress(obs.stamp_ns, self.robot, w.region, w.direction, float(w.s)))
+            w.sent_u = w.u
         if w.over:
             return self._walk_over(obs)
         if obs.sensed.resources and not self._carrying:

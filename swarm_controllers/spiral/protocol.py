@@ -62,7 +62,7 @@ class WalkProgress:
 
     Sec. IV: "A robot can communicate with another robot in the same region"; two walkers of a
     shared region "will eventually meet at some point in their spiral path and complete the
-    search in the region" (Fig. 5). A walker sends it at each waypoint it reaches; the walker
+    search in the region" (Fig. 5). A walker sends it every few gaps of progress; the walker
     of the same region in the other direction stops there (`mdbsa.MdbsaBehaviour`), as the
     authors' robots read each other's next point from shared memory
     (``firstSpiralTarget`` / ``secondSpiralTarget`` in ``DSA_controller::ReachSpiralTargets``).

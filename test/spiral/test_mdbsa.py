@@ -530,8 +530,8 @@ def test_kinematic_swarm_finishes_every_region_sharing_paths_then_idles():
 
 @pytest.mark.parametrize("radio", [True, False])
 def test_the_two_walkers_of_a_region_stop_where_they_meet(radio):
-    """Sec. IV / Fig. 5: the walkers of a shared region talk (`WalkProgress` at each waypoint) and
-    stop where they meet: together they cover the spiral with an overlap of at most about a leg.
+    """Sec. IV / Fig. 5: the walkers of a shared region talk (`WalkProgress` every waypoint spacing)
+    and stop where they meet: together they cover the spiral, overlapping by about that spacing.
     Without the radio each walks on to the stop the center last sent it (much more overlap)."""
     s = generic_scenario("mdbsa_d", [*ROW_MAJOR, "regions.count=4", f"controller.spiral.partner_radio={radio}"],
                          robots__count=8, arena__size=2.4, resources__clusters=1, resources__count=16)
@@ -548,8 +548,9 @@ def test_the_two_walkers_of_a_region_stop_where_they_meet(radio):
         overlaps.append(fwd[0] - rev[0])  # forward covered [0, fwd], reverse [rev, L]
     legs = np.diff(server.paths[0].cumulative)
     assert min(overlaps) >= -1e-6  # never a gap
+    step = SpiralConfig.of(s).waypoint_gaps * SpiralConfig.of(s).gap
     if radio:
-        assert max(overlaps) <= legs.max() + 0.1
+        assert max(overlaps) <= step  # about the waypoint spacing
     else:
         assert max(overlaps) > 2 * legs.max()
 
