@@ -57,8 +57,9 @@ Choices where the paper leaves a detail open:
   clamped to the stop.
 * **Lane following, finding, resuming, avoidance**: as the DDSA behaviour (`ddsa.py`): steer
   ``controller.spiral.waypoint_gaps`` gaps ahead of the progress on the current leg; steer to
-  the nearest resource seen while searching; the find position is the progress when ``obs.sensed.carrying`` turns True, and the
-  robot drives back to it (TRAVELING to the walk's start is the same motion); `LaneAvoidance`
+  the nearest resource seen while searching; the find position is the progress when
+  ``obs.sensed.carrying`` turns True, and the robot drives back to it (TRAVELING to the walk's
+  start is the same motion); `LaneAvoidance`
   on the lane and on the last ``approach_radius`` to it (a reverse walk starts on the outer
   lane, 0.2 m from the wall, which the general avoidance would never let a robot reach head
   on), the general avoidance (turning right) elsewhere. Avoidance runs every tick in every
