@@ -38,15 +38,15 @@ class SpiralConfig(Section):
     MDBSA every 3 gaps, and the remainder at a leg's end (``generateSpiralPath``, "create a point
     in every 3 searchGap", MARSLab-UTRGV/Adaptive-Multiple-Distributed-Spiral-Search-Algorithm,
     luki-dev, ``Centralized/source/DSA/DSA_loop_functions.cpp``). The paper says nothing of it."""
-    next_walk_at: Literal["center_range", "nest"] = "center_range"
+    next_walk_at: Literal["center_range", "depot"] = "center_range"
     """MDBSA: the way from a finished walk to the next. ``center_range``: straight from where the
-    robot asked (`mdbsa.ASK_MARGIN` inside ``center_range``; it never enters the depot). ``nest``:
-    by way of the depot centre + `mdbsa.NEST_OFFSET`, to within `mdbsa.NEST_HIT` of it, as the MDBSA
+    robot asked (`mdbsa.ASK_MARGIN` inside ``center_range``; it never enters the depot). ``depot``:
+    by way of the depot centre + `mdbsa.DEPOT_POINT`, to within `mdbsa.DEPOT_POINT_HIT` of it, as the MDBSA
     authors' robot goes (once its point list is empty: ``DSA = START; SetTarget(CVector2(0.1,
     0.1))``; START takes the next walk at once, and its first point becomes the target only when
     ``TargetHit``, squared distance below ``TargetDistanceTolerance`` = 0.01:
     ``DSA_controller::ReachSpiralTargets`` and ``ControlStep``, luki-dev, both controllers), so
-    every walk after the first starts across the nest. A robot with no walk left goes idle
+    every walk after the first starts across the depot (their nest). A robot with no walk left goes idle
     without it (their START sets IDLE and the region centre as its target at once). Our robots
     still ask within the center's range (the authors' robots read the assignment from shared
     memory anywhere)."""

@@ -30,8 +30,8 @@ depot centre, and answers two ticks later):
   region freed later by a robot declared dead is not taken up by idle robots.
 * **End of a walk**: back to the center (stopping `ASK_MARGIN` inside the range), report
   ``done=True`` with the arc length reached, wait for the next walk; with
-  ``controller.spiral.next_walk_at: nest`` a robot given a new walk first drives to within
-  `NEST_HIT` of the authors' nest point (an idle one goes straight to its idle spot).
+  ``controller.spiral.next_walk_at: depot`` a robot given a new walk first drives to within
+  `DEPOT_POINT_HIT` of `DEPOT_POINT` (the authors' point by the nest; an idle one goes straight to its idle spot).
 * **MDBSA-C on each delivery**: the route to the depot passes the center, so the carrier
   reports its progress (``done=False``) once per trip on entering the range; if its partner's
   frontier moved meanwhile the center answers with the walk's new ``stop_s`` (same region and
@@ -102,11 +102,11 @@ ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""
 ASK_MARGIN = 0.1
 """A robot heading for the center stops this far inside its range [m] before reporting."""
-NEST_OFFSET = (0.1, 0.1)
-"""``controller.spiral.next_walk_at: nest``: the point a walker passes on its way to a new walk
-[m from the depot centre, world axes]: the authors' ``SetTarget(CVector2(0.1, 0.1))`` with the nest at (0, 0)
+DEPOT_POINT = (0.1, 0.1)
+"""``controller.spiral.next_walk_at: depot``: the point a walker passes on its way to a new walk
+[m from the depot centre, world axes]: the authors' ``SetTarget(CVector2(0.1, 0.1))``, their nest at (0, 0)
 ("can not set it to (0,0) since the TargetHit will avoid to go to the center")."""
-NEST_HIT = 0.1
+DEPOT_POINT_HIT = 0.1
 """... and how close it must come to it before going on [m]: ``TargetHit``'s squared-distance test
 against ``TargetDistanceTolerance`` = 0.01 m^2."""
 _EPS = 1e-9
@@ -182,12 +182,12 @@ class MdbsaBehaviour:
         self._center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
         self._range = float(sp.center_range)
         self._ask_r2 = max(self._range - ASK_MARGIN, 0.5 * self._range) ** 2
-        self._nest = ((self._center[0] + NEST_OFFSET[0], self._center[1] + NEST_OFFSET[1])
-                      if sp.next_walk_at == "nest" else None)
+        self._depot_point = ((self._center[0] + DEPOT_POINT[0], self._center[1] + DEPOT_POINT[1])
+                      if sp.next_walk_at == "depot" else None)
         """Where a walker passes on its way from one walk to the next [m, world frame]; None: it
         does not."""
-        self._via_nest = False
-        """On the way to a new walk, the nest point is still ahead."""
+        self._via_depot = False
+        """On the way to a new walk, `DEPOT_POINT` is still ahead."""
         self._idle_r2 = float(RegionConfig.of(scenario).center_radius) ** 2
         self._drive = drive_for(scenario, rng)
         self._to_point = self._drive.to_point
@@ -340,7 +340,7 @@ class MdbsaBehaviour:
             return  # an idle answer while walking is stale: keep walking
         if not 0 <= m.region < len(self.paths) or self._state is MdbsaState.IDLE:
             return
-        self._via_nest = self._nest is not None and w is not None
+        self._via_depot = self._depot_point is not None and w is not None
         self._walk = _Walk(m, self.paths[m.region])
         if self._state is MdbsaState.DELIVERING:
             self._after_delivery = MdbsaState.TRAVELING
@@ -487,17 +487,17 @@ class MdbsaBehaviour:
 
     def _to_walk(self, obs: Observation) -> tuple[float, float]:
         """TRAVELING / RESUMING: to the walk's progress point (a new walk after another: by way
-        of the nest point, with ``next_walk_at: nest``), then search from there."""
+        of `DEPOT_POINT`, with ``next_walk_at: depot``), then search from there."""
         w = self._walk
         if w is None or w.over:
             return self._walk_over(obs)
         pose = obs.pose
-        if self._via_nest and self._state is MdbsaState.TRAVELING:
-            assert self._nest is not None
-            nx, ny = self._nest
-            if (pose.x - nx) ** 2 + (pose.y - ny) ** 2 > NEST_HIT**2:
+        if self._via_depot and self._state is MdbsaState.TRAVELING:
+            assert self._depot_point is not None
+            nx, ny = self._depot_point
+            if (pose.x - nx) ** 2 + (pose.y - ny) ** 2 > DEPOT_POINT_HIT**2:
                 return self._to_point(pose.x, pose.y, pose.yaw, nx, ny)
-            self._via_nest = False
+            self._via_depot = False
         tx, ty = (float(v) for v in w.path.point_at(w.u))
         if (tx - pose.x) ** 2 + (ty - pose.y) ** 2 < self._wp_tol2:
             w.next = max(w.path.next_waypoint_index(w.u), 1)

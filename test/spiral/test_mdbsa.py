@@ -31,7 +31,7 @@ from swarm_controllers.spiral.geometry import (
     region_side,
     segments_overlap_collinear,
 )
-from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, NEST_HIT, NEST_OFFSET, MdbsaBehaviour, MdbsaState
+from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, DEPOT_POINT_HIT, DEPOT_POINT, MdbsaBehaviour, MdbsaState
 from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment, WalkProgress
 from swarm_controllers.spiral.regions import RegionConfig
 from swarm_sim.messaging import Router
@@ -385,11 +385,11 @@ def _seg_distance(p, a, b):
     return float(np.hypot(*(a + t * (b - a) - p)))
 
 
-@pytest.mark.parametrize("mode", ["center_range", "nest"])
-def test_with_next_walk_at_nest_a_new_walk_starts_by_way_of_the_authors_nest_point(mode):
+@pytest.mark.parametrize("mode", ["center_range", "depot"])
+def test_with_next_walk_at_depot_a_new_walk_starts_by_way_of_the_authors_point(mode):
     """The MDBSA authors' robot, its point list empty, takes its next walk at once but first drives
     to within 0.1 m of (0.1, 0.1) (``SetTarget(CVector2(0.1, 0.1))``, then ``TargetHit``). Ours
-    asks in the center's range either way; with ``nest`` it then goes by way of that point."""
+    asks in the center's range either way; with ``depot`` it then goes by way of that point."""
     s = generic_scenario("mdbsa_c", ["regions.count=4", f"controller.spiral.next_walk_at={mode}"], robots__count=3,
                          arena__size=2.4, resources__clusters=1, resources__count=16)
     assert SpiralConfig.of(s).next_walk_at == mode
@@ -400,24 +400,24 @@ def test_with_next_walk_at_nest_a_new_walk_starts_by_way_of_the_authors_nest_poi
     rng = SpiralConfig.of(s).center_range
     assert rng - ASK_MARGIN - 0.05 < math.hypot(m.x, m.y) <= rng
     nxt = 3
-    straight = _seg_distance(NEST_OFFSET, (m.x, m.y), b.paths[nxt].start)
-    assert straight > NEST_HIT + 0.2  # the straight way misses the nest point
+    straight = _seg_distance(DEPOT_POINT, (m.x, m.y), b.paths[nxt].start)
+    assert straight > DEPOT_POINT_HIT + 0.2  # the straight way misses the nest point
     u.step([RegionAssignment(u.k * DT_NS, "robot_0", nxt, FORWARD, 0.0, b.paths[nxt].length, False)])
     nearest = math.inf
     for _ in range(600):
         if b.state is not MdbsaState.TRAVELING:
             break
         u.step()
-        nearest = min(nearest, math.hypot(u.x - NEST_OFFSET[0], u.y - NEST_OFFSET[1]))
+        nearest = min(nearest, math.hypot(u.x - DEPOT_POINT[0], u.y - DEPOT_POINT[1]))
     assert b.state is MdbsaState.SEARCHING and b.region == nxt
-    if mode == "nest":
-        assert nearest <= NEST_HIT
+    if mode == "depot":
+        assert nearest <= DEPOT_POINT_HIT
     else:
         assert nearest > straight - 0.05
 
 
-def test_with_next_walk_at_nest_an_idle_robot_does_not_visit_the_nest():
-    s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=nest"], robots__count=3,
+def test_with_next_walk_at_depot_an_idle_robot_does_not_visit_the_depot():
+    s = generic_scenario("mdbsa_c", ["regions.count=4", "controller.spiral.next_walk_at=depot"], robots__count=3,
                          arena__size=2.4, resources__clusters=1, resources__count=16)
     b = MdbsaBehaviour(s, "robot_0", None)
     u = Unicycle(b, 0.3, 0.0)
@@ -427,8 +427,8 @@ def test_with_next_walk_at_nest_an_idle_robot_does_not_visit_the_nest():
     nearest = math.inf
     for _ in range(300):
         u.step()
-        nearest = min(nearest, math.hypot(u.x - NEST_OFFSET[0], u.y - NEST_OFFSET[1]))
-    assert nearest > NEST_HIT + 0.2
+        nearest = min(nearest, math.hypot(u.x - DEPOT_POINT[0], u.y - DEPOT_POINT[1]))
+    assert nearest > DEPOT_POINT_HIT + 0.2
 
 
 @pytest.mark.parametrize("gaps", [1, 3])
