@@ -35,5 +35,11 @@ class QueueConfig(Section):
     CPFA-2.0, their Q_ST: ``CPFA_controller::Returning``, source/CPFA/CPFA_controller.cpp). Only
     the paper's text is the default; ``anywhere`` is what the authors ran."""
 
+    seek_timeout: float = 120.0
+    """Tail joining: a searcher that has not joined after this long [s, sim time] falls back to
+    entry-point joining. Our addition, against livelock: the paper's searcher only switches to its
+    fallback (the nearest line, followed to its endpoint) on reaching the inner region's boundary
+    without meeting anyone, and the authors' Q_ST code has no give-up either. One beyond the run's duration: never."""
+
     SECTION: ClassVar[str] = "queue"
 

@@ -516,6 +516,8 @@ def check_queue(scenario: Scenario) -> None:
     """The queue layout must fit the scenario's depot (ValueError naming the parameter): the
     queue strategies' check (`swarm_controllers.queue.registration`)."""
     q = QueueConfig.of(scenario)
+    if not q.seek_timeout > 0:
+        raise ValueError("controller.queue.seek_timeout: must be positive")
     try:
         geometry = DepotGeometryConfig.from_scenario(scenario)
         geometry.validate()

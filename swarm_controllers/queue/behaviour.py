@@ -34,8 +34,8 @@ Phases of a delivery, and the choices the paper leaves open:
   along their line (opposite to the queue's direction) to about gamma behind the lowest slot it
   heard of, and asks again. Reaching the inner region's boundary without hearing anyone, it
   takes the nearest slot of the nearest entry line (the fallback) and asks to join there; a
-  refusal sends it backwards along that line. After `SEEK_TIMEOUT` without joining it falls
-  back to entry-point joining.
+  refusal sends it backwards along that line. After ``controller.queue.seek_timeout`` without
+  joining it falls back to entry-point joining (our addition).
 * **Queued**. The robot drives slot to slot along its route (entry line, then for the single
   queue the inner queue the manager dispatched it to, then the exit line), reporting every slot
   it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
@@ -77,8 +77,6 @@ QUERY_PERIOD = 0.5
 """Tail joining: at most one radio query per this many seconds [s]."""
 YIELD_TIME = 1.0
 """Tail joining: how long a yielding searcher stands still [s]."""
-SEEK_TIMEOUT = 120.0
-"""Tail joining: give up and use entry-point joining after this long [s]."""
 RETRY_PERIOD = 1.0
 """How often a refused join is asked again [s]."""
 SLOT_TOLERANCE = 0.05
@@ -144,7 +142,7 @@ class QueueBehaviour:
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
-        "_retry_at", "_rng", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
+        "_retry_at", "_rng", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
     )
 
@@ -162,6 +160,7 @@ class QueueBehaviour:
         self._lane = queue.lane_spacing
         self._gamma = scenario.robots.radio_range
         self._tail = queue.joining == "tail"
+        self._seek_time = queue.seek_timeout
         self._keep_out = self._R + KEEP_OUT_BAND
         """Non-carriers stay outside this radius about the depot centre [m]."""
         self._detour_far = self._drive.blind_legs
@@ -377,7 +376,7 @@ class QueueBehaviour:
         self._line, self._cell = "", -1
         if self._tail:
             self._phase = Phase.SEEKING
-            self._seek_until = obs.t + SEEK_TIMEOUT
+            self._seek_until = obs.t + self._seek_time
             self._goal = None
         else:
             self._start_entry_joining(obs)

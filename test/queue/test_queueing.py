@@ -305,3 +305,25 @@ def test_a_robot_that_lost_its_resource_on_the_way_reports_unloaded_at_its_dock(
                             ForagingSense((), False)))
     kinds = [(m.kind, m.line, m.cell) for m in at.messages if isinstance(m, DepotReport)]
     assert kinds == [(ReportKind.AT, dock_line, dock_cell), (ReportKind.UNLOADED, dock_line, dock_cell)]
+
+
+@pytest.mark.parametrize("timeout", [3.0, 120.0])
+def test_a_tail_seeker_falls_back_to_entry_joining_after_seek_timeout(timeout):
+    """``controller.queue.seek_timeout`` (our addition; the paper's searcher has no give-up): a
+    carrier that has not joined by then heads for an entry point instead."""
+    from swarm_sim.registry import make_behaviour
+    from swarm_sim.scenario import ScenarioError
+
+    s = generic_scenario("queue_qst", ["robots.count=2", f"controller.queue.seek_timeout={timeout}"])
+    assert QueueConfig.of(s).seek_timeout == timeout
+    b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+    ranges = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
+    x = s.depot.perimeter_radius - 0.1  # inside the perimeter, carrying: it starts seeking
+    phases = []
+    for k in range(40):  # 4 s, standing where it is (nobody answers)
+        b.step(Observation("robot_0", k * s.dt_ns, Pose2D(x, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), True)))
+        phases.append(b._phase)
+    assert phases[0] is Phase.SEEKING
+    assert (phases[-1] is Phase.TO_ENTRY) == (timeout < 4.0)
+    with pytest.raises(ScenarioError, match="controller.queue.seek_timeout"):
+        generic_scenario("queue_qst", ["controller.queue.seek_timeout=0"])
