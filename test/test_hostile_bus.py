@@ -199,7 +199,7 @@ def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_
     forged = h.publisher(topics.CLOCK, SENSOR_LOCKSTEP)
     strings = other.create_publisher(String, topics.CLOCK, 10)
     h.wait_matched(run)
-    for _ in range(3):
+    for _ in range(10):  # best effort, and the depot manager may match the forger late: 10 sent, 3 counted
         forged.publish(clock.encode_clock(h.stamp + 10**13))
         strings.publish(String(data="tick"))
         h.spin(0.3)
