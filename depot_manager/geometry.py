@@ -513,8 +513,8 @@ def make_layout(
 
 
 def check_queue(scenario: Scenario) -> None:
-    """The queue layout must fit the scenario's depot (ValueError naming the parameter): the
-    queue strategies' check (`swarm_controllers.queue.registration`)."""
+    """The queue strategies' check (`swarm_controllers.queue.registration`; ValueError naming the
+    parameter): the searchers' give-up time is positive and the queue layout fits the depot."""
     q = QueueConfig.of(scenario)
     if not q.seek_timeout > 0:
         raise ValueError("controller.queue.seek_timeout: must be positive")

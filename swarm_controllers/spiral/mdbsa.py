@@ -157,6 +157,11 @@ class _Walk:
         """Progress as the center counts it [m from the spiral's start]."""
         return self.to_u(self.u)
 
+    def stop_at(self, s: float) -> None:
+        """The partner has been up to `s` [m from the spiral's start]: the stop moves there if
+        that is nearer, never behind the progress."""
+        self.stop_u = max(self.u, min(self.stop_u, self.to_u(s)))
+
     @property
     def over(self) -> bool:
         return self.u >= self.stop_u - _EPS or self.next >= len(self.wp)
@@ -330,7 +335,7 @@ class MdbsaBehaviour:
         asked = self._state is MdbsaState.WAITING and m.stamp_ns > self._asked_ns
         if not asked and w is not None and m.region == w.region and m.direction == w.direction:
             # The center passes on the partner's frontier: the stop only moves toward us.
-            w.stop_u = max(w.u, min(w.stop_u, w.to_u(m.stop_s)))
+            w.stop_at(m.stop_s)
             return
         if self._state is MdbsaState.WAITING and not asked:
             return
@@ -353,7 +358,7 @@ class MdbsaBehaviour:
         if w is None or m.robot == self.robot or m.region != w.region or m.direction != -w.direction:
             return
         if math.isfinite(m.s):
-            w.stop_u = max(w.u, min(w.stop_u, w.to_u(m.s)))
+            w.stop_at(m.s)
 
     def _on_carrying(self, carrying: bool) -> None:
         if carrying == self._carrying:

@@ -10,7 +10,14 @@ from __future__ import annotations
 import numpy as np
 from graph_helpers import run_graph
 
-from swarm_controllers.spiral.codec import CENTER, CENTER_ASSIGNMENTS, CENTER_MARKERS, CENTER_REPORTS, CENTER_STATE
+from swarm_controllers.spiral.codec import (
+    CENTER,
+    CENTER_ASSIGNMENTS,
+    CENTER_MARKERS,
+    CENTER_REPORTS,
+    CENTER_STATE,
+    WALK_PROGRESS,
+)
 from swarm_controllers.spiral.geometry import region_centers, region_side
 from swarm_controllers.spiral.protocol import RegionAssignment
 from swarm_msgs_py import topics
@@ -39,7 +46,7 @@ def test_mdbsa_d_graph_run_stays_in_assigned_regions(tmp_path):
     scenario = load_scenario("mdbsa_d", [f"robots.count={ROBOTS}", "regions.order=row_major"])
     counts = bag_info(bag).message_counts
     for topic in (CENTER_REPORTS, CENTER_ASSIGNMENTS, CENTER_STATE,
-                  CENTER_MARKERS, topics.LOCKSTEP_ACK):
+                  CENTER_MARKERS, topics.LOCKSTEP_ACK, WALK_PROGRESS):  # the walkers' radio too
         assert counts.get(topic, 0) > 0, topic
 
     assignments: dict[str, list[tuple[float, int]]] = {}
