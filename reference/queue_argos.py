@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import resource
 import subprocess
 import sys
 import time
@@ -66,7 +67,8 @@ def parse_line(output: str) -> dict:
     return {k: float(v) for k, v in match.groupdict().items()}
 
 
-def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, provenance: dict) -> dict:
+def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, provenance: dict,
+        cpu_s: float | None = None) -> dict:
     """One reference run in our results schema (the fields our queue rows share) plus provenance."""
     if int(printed["seed"]) != seed:
         raise ReferenceError(f"the run printed seed {int(printed['seed'])}, it was given {seed}")
@@ -76,6 +78,7 @@ def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, pro
         "strategy": strategy, "cell": robots, "scenario": strategy, "seed": seed, "robots": robots,
         "mode": "reference", "reference": True,
         "sim_seconds": round(sim_s, 3), "wall_seconds": round(wall_s, 3),
+        "cpu_seconds": None if cpu_s is None else round(cpu_s, 3),
         "real_time_factor": round(sim_s / wall_s, 2) if wall_s > 0 else None,
         "total_resources": TOTAL_RESOURCES, "resources_delivered": int(round(score)),
         "resources_collected_pct": round(100.0 * score / TOTAL_RESOURCES, 6),
@@ -87,15 +90,21 @@ def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, pro
     }
 
 
-def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) -> tuple[dict, float]:
+def _children_cpu_s() -> float:
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
+
+
+def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) -> tuple[dict, float, float]:
+    """The printed numbers, the wall seconds and the CPU seconds (user + system) of one run."""
     xml = experiment_xml((tree / EXPERIMENT).read_text(), robots, seed)
     temp = tree / f".swarmforage_r{robots}_s{seed}.xml"
     temp.write_text(xml)
     try:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), _children_cpu_s()
         done = subprocess.run([argos, "-c", str(temp.name)], cwd=tree, capture_output=True, text=True,
                               timeout=timeout_s, stdin=subprocess.DEVNULL)
-        wall = time.perf_counter() - start
+        wall, cpu = time.perf_counter() - start, _children_cpu_s() - cpu
     except subprocess.TimeoutExpired:
         raise ReferenceError(f"robots {robots} seed {seed}: argos3 ran past {timeout_s:.0f} s") from None
     finally:
@@ -103,7 +112,7 @@ def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) ->
     if done.returncode != 0:
         tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
         raise ReferenceError(f"robots {robots} seed {seed}: argos3 exited {done.returncode}: {tail[0]}")
-    return parse_line(done.stdout + done.stderr), wall
+    return parse_line(done.stdout + done.stderr), wall, cpu
 
 
 def _done(out: Path) -> set[tuple[str, int, int, str]]:
@@ -151,12 +160,12 @@ def main(argv: list[str] | None = None) -> int:
             for seed in AUTHORS_SEEDS[:a.seeds]:
                 if (a.strategy, robots, seed, a.commit) in done:
                     continue
-                printed, wall = run_one(a.argos, a.tree, robots, seed, a.timeout)
-                r = row(a.strategy, robots, seed, printed, wall, provenance)
+                printed, wall, cpu = run_one(a.argos, a.tree, robots, seed, a.timeout)
+                r = row(a.strategy, robots, seed, printed, wall, provenance, cpu)
                 with a.out.open("a") as f:
                     f.write(json.dumps(r) + "\n")
                 print(f"[reference] {a.strategy} {robots} robots seed {seed}: "
-                      f"{r['resources_delivered']} resources in {wall:.1f} s wall", flush=True)
+                      f"{r['resources_delivered']} resources in {wall:.1f} s wall, {cpu:.1f} s CPU", flush=True)
     except (ReferenceError, OSError) as e:
         print(f"reference: {e}", file=sys.stderr)
         return 2
