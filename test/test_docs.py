@@ -27,16 +27,20 @@ _LINK = re.compile(r"!?\[(?:[^\]\[]|\[[^\]]*\])*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\
 _HEADING = re.compile(r"^(#{1,6})\s+(.*?)\s*#*\s*$")
 
 
-def _prose(text: str) -> list[tuple[int, str]]:
-    """(line number, line) of `text` outside fenced code blocks, inline code spans blanked."""
+def _outside_fences(text: str) -> list[tuple[int, str]]:
+    """(line number, line) of `text` outside fenced code blocks."""
     out, fenced = [], False
     for number, line in enumerate(text.splitlines(), 1):
         if _FENCE.match(line.lstrip()):
             fenced = not fenced
-            continue
-        if not fenced:
-            out.append((number, re.sub(r"`[^`]*`", "``", line)))
+        elif not fenced:
+            out.append((number, line))
     return out
+
+
+def _prose(text: str) -> list[tuple[int, str]]:
+    """(line number, line) of `text` outside fenced code blocks, inline code spans blanked."""
+    return [(number, re.sub(r"`[^`]*`", "``", line)) for number, line in _outside_fences(text)]
 
 
 def _heading_text(raw: str) -> str:
@@ -62,25 +66,13 @@ def anchors(path: Path, slug) -> set[str]:
     """The anchors of `path`'s headings by `slug`, repeated headings numbered as both renderers do."""
     seen: dict[str, int] = {}
     out = set()
-    for _, line in _prose_with_code(path.read_text()):
+    for _, line in _outside_fences(path.read_text()):
         match = _HEADING.match(line)
         if match:
             base = slug(match.group(2))
             n = seen.get(base, 0)
             seen[base] = n + 1
             out.add(base if n == 0 else f"{base}_{n}" if slug is mkdocs_anchor else f"{base}-{n}")
-    return out
-
-
-def _prose_with_code(text: str) -> list[tuple[int, str]]:
-    """(line number, line) outside fenced code blocks, code spans kept (headings need them)."""
-    out, fenced = [], False
-    for number, line in enumerate(text.splitlines(), 1):
-        if _FENCE.match(line.lstrip()):
-            fenced = not fenced
-            continue
-        if not fenced:
-            out.append((number, line))
     return out
 
 
@@ -174,8 +166,10 @@ def test_the_site_builds_without_a_warning(tmp_path):
 
 # ---------------------------------------------------------------------------- the tutorial
 
-_MARKED = re.compile(r"^<!-- (file: (?P<file>\S+)|(?P<kind>install|run|run: fails)) -->\s*\n```[a-z]*\n(?P<body>.*?)^```",
-                     re.M | re.S)
+_MARKED = re.compile(r"^<!-- (file: (?P<file>\S+)|(?P<kind>install|run|run: fails)) -->\s*\n"
+                     r"```[a-z]*\n(?P<body>.*?)^```", re.M | re.S)
+"""A code block of the tutorial marked for the test by the HTML comment before it (invisible in
+the rendered page): a file to write, the install command, a command to run, one that must fail."""
 
 
 def tutorial_blocks(text: str) -> list[tuple[str, str, str]]:
