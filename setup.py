@@ -44,6 +44,9 @@ setup(
         ],
         "dask": ["distributed"],  # sweeps on a Dask cluster (--scheduler, --dask-local)
         "test": ["pytest", "hypothesis", "websockets", "distributed"],
+        # The documentation site (mkdocs.yml, docs/): MkDocs, the standard, well-kept static site
+        # builder for Markdown; its --strict build is a test (test/test_docs.py).
+        "docs": ["mkdocs"],
     },
     entry_points={
         # Every paper registers itself as a third-party plug-in would (swarm_sim.registry).

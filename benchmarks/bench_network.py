@@ -6,7 +6,7 @@ Root only (network namespaces). The testbed of ``test/network`` (`netns.Testbed`
 user-space switch `linkemu`): the world on one host, the controllers on two others (even and odd
 robots), both controller links shaped alike, in lockstep and in realtime at 1x (command timeout
 0.5 s); the rows with a partition cut hostb off for 3 s once a third of the run is done. Prints
-the README's table (one markdown row per setting) and each run's per-host counts.
+the table of benchmarks/README.md (one markdown row per setting) and each run's per-host counts.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ swarm-run takes ``--bind`` itself (`launch_py.run`); ``swarm-world``, ``swarm-se
 
 ``python -m launch_py.hosts env --bind ADDR --discovery-server ADDR:PORT`` prints the environment
 (and writes the profile) that lets a stock ``ros2`` CLI on that host join the run, as a super
-client of the discovery server (README, *Across hosts*).
+client of the discovery server (docs/across_hosts.md).
 """
 
 from __future__ import annotations
@@ -127,7 +127,7 @@ ACK_WAIT = 10.0
 before it answers the tick (`swarm_sim.nodes.endpoint.wait_acked`): past a partition of that
 length a run may leave the batch run's path. A node waiting longer than the world's tick timeout
 is stale at that tick first (and dead after three): runs across unreliable links want a
-``--tick-timeout`` above the outages they should ride out (README, *Across hosts*)."""
+``--tick-timeout`` above the outages they should ride out (docs/across_hosts.md)."""
 HEARTBEAT_NS = 100_000_000
 """Reliable writers' heartbeat period across hosts [ns] (Fast DDS's default: 3 s). A reader learns
 that it missed a sample from the writer's next heartbeat (or a later sample), so on a lossy link
@@ -254,7 +254,7 @@ def node_main(kind: str, argv: list[str] | None = None) -> int:
         try:
             return importlib.import_module(module).main(rest)
         finally:
-            print(f"\nacross hosts (README, *Across hosts*):\n{parser.format_help().split(chr(10), 2)[2]}")
+            print(f"\nacross hosts (docs/across_hosts.md):\n{parser.format_help().split(chr(10), 2)[2]}")
     if args.bind is not None or args.discovery_server is not None:
         try:
             apply(role, args.bind, args.discovery_server)

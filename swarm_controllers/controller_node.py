@@ -15,7 +15,7 @@ behaviour itself, is counted on ``/diagnostics``.
 
 The node serves the standard parameter services (``ros2 param list/get``), created with it:
 twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
-discovery (README, Benchmarks); the discovery server only tells each process of the endpoints on
+discovery (benchmarks/README.md); the discovery server only tells each process of the endpoints on
 its own topics. ``--no-parameter-services`` leaves them out: more than half of a controller's
 endpoints, and with 1000 robots 45 % of the start-up's CPU (Fast DDS pairs every endpoint it
 learns of with every local one: the world, as discovery server, learns of them all).

@@ -6,7 +6,7 @@
   controller that has answered that tick sends its answer again (`WorldNode._await_commands`).
   Reliability on top of that made every sample cost a heartbeat/acknack exchange and a writer
   timer: with 112 robots in one controller process, 1250 context switches and 19 ms of CPU
-  per tick in the world, 190 and 13 ms best effort (issue 14, README Benchmarks). Depth 10
+  per tick in the world, 190 and 13 ms best effort (docs/benchmarks.md). Depth 10
   absorbs a slow subscriber for a few ticks; volatile, since a late joiner wants the next tick,
   not old ones. A stock ``ros2 topic echo`` matches it (it adapts to the publishers' QoS).
 - `STATE_LATCHED` (assignments, depot/queue state, markers, cumulative robot stats):

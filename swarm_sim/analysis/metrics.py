@@ -123,7 +123,7 @@ def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
 
 
 def summarize(trace: RunTrace) -> dict[str, Any]:
-    """The JSON result of one run (schema documented in the README; fields are only ever added)."""
+    """The JSON result of one run (schema documented in docs/command_line.md)."""
     collision = collision_time_by_robot(trace)
     contact = contact_time_by_robot(trace)
     oae = oae_by_robot(trace)

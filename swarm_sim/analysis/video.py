@@ -239,7 +239,7 @@ def render_video(bag: Path | str, out: Path | str, *, speedup: float = 10.0, fps
 
 
 def save_frame(bag: Path | str, t: float, out: Path | str) -> Path:
-    """One frame of the replay, at sim time `t` [s], as a PNG (the README's picture)."""
+    """One frame of the replay, at sim time `t` [s], as a PNG (docs/replay_frame.png is one)."""
     import imageio.v2 as imageio
 
     (frame,) = frames(bag, np.array([float(t)]))

@@ -1,6 +1,6 @@
 """A stand-in for a stock ``ros2 topic echo TOPIC`` (ros2cli is not installed here): what it does,
 with plain rclpy, in a process whose environment a user's ``ros2`` would get from
-``python -m launch_py.hosts env`` (README, *Across hosts*).
+``python -m launch_py.hosts env`` (docs/across_hosts.md).
 
 ``echo.py TOPIC COUNT TIMEOUT``: like ``ros2 topic echo``, learn the topic's type from the ROS
 graph (which needs the discovery server's super-client view), match the publishers' reliability,

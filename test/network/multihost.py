@@ -1,6 +1,6 @@
 """A swarm-run across the hosts of a `netns.Testbed`: the world (and its servers) on host ``world``,
 the controllers on ``hosta`` and ``hostb``, started from the very commands swarm-run prints for
-them (README, *Across hosts*), and a stand-in ``ros2 topic echo`` (`echo.py`) on ``cli``."""
+them (docs/across_hosts.md), and a stand-in ``ros2 topic echo`` (`echo.py`) on ``cli``."""
 
 from __future__ import annotations
 
@@ -85,7 +85,7 @@ class _Lines:
 
 
 def start_echo(testbed: Testbed, server: str, topic: str, count: int, timeout: float, tmp: Path) -> subprocess.Popen:
-    """The stand-in ``ros2 topic echo`` (`echo.py`) on host ``cli``, in the environment the README's
+    """The stand-in ``ros2 topic echo`` (`echo.py`) on host ``cli``, in the environment docs/across_hosts.md's
     recipe gives a stock ``ros2`` there (``python -m launch_py.hosts env``)."""
     lines = testbed.run("cli", [sys.executable, "-m", "launch_py.hosts", "env", "--bind", "eth0",
                                 "--discovery-server", server, "--profile", str(tmp / "cli.xml")])
