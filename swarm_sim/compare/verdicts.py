@@ -109,13 +109,16 @@ class Claim:
     """Level: the paper's number, in the measure's unit times `scale`."""
     size: float | None = None
     """Relation, trend: the paper's single stated size [% of A]."""
+    sizes: tuple[tuple[object, float], ...] = ()
+    """Relation: the paper's size cell by cell [% of A] (a table's numbers), where it has one."""
     band: tuple[float, float] | None = None
     """The paper's own spread (level) or stated range [%] (relation, trend); else from
-    `value` / `size` and `LEVEL_BAND`."""
+    `value` / `size` / `sizes` and `LEVEL_BAND`; a "no difference" claim without one:
+    ±`LEVEL_BAND`; a direction without a stated size: any size that way."""
     sign: int = 1
     """Relation, trend: +1 B above A, -1 below, 0 no difference."""
     pooled: bool = False
-    """Relation: the runs of all `cells` pooled ("on average") instead of cell by cell."""
+    """The runs of all `cells` pooled ("on average") instead of cell by cell."""
     scale: float = 1.0
     """Factor from the rows' unit to the paper's."""
     unit: str = ""
@@ -134,18 +137,26 @@ class Claim:
             raise ValueError(f"claim {self.id}: a trend needs its first and last cell")
         if self.kind != LEVEL and self.sign not in (-1, 0, 1):
             raise ValueError(f"claim {self.id}: sign must be -1, 0 or 1")
-        if self.kind != LEVEL and self.sign == 0 and self.band is None and self.size is None:
-            raise ValueError(f"claim {self.id}: a 'no difference' claim needs its band")
+        if self.kind != LEVEL and self.sign != 0 and self.size is not None and self.size * self.sign <= 0:
+            raise ValueError(f"claim {self.id}: size {self.size} against its sign {self.sign}")
 
-    def limits(self) -> tuple[float, float]:
-        """The band: the paper's spread or range, else ±`LEVEL_BAND` of its value or size."""
+    def limits(self, cell: object = None) -> tuple[float, float]:
+        """The band (in `cell`): the paper's spread or range, else ±`LEVEL_BAND` of its value or size."""
         if self.band is not None:
             return (min(self.band), max(self.band))
-        centre = self.value if self.kind == LEVEL else self.size
+        centre = self.value if self.kind == LEVEL else dict(self.sizes).get(cell, self.size)
         if self.kind != LEVEL and self.sign == 0:
-            return (-abs(centre), abs(centre))
+            half = 100.0 * LEVEL_BAND if centre is None else abs(centre)
+            return (-half, half)
+        if centre is None:  # a direction without a stated size
+            return (0.0, math.inf) if self.sign > 0 else (-math.inf, 0.0)
         half = abs(centre) * LEVEL_BAND
         return (centre - half, centre + half)
+
+    @property
+    def stated(self) -> bool:
+        """Whether the paper states a size (else only a direction)."""
+        return self.kind == LEVEL or self.band is not None or self.size is not None or bool(self.sizes)
 
     def cause(self, model: str) -> Cause | None:
         return dict(self.causes).get(model) or dict(self.causes).get("*")
@@ -157,8 +168,12 @@ class Claim:
             return v + (f" {self.unit}" if self.unit else "")
         if self.sign == 0:
             return f"no difference (within {lo:+.0f} … {hi:+.0f} %)"
+        if self.sizes:
+            return ", ".join(f"{c}: {v:+.1f} %" for c, v in self.sizes)
         if self.size is not None and self.band is None:
             return f"{self.size:+.1f} %"
+        if not self.stated:
+            return ("higher" if self.sign > 0 else "lower") + " (no size stated)"
         return f"{lo:+.1f} … {hi:+.1f} %"
 
 
@@ -320,7 +335,7 @@ def judge(claim: Claim, c: CellVerdict, a: Sequence[float] = (), b: Sequence[flo
     """The verdict of a cell once its p-value is adjusted (`c.p_adj`)."""
     if not math.isfinite(c.p_adj):
         return replace(c, verdict=NA)
-    lo, hi = claim.limits()
+    lo, hi = claim.limits(c.cell)
     significant = c.p_adj < ALPHA
     if claim.kind == LEVEL:
         if significant:
@@ -336,7 +351,7 @@ def judge(claim: Claim, c: CellVerdict, a: Sequence[float] = (), b: Sequence[flo
         return replace(c, verdict=NOT_SHOWN, seeds=runs_needed(sigma, hi / 100.0 * abs(c.means[0])))
     right = c.effect * claim.sign > 0
     if not significant:
-        paper = (lo + hi) / 2
+        paper = (lo + hi) / 2 if claim.stated else math.nan  # no stated size: no power to compute
         return replace(c, verdict=NOT_SHOWN, seeds=runs_needed(sigma, paper / 100.0 * abs(c.means[0])))
     if not right:
         return replace(c, verdict=CONTRADICTS)
@@ -357,8 +372,10 @@ def _measure(claim: Claim, rows: Sequence[dict]) -> _Pending:
     out = _Pending(claim)
     lo, hi = claim.limits()
     if claim.kind == LEVEL:
-        for cell in claim.cells:
-            ours = values(rows, claim.a, cell, claim.measure, claim.scale)
+        groups = [("pooled", [v for cell in claim.cells for v in values(rows, claim.a, cell, claim.measure,
+                                                                         claim.scale)])] if claim.pooled else \
+            [(cell, values(rows, claim.a, cell, claim.measure, claim.scale)) for cell in claim.cells]
+        for cell, ours in groups:
             out.cells.append(level_cell(claim, ours, cell, lo, hi))
             out.samples.append((ours, []))
         return out
