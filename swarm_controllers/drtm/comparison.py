@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from swarm_controllers.drtm.config import NestConfig
-from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table, save_figure
 from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
@@ -263,32 +263,6 @@ def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int]
     return written
 
 
-HEADLINES: tuple[tuple[str, str, str, bool], ...] = (
-    ("food_deviation", "DRTM keeps the food closer to F_d (V_f lower than ARTM's)", "Secs. 3.1, 4.1-4.4", True),
-    ("oae_total", "DRTM has fewer obstacle-avoidance events (M_T lower than ARTM's)", "Secs. 3.1, 4.1-4.4; t-tests", True),
-    ("energy_efficiency", "DRTM is more energy-efficient (E_e higher than ARTM's)", "Secs. 3.1, 4.1-4.4", False),
-)
-"""(field, claim, where the paper says it, DRTM better when lower): the paper's headline claims,
-each made for every condition."""
-
-
-def drtm_headlines(rows: Sequence[dict], conditions: Sequence[int]) -> list[Headline]:
-    """Each headline claim checked on the means of every condition run: it holds where DRTM beats
-    ARTM in all of them (None without both models' runs)."""
-    out = []
-    for metric, claim, where, lower in HEADLINES:
-        wins, seen = [], []
-        for cell in conditions:
-            a, b = (describe(values_of(rows, s, cell, metric)).mean for s in DRTM_STRATEGIES)
-            if math.isfinite(a) and math.isfinite(b):
-                seen.append(DRTM_CONDITIONS[cell].section)
-                if (a < b) == lower and a != b:
-                    wins.append(DRTM_CONDITIONS[cell].section)
-        ours = f"DRTM better in {len(wins)}/{len(seen)}: {', '.join(wins) or 'none'}" if seen else "—"
-        out.append(Headline(claim, f"all five ({where})", ours, len(wins) == len(seen) if seen else None))
-    return out
-
-
 def _sections(text: Sequence[str] | None) -> list[int]:
     known = [c.section for c in DRTM_CONDITIONS]
     if not text:
@@ -312,8 +286,10 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_drtm_report(rows, out, _sections(args.conditions), strategies)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    return drtm_headlines(rows, _sections(args.conditions))
+def _claims(args: argparse.Namespace) -> tuple:
+    from swarm_controllers.drtm.claims import DRTM_CLAIMS  # lazy: the claims read this module's numbers
+
+    return DRTM_CLAIMS
 
 
 DRTM_COMPARISON = Comparison(
@@ -324,5 +300,5 @@ DRTM_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
-    headlines=_headlines,
+    claims=_claims,
 )
