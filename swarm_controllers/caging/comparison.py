@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, md_table
 from swarm_sim.compare.stats import Stats, describe, pair_test, u_can_reject, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
@@ -160,50 +160,6 @@ def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
     return written
 
 
-ERROR_CLAIM_FACTOR = 2.0
-"""The error claim ("around 3.8 %") counts as holding when our mean normalised error is at most
-this many times the paper's: the paper gives no spread to test against."""
-
-
-def caging_headlines(rows: Sequence[dict]) -> list[Headline]:
-    """The paper's claims (sec. 5) checked on our cells; None where the cells they need were not run.
-
-    Recruitment "is not affected by the variation of the step" (Table 1: 164.5 s for both steps):
-    holds when a two-sided Mann-Whitney U test finds no difference (p >= 0.05). The coarser grid
-    searches faster (Table 1: 197.5 s against 222.2 s): holds when our mean is lower too. The
-    object follows the planned path with an error of about 3.8 %: see `ERROR_CLAIM_FACTOR`. Every
-    swarm size and object is transported with the cage holding (Table 2 has every case delivered).
-    """
-    def times(cell: int, metric: str) -> list[float]:
-        return values_of(rows, STRATEGY, cell, metric)
-
-    out = []
-    fine, coarse = times(0, "recruitment_time_s"), times(1, "recruitment_time_s")
-    _, p = pair_test(fine, coarse, "u")
-    out.append(Headline("recruitment time does not depend on the landmark step (Table 1)", "164.5 s for both",
-                        f"medians {_median(fine)} / {_median(coarse)} s, Mann-Whitney p = {fmt_p(p)}",
-                        None if math.isnan(p) or not u_can_reject(len(fine), len(coarse)) else p >= 0.05))
-    fine, coarse = describe(times(0, "search_time_s")).mean, describe(times(1, "search_time_s")).mean
-    known = math.isfinite(fine) and math.isfinite(coarse)
-    out.append(Headline("a 1 m landmark step makes the search faster than 0.5 m (Table 1)", "197.5 < 222.2 s",
-                        f"{fmt(coarse, 1)} vs {fmt(fine, 1)} s (means)" if known else "—",
-                        coarse < fine if known else None))
-    errors = _over_all_runs(rows, "trajectory_error_pct")
-    known = math.isfinite(errors.mean)
-    out.append(Headline("the object follows the planned path with an error around 3.8 % (sec. 5)",
-                        f"{PAPER_NORMALISED_ERROR_PCT} %", f"{fmt(errors.mean, 1)} % (mean of {errors.n})" if known else "—",
-                        errors.mean <= ERROR_CLAIM_FACTOR * PAPER_NORMALISED_ERROR_PCT if known else None))
-    runs = [r for r in rows if r.get("strategy") == STRATEGY]
-    held = sum(1 for r in runs if r.get("transport_time_s") is not None and r.get("cage_held") is True)
-    out.append(Headline("every swarm size (6-8) and object is caged and delivered (Table 2)", "all cases",
-                        f"{held}/{len(runs)} runs", held == len(runs) if runs else None))
-    return out
-
-
-def _median(values: Sequence[float]) -> str:
-    return fmt(describe(values).median, 0) if values else "—"
-
-
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cells", type=int, nargs="+", choices=[c.number for c in CELLS],
                         help="a subset of the cells: " + "; ".join(f"{c.number} = {c.name}" for c in CELLS))
@@ -217,8 +173,10 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_caging_report(rows, out)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    return caging_headlines(rows)
+def _claims(args: argparse.Namespace) -> tuple:
+    from swarm_controllers.caging.claims import CAGING_CLAIMS  # lazy: the claims read this module's tables
+
+    return CAGING_CLAIMS
 
 
 CAGING_COMPARISON = Comparison(
@@ -229,5 +187,5 @@ CAGING_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
-    headlines=_headlines,
+    claims=_claims,
 )
