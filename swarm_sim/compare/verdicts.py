@@ -11,7 +11,8 @@ The scale (`VERDICTS`), cell by cell:
 - *holds*: the direction is right, the difference is significant and the size lies within the band;
 - *direction only*: right and significant, the size outside the band;
 - *not shown*: not significant; `CellVerdict.seeds` says how many runs per group a power
-  calculation (two-sided, `ALPHA`, `POWER`, our spread) says would show the paper's effect;
+  calculation (two-sided, `ALPHA`, `POWER`, our spread) says would show the paper's effect (a
+  level: would put the interval on one side of the band's nearer edge at our mean);
 - *contradicts*: significant the other way;
 - *n/a*: our runs cannot be tested (fewer than two runs of a group), with the reason.
 
@@ -341,7 +342,8 @@ def judge(claim: Claim, c: CellVerdict, a: Sequence[float] = (), b: Sequence[flo
         if significant:
             return replace(c, verdict=HOLDS if c.reason == "inside" else CONTRADICTS)
         sigma = float(np.std(a, ddof=1)) if len(a) > 1 else math.nan
-        return replace(c, verdict=NOT_SHOWN, seeds=runs_needed(sigma, (hi - lo) / 2, groups=1))
+        edge = min(abs(c.effect - lo), abs(c.effect - hi))  # the interval must clear the nearer edge
+        return replace(c, verdict=NOT_SHOWN, seeds=runs_needed(sigma, edge, groups=1))
     sigma = math.sqrt((np.var(a, ddof=1) + np.var(b, ddof=1)) / 2) if min(len(a), len(b)) > 1 else math.nan
     if claim.sign == 0:
         if significant:
