@@ -18,11 +18,15 @@ from swarm_sim.compare.verdicts import LEVEL, OPEN, PARTIAL, RELATION, TREND, Ca
 _BODY = Cause(PARTIAL, "the foot-bot's 0.17 m body: with the e-puck's 0.07 m body DRTM's OAEs fall below ARTM's "
                        "at 3.1 and DRTM keeps F closer to F_d at 4.3-4.4 (factor `body_0.07`, drtm31 / drtm43, "
                        "2 seeds)", "body_0.07", 2)
+_LEVEL = Cause(OPEN, "not measured: the paper's numbers come from ARGoS runs whose OAE rule and sensing the paper "
+                     "does not give in full, and the authors published no code (CAUSES.md, DRTM)")
 _OAE = Cause(OPEN, "how ARGoS counted an OAE is not stated and the authors published no code: our counts are "
                    "1-5x the paper's; not measured")
 _EE = Cause(PARTIAL, "E_e = F(T) / F_t: the food DRTM keeps in the nest carries 62-96 % of the gap (the split in "
                      "each table.md, 20 seeds); F settles where S = F_d - F meets a threshold whose OAE term "
                      "is our OAE count (`mt2_returning`, `body_0.07`: 2 seeds)", "mt2_returning", 2)
+_FT_TEST = Cause(OPEN, "not measured: our DRTM and ARTM collect within a few per cent of each other; what would "
+                       "separate them as Tables 2 and 4 do is not known")
 _FT = Cause(OPEN, "F_t is 30-40 % below the paper's on both robots; not measured")
 
 
@@ -36,12 +40,10 @@ def _levels() -> list[Claim]:
         for s in ("drtm", "artm"):
             for metric, (symbol, meaning, scale) in DRTM_METRICS.items():
                 value = PAPER[c.section][s][metric]
-                cause = _OAE if metric.startswith("oae") else _EE if metric in ("energy_efficiency",
-                                                                               "nest_food_final") else \
-                    _FT if metric == "food_collected" else _BODY
+                cause = _OAE if metric.startswith("oae") else _FT if metric == "food_collected" else _LEVEL
                 out.append(Claim(f"{c.section}.{DRTM_LABELS[s]}.{symbol}", LEVEL,
                                  f"{DRTM_LABELS[s]}'s {symbol} ({meaning}) is {value:g}", f"Sec. {c.section}",
-                                 metric, s, (cell,), value=value, scale=scale, causes=(("*", cause),)))
+                                 metric, s, (cell,), value=value, scale=scale, causes=(("authors", cause),)))
     return out
 
 
@@ -56,15 +58,15 @@ def _relations() -> list[Claim]:
     out = [
         Claim("DRTM<ARTM.V_f", RELATION, "DRTM keeps the food closer to F_d (V_f lower than ARTM's)",
               "Secs. 3.1, 4.2-4.4", "food_deviation", "artm", vf, b="drtm", sign=-1,
-              sizes=tuple((c, _pct("food_deviation", c)) for c in vf), causes=(("*", _BODY),)),
+              sizes=tuple((c, _pct("food_deviation", c)) for c in vf), causes=(("authors", _BODY),)),
         Claim("DRTM=ARTM.V_f.4.1", RELATION, "both keep the food near F_d with N_f = 25 (V_f 2.90 / 2.92)",
-              "Sec. 4.1", "food_deviation", "artm", (1,), b="drtm", sign=0, causes=(("*", _BODY),)),
+              "Sec. 4.1", "food_deviation", "artm", (1,), b="drtm", sign=0, causes=(("authors", _BODY),)),
         Claim("DRTM<ARTM.M_T", RELATION, "DRTM has fewer obstacle-avoidance events (M_T)",
               "Secs. 3.1, 4.1-4.4; Tables 2, 4", "oae_total", "artm", every, b="drtm", sign=-1,
-              sizes=tuple((c, _pct("oae_total", c)) for c in every), causes=(("*", _BODY),)),
+              sizes=tuple((c, _pct("oae_total", c)) for c in every), causes=(("authors", _BODY),)),
         Claim("DRTM>ARTM.E_e", RELATION, "DRTM is more energy-efficient (E_e higher)", "Secs. 3.1, 4.1-4.4",
               "energy_efficiency", "artm", every, b="drtm", sign=1, scale=100.0,
-              sizes=tuple((c, _pct("energy_efficiency", c)) for c in every), causes=(("*", _EE),)),
+              sizes=tuple((c, _pct("energy_efficiency", c)) for c in every), causes=(("authors", _EE),)),
     ]
     for cell in every:
         size = _pct("food_collected", cell)
@@ -74,7 +76,7 @@ def _relations() -> list[Claim]:
         out.append(Claim(f"F_t.{c.section}", RELATION,
                          f"F_t differs significantly between DRTM and ARTM (t = {t}, p = {p:g})",
                          f"Sec. {c.section}, {table}", "food_collected", "artm", (cell,), b="drtm",
-                         sign=1 if size > 0 else -1, size=size, causes=(("*", _FT),)))
+                         sign=1 if size > 0 else -1, size=size, causes=(("*", _FT_TEST),)))
     return out
 
 
@@ -102,8 +104,7 @@ def _trends() -> list[Claim]:
             out.append(Claim(f"trend.{section}.{DRTM_LABELS[s]}.{symbol}", TREND, f"{DRTM_LABELS[s]}, {text}",
                              f"Sec. {section} against Sec. 3.1", metric, s, (0, cell), sign=sign, scale=scale,
                              size=round(100.0 * (there - base) / base, 1),
-                             causes=(("*", _OAE if metric == "oae_total" else _BODY if metric == "food_deviation"
-                                      else _EE),)))
+                             causes=(("*", _OAE if metric == "oae_total" else _LEVEL),)))
     return out
 
 

@@ -35,6 +35,11 @@ _COLL_RULE = Cause(OPEN, "collision time counted by the world's proximity ring f
                          "fastest of the queue strategies (CAUSES.md); not a one-factor sweep")
 
 
+def _on(cause: Cause) -> tuple[tuple[str, Cause], ...]:
+    """The models a cause applies to: the motion rule is the foot-bot's only."""
+    return (("authors", cause),) if cause is _MOTION else (("*", cause),)
+
+
 def _pair_sizes(a: str, b: str) -> tuple[tuple[int, float], ...]:
     pa, pb = PAPER_TABLE_II[a], PAPER_TABLE_II[b]
     return tuple((n, round(100.0 * (pb[n] - pa[n]) / pa[n], 1)) for n in QUEUE_SIZES)
@@ -47,7 +52,7 @@ def _levels() -> list[Claim]:
             cause = _CPFA_LATE if s == "queue_cpfa" else _JOIN if s == "queue_qst" else _MOTION
             out.append(Claim(f"T2.{QUEUE_LABELS[s]}.{n}", LEVEL, f"{QUEUE_LABELS[s]} collects {PAPER_TABLE_II[s][n]} % "
                              f"with {n} robots", "Table II", PCT, s, (n,), value=PAPER_TABLE_II[s][n], unit="%",
-                             note=TEXT_COUNTS.get((s, n), ""), causes=(("*", cause),)))
+                             note=TEXT_COUNTS.get((s, n), ""), causes=_on(cause)))
     return out
 
 
@@ -66,7 +71,7 @@ def _order() -> list[Claim]:
                              f"{QUEUE_LABELS[b]} collects more than {QUEUE_LABELS[a]}",
                              "Table II (every size)" + ("; Sec. VIII-A: Q_ST about 2 Q_SE" if b == "queue_qst" and
                                                        a == "queue_qse" else ""),
-                             PCT, a, QUEUE_SIZES, b=b, sizes=_pair_sizes(a, b), causes=(("*", cause),)))
+                             PCT, a, QUEUE_SIZES, b=b, sizes=_pair_sizes(a, b), causes=_on(cause)))
     return out
 
 
@@ -80,9 +85,9 @@ def _trends() -> list[Claim]:
         Claim("trend.CPFA", TREND, "CPFA collects less with more robots (49 -> 37 resources)", "Sec. VIII-A, Table II",
               PCT, "queue_cpfa", ends, size=pct("queue_cpfa"), sign=-1, causes=(("*", _CPFA_LATE),)),
         Claim("trend.Q_ME", TREND, "Q_ME collects more with more robots", "Sec. VIII-A, Table II", PCT, "queue_qme",
-              ends, size=pct("queue_qme"), causes=(("*", _MOTION),)),
+              ends, size=pct("queue_qme"), causes=_on(_MOTION)),
         Claim("trend.Q_MT", TREND, "Q_MT collects more with more robots (202 -> 264 resources)",
-              "Sec. VIII-A, Table II", PCT, "queue_qmt", ends, size=pct("queue_qmt"), causes=(("*", _MOTION),)),
+              "Sec. VIII-A, Table II", PCT, "queue_qmt", ends, size=pct("queue_qmt"), causes=_on(_MOTION)),
     ]
 
 
