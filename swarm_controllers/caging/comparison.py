@@ -10,15 +10,15 @@ r = 0.3 m, M = 0.3 kg) is Table 1's step 0.5 row, case 1's rho = 8 row and case 
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from swarm_sim.compare.comparison import Comparison
-from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, md_table
-from swarm_sim.compare.stats import Stats, describe, pair_test, u_can_reject, values_of
+from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, md_table
+from swarm_sim.compare.stats import Stats, describe, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import level_marks
 
 STRATEGY = "caging"
 DURATION_S = 2400.0
@@ -141,16 +141,26 @@ def caging_tables_md(rows: Sequence[dict]) -> str:
 
 
 def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
+    """tables.md and the box plots by cell, the paper's numbers (Tables 1-2, sec. 5) drawn on them."""
+    from swarm_controllers.caging.claims import CAGING_CLAIMS  # lazy: the claims read this module's tables
+
     out.mkdir(parents=True, exist_ok=True)
     tables = out / "tables.md"
     tables.write_text(caging_tables_md(rows))
     cells = [c.number for c in CELLS]
     labels = {STRATEGY: "ours"}
+    marks = {m: level_marks(CAGING_CLAIMS, m) for m in ("search_time_s", "recruitment_time_s", "transport_time_s",
+                                                         "planned_path_m", "trajectory_error_m")}
+    text = "paper (Tables 1-2) and its ±25 % band"
     written = [tables]
     written.append(boxplot_figure(
         [("search_time_s", "search time [s]"), ("recruitment_time_s", "recruitment time [s]"),
          ("transport_time_s", "transport time [s]")], rows, cells, [STRATEGY], labels,
-        "cell (see tables.md)", "Stage times by cell", out / "times.png"))
+        "cell (see tables.md)", "Stage times by cell", out / "times.png", paper=marks, paper_text=text))
+    written.append(boxplot_figure(
+        [("planned_path_m", "planned path length [m]"), ("trajectory_error_m", "trajectory error [m]")], rows, cells,
+        [STRATEGY], labels, "cell (see tables.md)", "Path length and error by cell (Table 2)", out / "path.png",
+        paper=marks, paper_text=text))
     written.append(boxplot_figure(
         [("trajectory_error_pct", "trajectory error [% of the planned path]"),
          ("max_path_deviation_m", "largest deviation from the planned path [m]")], rows, cells, [STRATEGY], labels,

@@ -23,6 +23,7 @@ from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table, save_figure
 from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import level_marks
 from swarm_sim.scenario import load_scenario, scenario_to_dict
 
 DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
@@ -218,9 +219,12 @@ def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:
 
 
 def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: Sequence[str], key: str,
-                  path: Path, desired: dict[int, float] | None = None) -> Path:
+                  path: Path, desired: dict[int, float] | None = None,
+                  paper: tuple[str, dict] | None = None) -> Path:
     """One panel per condition: the mean of `key` over the seeds with a ±1 std band, one colour
-    per model, F_d dashed where given (Figs. 5-6, 10-17)."""
+    per model, F_d dashed where given (Figs. 5-6, 10-17); `paper`: (name, (strategy, cell) ->
+    (band low, value, band high)) of the paper's number at the run's end (M_T, F(T)), drawn as a
+    diamond with its band in the model's colour at the last time."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -237,6 +241,15 @@ def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: S
                 ax.fill_between(t / 60.0, mean - std, mean + std, color=f"C{j}", alpha=0.2)
         if desired and cell in desired:
             ax.axhline(desired[cell], color="black", linestyle="--", linewidth=1, label="F_d")
+        end = max((t for r in rows if r.get("cell") == cell for t, _ in (r.get(key) or [])[-1:]), default=None)
+        for j, s in enumerate(strategies):
+            mark = paper[1].get((s, cell)) if paper and end is not None else None
+            if mark:
+                lo, value, hi = mark
+                x = end / 60.0 + 0.4 * j  # the models side by side at the end
+                ax.plot([x] * 2, [lo, hi], color=f"C{j}", lw=1.5, alpha=0.8)
+                ax.plot([x], [value], marker="D", markersize=6, color=f"C{j}", markeredgecolor="black",
+                        ls="none", label=f"paper {paper[0]} ({DRTM_LABELS.get(s, s)}) ±25 %")
         ax.set(title=f"Sec. {c.section}: {c.what.split(' (')[0]}", xlabel="time [min]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize="small")
@@ -256,10 +269,14 @@ def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int]
     written[0].write_text(drtm_table_md(rows, conditions, strategies))
     written[1].write_text(drtm_ttests_md(rows, conditions))
     desired = {c: NestConfig.of(load_scenario(DRTM_CONDITIONS[c].scenario)).desired_food for c in conditions}
+    from swarm_controllers.drtm.claims import DRTM_CLAIMS  # lazy: the claims read this module's numbers
+
+    paper = {"nest_food_series": ("F(T)", level_marks(DRTM_CLAIMS, "nest_food_final")),
+             "oae_series": ("M_T", level_marks(DRTM_CLAIMS, "oae_total"))}
     for name, key in (("food.png", "nest_food_series"), ("oae.png", "oae_series"),
                       ("active.png", "active_robots_series")):
         written.append(series_figure(rows, conditions, strategies, key, out / name,
-                                     desired if key == "nest_food_series" else None))
+                                     desired if key == "nest_food_series" else None, paper.get(key)))
     return written
 
 

@@ -23,6 +23,7 @@ from swarm_sim.compare.stats import (
     values_of,
 )
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import relation_marks
 
 SPIRAL_STRATEGIES: tuple[str, ...] = ("ddsa", "mdbsa_c", "mdbsa_d")
 SPIRAL_LABELS: dict[str, str] = {"ddsa": "DDSA", "mdbsa_c": "MDBSA-C", "mdbsa_d": "MDBSA-D"}
@@ -274,9 +275,13 @@ def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells:
     xlabel = f"number of {exp.vary}"
     panels = [(m, SPIRAL_METRICS[m]) for m in ("resources_per_robot", "collision_time_per_robot_s")]
     fig = {1: "Fig. 6", 2: "Fig. 8", 3: "Fig. 10"}[experiment]
+    from swarm_controllers.spiral.claims import SPIRAL_CLAIMS  # lazy: the claims are this module's neighbours
+
+    paper = {m: relation_marks(SPIRAL_CLAIMS[experiment], m, rows) for m, _ in panels}
     written.append(boxplot_figure(panels, rows, cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment} (cf. MDBSA paper {fig})",
-                                  out / "resources_collision.png", notch=True))
+                                  out / "resources_collision.png", notch=True, paper=paper,
+                                  paper_text="paper: our A's mean x (1 + its stated difference), band"))
     written.append(boxplot_figure([("foraging_rate_per_min", SPIRAL_METRICS["foraging_rate_per_min"])], rows,
                                   cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment}: whole-run foraging rate",

@@ -468,3 +468,36 @@ def counts(verdicts: Iterable[Verdict]) -> dict[str, int]:
     for v in verdicts:
         out[v.verdict] += 1
     return out
+
+
+def level_marks(claims: Iterable[Claim], measure: str) -> dict[tuple[str, object], tuple[float, float, float]]:
+    """(strategy, cell) -> (band low, the paper's value, band high) of every one-cell level of
+    `measure`: what a comparison figure draws as the paper's (`swarm_sim.compare.report.paper_marks`)."""
+    out = {}
+    for c in claims:
+        if c.kind == LEVEL and c.measure == measure and not c.pooled and c.value is not None:
+            lo, hi = c.limits()
+            for cell in c.cells:
+                out[(c.a, cell)] = (lo, c.value, hi)
+    return out
+
+
+def relation_marks(claims: Iterable[Claim], measure: str, rows: Sequence[dict]
+                   ) -> dict[tuple[str, object], tuple[float, float, float]]:
+    """(B, cell) -> B's level the paper's stated difference implies from our A's mean in that cell
+    (band low, centre, band high), for every relation of `measure` that states a size (the first
+    claim about a box wins)."""
+    out = {}
+    for c in claims:
+        if c.kind != RELATION or c.measure != measure or not (c.stated or c.sign == 0):
+            continue
+        for cell in c.cells:
+            a = values(rows, c.a, cell, c.measure, c.scale)
+            if not a:
+                continue
+            lo, hi = c.limits(cell)
+            centre = dict(c.sizes).get(cell, c.size)
+            centre = (lo + hi) / 2 if centre is None else centre
+            base = float(np.mean(a))
+            out.setdefault((c.b, cell), tuple(base * (1 + x / 100.0) for x in (lo, centre, hi)))
+    return out
