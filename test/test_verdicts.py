@@ -223,3 +223,20 @@ def test_the_report_counts_every_claim_once_and_renders_the_reference_column(tmp
     dup = [*sweeps, SimpleNamespace(comparison=comparison, claims=(LEVEL_100,), rows=data, extra={})]
     with pytest.raises(ValueError, match="repeat"):
         report_verdicts({"authors": dup}, tmp_path, {"authors": "authors' robots"})
+
+
+def test_the_readme_states_the_reports_counts():
+    """README's claim counts are REPORT.md's (both committed; `swarm-compare all --report-only`)."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    report = (root / "results" / "REPORT.md").read_text()
+    readme = (root / "README.md").read_text()
+    found = re.findall(r"^\| \*\*all\*\* \| ([^|]+) \| \*\*(\d+)\*\* \| \*\*(\d+)\*\* \| \*\*(\d+)\*\* \| \*\*(\d+)\*\* "
+                       r"\| \*\*(\d+)\*\* \|", report, re.M)
+    assert len(found) == 2
+    for model, holds, direction, not_shown, contradicts, na in found:
+        text = (f"**{holds} hold**, {direction} direction only, {not_shown} not shown, {contradicts} contradict, "
+                f"{na} n/a")
+        assert text in " ".join(readme.split()), (model, text)

@@ -11,61 +11,26 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
+from swarm_controllers.caging.claims import (
+    CAGING_CLAIMS,
+    CELLS,
+    PAPER_NORMALISED_ERROR_PCT,
+    PAPER_TABLE1,
+    PAPER_TABLE2,
+    STRATEGY,
+)
 from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, md_table
 from swarm_sim.compare.stats import Stats, describe, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 from swarm_sim.compare.verdicts import level_marks
 
-STRATEGY = "caging"
 DURATION_S = 2400.0
 """Sim seconds a run may last: the transport follows the recruiter's whole random walk reversed,
 so a long search means a long transport (our longest runs end after ~1400 s). Runs end as soon as
 every robot is done (``sim.stop_when_finished``)."""
-
-
-@dataclass(frozen=True)
-class Cell:
-    number: int
-    step: float
-    """Landmark grid step [m]."""
-    robots: int
-    radius: float
-    """r [m]."""
-    mass: float
-    """M [kg]."""
-
-    @property
-    def overrides(self) -> tuple[str, ...]:
-        return (f"transport.landmarks.step={self.step}", f"robots.count={self.robots}",
-                f"transport.object.radius={self.radius}", f"transport.object.mass={self.mass}")
-
-    @property
-    def name(self) -> str:
-        return f"step {self.step:g} m, rho {self.robots}, r {self.radius:g} m, M {self.mass:g} kg"
-
-
-CELLS: tuple[Cell, ...] = (
-    Cell(0, 0.5, 8, 0.3, 0.3), Cell(1, 1.0, 8, 0.3, 0.3), Cell(2, 0.5, 6, 0.3, 0.3),
-    Cell(3, 0.5, 7, 0.3, 0.3), Cell(4, 0.5, 8, 0.4, 0.7), Cell(5, 0.5, 8, 0.45, 1.0),
-)
-
-PAPER_TABLE1: dict[tuple[str, float], float] = {
-    ("search_time_s", 0.5): 222.165, ("search_time_s", 1.0): 197.535,
-    ("recruitment_time_s", 0.5): 164.481, ("recruitment_time_s", 1.0): 164.481,
-}
-"""THE PAPER'S Table 1: mean time [s] by stage and landmark step (rho not stated)."""
-PAPER_TABLE2: dict[int, tuple[float, float, float]] = {
-    2: (4.3284, 0.1778, 215.07), 3: (4.7426, 0.1894, 239.35), 0: (3.9142, 0.1526, 244.79),
-    4: (4.3284, 0.1686, 282.47), 5: (4.7426, 0.1474, 258.62),
-}
-"""THE PAPER'S Table 2 by our cell: (path length [m], error [m], time [s]). The paper's rho = 8
-row of case 1 and its (0.3, 0.3) row of case 2 are the same run."""
-PAPER_NORMALISED_ERROR_PCT = 3.8
-"""Sec. 5: "For all cases, the average error in the trajectory is around 3.8%"."""
 
 TABLE2_METRICS: dict[str, str] = {
     "planned_path_m": "planned path [m]",
@@ -142,7 +107,6 @@ def caging_tables_md(rows: Sequence[dict]) -> str:
 
 def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
     """tables.md and the box plots by cell, the paper's numbers (Tables 1-2, sec. 5) drawn on them."""
-    from swarm_controllers.caging.claims import CAGING_CLAIMS  # lazy: the claims read this module's tables
 
     out.mkdir(parents=True, exist_ok=True)
     tables = out / "tables.md"
@@ -184,8 +148,6 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
 
 
 def _claims(args: argparse.Namespace) -> tuple:
-    from swarm_controllers.caging.claims import CAGING_CLAIMS  # lazy: the claims read this module's tables
-
     return CAGING_CLAIMS
 
 

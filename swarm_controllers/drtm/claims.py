@@ -12,8 +12,79 @@ falls (46.30 -> 40.11) while M_T rises; M_T's rise is not stated either.
 
 from __future__ import annotations
 
-from swarm_controllers.drtm.comparison import DRTM_CONDITIONS, DRTM_LABELS, DRTM_METRICS, PAPER, PAPER_TTESTS
+from dataclasses import dataclass
+
 from swarm_sim.compare.verdicts import LEVEL, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
+
+DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
+DRTM_LABELS: dict[str, str] = {"drtm": "DRTM", "artm": "ARTM"}
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One experiment of the paper: its section, the scenario that holds it, its figures."""
+
+    section: str
+    scenario: str
+    what: str
+    figures: str
+    table4: str = ""
+    """Its row label in the paper's Table 4 (which numbers Sec. 4's subsections 5.1-5.4)."""
+
+
+DRTM_CONDITIONS: tuple[Condition, ...] = (
+    Condition("3.1", "drtm", "N_f = 20, E_a = 10, N_r = 20, L = 4 m (comparison)", "Figs. 5-6"),
+    Condition("4.1", "drtm_nf25", "N_f = 25", "Figs. 10-11", "5.1"),
+    Condition("4.2", "drtm_ea20", "E_a = 20", "Figs. 12-13", "5.2"),
+    Condition("4.3", "drtm_nr30", "N_r = 30", "Figs. 14-15", "5.3"),
+    Condition("4.4", "drtm_l3", "L = 3 m, d = 1 m", "Figs. 16-17", "5.4"),
+)
+"""The cells of the sweep, in order (cell = index)."""
+
+DRTM_METRICS: dict[str, tuple[str, str, float]] = {
+    "food_deviation": ("V_f", "average deviation of food [tokens]", 1.0),
+    "energy_efficiency": ("E_e", "energy efficiency [%]", 100.0),
+    "oae_total": ("M_T", "obstacle-avoidance events, total", 1.0),
+    "oae_per_robot": ("M_v", "obstacle-avoidance events per robot", 1.0),
+    "food_collected": ("F_t", "food tokens collected", 1.0),
+    "nest_food_final": ("F(T)", "net food in the nest at the end [tokens]", 1.0),
+}
+"""JSON field -> (the paper's symbol, meaning, factor to the paper's unit)."""
+
+PAPER: dict[str, dict[str, dict[str, float]]] = {
+    "3.1": {"drtm": {"food_deviation": 2.55, "energy_efficiency": 11.99, "oae_total": 925.96, "oae_per_robot": 46.30,
+                     "food_collected": 173.76, "nest_food_final": 20.84},
+            "artm": {"food_deviation": 4.74, "energy_efficiency": 9.99, "oae_total": 1148.44, "oae_per_robot": 57.42,
+                     "food_collected": 183.46, "nest_food_final": 18.34}},
+    "4.1": {"drtm": {"food_deviation": 2.90, "energy_efficiency": 13.31, "oae_total": 760.22, "oae_per_robot": 38.01,
+                     "food_collected": 156.90, "nest_food_final": 20.88},
+            "artm": {"food_deviation": 2.92, "energy_efficiency": 11.06, "oae_total": 1053.20, "oae_per_robot": 52.66,
+                     "food_collected": 150.44, "nest_food_final": 16.63}},
+    "4.2": {"drtm": {"food_deviation": 3.06, "energy_efficiency": 10.78, "oae_total": 912.06, "oae_per_robot": 45.60,
+                     "food_collected": 189.14, "nest_food_final": 20.39},
+            "artm": {"food_deviation": 5.18, "energy_efficiency": 8.45, "oae_total": 1152.26, "oae_per_robot": 57.61,
+                     "food_collected": 189.32, "nest_food_final": 15.99}},
+    "4.3": {"drtm": {"food_deviation": 3.17, "energy_efficiency": 8.72, "oae_total": 1203.32, "oae_per_robot": 40.11,
+                     "food_collected": 229.44, "nest_food_final": 19.99},
+            "artm": {"food_deviation": 4.94, "energy_efficiency": 6.67, "oae_total": 1612.26, "oae_per_robot": 53.74,
+                     "food_collected": 236.40, "nest_food_final": 15.77}},
+    "4.4": {"drtm": {"food_deviation": 2.35, "energy_efficiency": 10.74, "oae_total": 1423.08, "oae_per_robot": 71.15,
+                     "food_collected": 165.32, "nest_food_final": 17.75},
+            "artm": {"food_deviation": 4.61, "energy_efficiency": 8.91, "oae_total": 1882.32, "oae_per_robot": 94.12,
+                     "food_collected": 170.90, "nest_food_final": 15.22}},
+}
+"""THE PAPER'S numbers, not ours: means over 50 ARGoS runs of 20 min (Secs. 3.1 and 4.1-4.4;
+E_e in %). Every E_e it gives equals F(T) / F_t."""
+
+PAPER_TTESTS: dict[str, dict[str, tuple[float, float]]] = {
+    "3.1": {"food_collected": (3.1918, 0.0019), "oae_total": (2.2899, 0.0242)},
+    "4.1": {"food_collected": (4.9663, 2.89e-6), "oae_total": (2.7761, 6.59e-3)},
+    "4.2": {"food_collected": (3.2744, 1.46e-3), "oae_total": (2.3803, 0.0192)},
+    "4.3": {"food_collected": (4.7869, 6.00e-6), "oae_total": (3.9267, 1.60e-4)},
+    "4.4": {"food_collected": (2.1899, 0.0310), "oae_total": (2.6984, 8.21e-3)},
+}
+"""THE PAPER'S Tables 2 and 4: (t, two-tailed p) of DRTM vs ARTM, 50 runs each (98 d.o.f.), all
+reported significant; the paper gives no sign convention and every t is positive."""
 
 _BODY = Cause(PARTIAL, "the foot-bot's 0.17 m body: with the e-puck's 0.07 m body DRTM's OAEs fall below ARTM's "
                        "at 3.1 and DRTM keeps F closer to F_d at 4.3-4.4 (factor `body_0.07`, drtm31 / drtm43, "

@@ -12,8 +12,25 @@ stable times (no two-sample test compares growths).
 
 from __future__ import annotations
 
-from swarm_controllers.queue.comparison import PAPER_TABLE_II, QUEUE_LABELS, QUEUE_SIZES, QUEUE_STRATEGIES
 from swarm_sim.compare.verdicts import LEVEL, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
+
+QUEUE_STRATEGIES: tuple[str, ...] = ("queue_cpfa", "queue_qse", "queue_qst", "queue_qme", "queue_qmt")
+"""Scenario names of the queue paper's five strategies, in the paper's Table II row order."""
+QUEUE_LABELS: dict[str, str] = {
+    "queue_cpfa": "CPFA", "queue_qse": "Q_SE", "queue_qst": "Q_ST", "queue_qme": "Q_ME", "queue_qmt": "Q_MT",
+}
+QUEUE_SIZES: tuple[int, ...] = (48, 64, 80, 96, 112)
+"""The paper's swarm sizes (Table I)."""
+
+PAPER_TABLE_II: dict[str, dict[int, float]] = {
+    "queue_cpfa": {48: 15.17, 64: 13.33, 80: 12.17, 96: 11.47, 112: 11.39},
+    "queue_qse": {48: 17.39, 64: 18.09, 80: 17.36, 96: 16.63, 112: 18.06},
+    "queue_qst": {48: 37.98, 64: 38.88, 80: 42.45, 96: 37.44, 112: 34.60},
+    "queue_qme": {48: 46.61, 64: 54.29, 80: 59.19, 96: 61.42, 112: 64.22},
+    "queue_qmt": {48: 62.94, 64: 71.93, 80: 76.39, 96: 82.31, 112: 82.39},
+}
+"""THE PAPER'S numbers, not ours: queue paper Table II, "Resource Collection (%)", mean over 50
+ARGoS runs of 18 min, 12 x 12 m arena, 320 resources in five 8 x 8 clusters."""
 
 PCT, COLLISION, DROPOFF = "resources_collected_pct", "collision_time_per_robot_s", "dropoff_time_mean_s"
 TEXT_COUNTS = {("queue_cpfa", 48): "text: 49 of 320 (15.3 %)", ("queue_cpfa", 112): "text: 37 of 320 (11.6 %)",

@@ -8,6 +8,13 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
+from swarm_controllers.queue.claims import (
+    PAPER_TABLE_II,
+    QUEUE_CLAIMS,
+    QUEUE_LABELS,
+    QUEUE_SIZES,
+    QUEUE_STRATEGIES,
+)
 from swarm_sim.cli import scenario_fields
 from swarm_sim.compare.comparison import Comparison, Rule
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, label, md_table
@@ -15,23 +22,6 @@ from swarm_sim.compare.stats import all_pairs, cells_of, describe, ordering, pai
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
 from swarm_sim.compare.verdicts import level_marks
 
-QUEUE_STRATEGIES: tuple[str, ...] = ("queue_cpfa", "queue_qse", "queue_qst", "queue_qme", "queue_qmt")
-"""Scenario names of the queue paper's five strategies, in the paper's Table II row order."""
-QUEUE_LABELS: dict[str, str] = {
-    "queue_cpfa": "CPFA", "queue_qse": "Q_SE", "queue_qst": "Q_ST", "queue_qme": "Q_ME", "queue_qmt": "Q_MT",
-}
-QUEUE_SIZES: tuple[int, ...] = (48, 64, 80, 96, 112)
-"""The paper's swarm sizes (Table I)."""
-
-PAPER_TABLE_II: dict[str, dict[int, float]] = {
-    "queue_cpfa": {48: 15.17, 64: 13.33, 80: 12.17, 96: 11.47, 112: 11.39},
-    "queue_qse": {48: 17.39, 64: 18.09, 80: 17.36, 96: 16.63, 112: 18.06},
-    "queue_qst": {48: 37.98, 64: 38.88, 80: 42.45, 96: 37.44, 112: 34.60},
-    "queue_qme": {48: 46.61, 64: 54.29, 80: 59.19, 96: 61.42, 112: 64.22},
-    "queue_qmt": {48: 62.94, 64: 71.93, 80: 76.39, 96: 82.31, 112: 82.39},
-}
-"""THE PAPER'S numbers, not ours: queue paper Table II, "Resource Collection (%)", mean over 50
-ARGoS runs of 18 min, 12 x 12 m arena, 320 resources in five 8 x 8 clusters."""
 PAPER_QUEUE_QUOTES = (
     "Given a total of 320 available resources, the average number of collected resources "
     "decreases from 49 with 48 robots to 37 with 112 robots. [CPFA]",
@@ -233,7 +223,6 @@ def write_queue_report(rows: Sequence[dict], out: Path, sizes: Sequence[int] | N
     written = [out / "table.md", out / "ttests.md"]
     written[0].write_text(queue_table_md(rows, sizes, strategies))
     written[1].write_text(queue_ttests_md(rows, sizes, strategies))
-    from swarm_controllers.queue.claims import QUEUE_CLAIMS  # lazy: the claims read this module's Table II
 
     paper = {"resources_collected_pct": level_marks(QUEUE_CLAIMS, "resources_collected_pct")}
     for name, metric, fig in (("collected.png", "resources_collected_pct", "Fig. 8; paper: Table II"),
@@ -260,8 +249,6 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
 
 
 def _claims(args: argparse.Namespace) -> tuple:
-    from swarm_controllers.queue.claims import QUEUE_CLAIMS  # lazy: the claims read this module's Table II
-
     return QUEUE_CLAIMS
 
 

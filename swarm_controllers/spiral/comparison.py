@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from swarm_controllers.spiral.claims import SPIRAL_CLAIMS
 from swarm_sim.compare.comparison import Comparison, Rule
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table, save_figure
 from swarm_sim.compare.stats import (
@@ -219,8 +220,6 @@ def per_minute_figure(rows: Sequence[dict], experiment: int, cells: Sequence[int
 
 def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence[int],
                           strategies: Sequence[str]) -> str:
-    from swarm_controllers.spiral.claims import SPIRAL_CLAIMS  # lazy: the claims are this module's neighbours
-
     exp = SPIRAL_EXPERIMENTS[experiment]
     claims = [c for c in SPIRAL_CLAIMS[experiment] if c.b]
     pairs = [(a, b) for a, b in SPIRAL_PAIRS if a in strategies and b in strategies]
@@ -275,8 +274,6 @@ def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells:
     xlabel = f"number of {exp.vary}"
     panels = [(m, SPIRAL_METRICS[m]) for m in ("resources_per_robot", "collision_time_per_robot_s")]
     fig = {1: "Fig. 6", 2: "Fig. 8", 3: "Fig. 10"}[experiment]
-    from swarm_controllers.spiral.claims import SPIRAL_CLAIMS  # lazy: the claims are this module's neighbours
-
     paper = {m: relation_marks(SPIRAL_CLAIMS[experiment], m, rows) for m, _ in panels}
     written.append(boxplot_figure(panels, rows, cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment} (cf. MDBSA paper {fig})",
@@ -316,8 +313,6 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
 
 
 def _claims(args: argparse.Namespace) -> tuple:
-    from swarm_controllers.spiral.claims import SPIRAL_CLAIMS  # lazy: the claims are this module's neighbours
-
     return SPIRAL_CLAIMS[args.experiment]
 
 

@@ -108,6 +108,8 @@ def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[s
             if len(set(ids)) != len(ids):
                 raise ValueError(f"{name}: claim ids repeat: {sorted({i for i in ids if ids.count(i) > 1})}")
             rows = {c.id: r.rows for r in mine for c in r.claims}
+            if not claims:  # a comparison that declares none has nothing to judge
+                continue
             verdicts = evaluate(claims, rows)
             reference = _reference(out, name)
             against = {}
@@ -179,6 +181,12 @@ def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps:
              "its 95 % interval (n runs); `ratio`: ours / paper.", ""]
     for name, per in papers.items():
         lines += [f"### {name}: {helps.get(name, '')}", ""]
+        for m in models:
+            cells = [cv for v in per.get(m, ([], {}))[0] if v.claim.kind == LEVEL for cv in v.cells]
+            lines.append(f"- {title[m]}: mean within the band in {sum(cv.reason == 'inside' for cv in cells)} of "
+                         f"{len(cells)} cells, holding (the interval within) in "
+                         f"{sum(cv.verdict == HOLDS for cv in cells)}.")
+        lines.append("")
         ref = any(per[m][1] for m in models if m in per)
         header = ["claim", "where", "paper"]
         for m in models:

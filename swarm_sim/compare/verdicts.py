@@ -29,7 +29,7 @@ level's value or of a relation's stated size; the paper's stated range for a rel
 The test is one for every claim: Welch's two-sample t-test, two-sided (for a level: the one-sample
 t-test of our runs against the band's edges). Welch because every claim is about means (the papers
 print means, and the sizes are ratios of means), it does not assume the equal spreads our
-strategies do not have (a jammed CPFA and a flowing Q_MT), and its power has a closed form; a rank
+strategies do not have (a jammed baseline beside a flowing one), and its power has a closed form; a rank
 test would judge a different quantity (stochastic order) from the size it is paired with. All the
 p-values of one paper on one robot model are corrected together with Holm's step-down method
 (`holm`). Every effect comes with a 95 % interval: a level's from the t distribution, a relation's
