@@ -115,11 +115,11 @@ def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], 
             strategies = list(comparison.strategies)
             report = SweepReport(comparison, tuple(options), comparison.out_dir(sub), 0)
             try:
+                report.claims = tuple(comparison.claims(sub))  # first: a failed sweep's claims read n/a
                 report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
                                                                executor=ex)
                 report.rows, report.extra = _rows(report.out, comparison, sub, strategies)
                 report.runs = len(report.rows)
-                report.claims = tuple(comparison.claims(sub))
             except KeyboardInterrupt:
                 raise
             except Exception as exc:  # one paper's broken report must not lose the others
