@@ -145,8 +145,9 @@ def report_verdicts(by_model: Mapping[str, Sequence[Any]], out: Path, titles: Ma
              "contradicts when it lies wholly outside. The band: the paper's stated range, else "
              f"±{LEVEL_BAND:.0%} of its number. One test everywhere: Welch's t, two-sided (one-sample against a "
              "level's band), every p-value of a paper on a robot model Holm-corrected together; effects with 95 % "
-             f"intervals (a level's from t, a relation's by a seeded bootstrap of {BOOTSTRAP} resamples). A claim "
-             "over several cells takes its worst cell.", ""]
+             f"intervals (a level's from t, a relation's by a seeded bootstrap of {BOOTSTRAP} resamples). The "
+             "intervals shown are the plain 95 % ones; the verdicts use the Holm-corrected p, so an interval just "
+             "clear of a band can still read *not shown*. A claim over several cells takes its worst cell.", ""]
     header = ["paper", "robot model", *VERDICTS, "claims"]
     body, totals = [], {m: dict.fromkeys(VERDICTS, 0) for m in models}
     for name, per in papers.items():
