@@ -19,7 +19,6 @@ from swarm_controllers.queue.comparison import (
     write_queue_report,
 )
 from swarm_controllers.spiral.comparison import (
-    PAPER_SPIRAL_CLAIMS,
     SPIRAL_EXPERIMENTS,
     SPIRAL_STRATEGIES,
     resource_layout,
@@ -190,7 +189,7 @@ def test_spiral_report_shows_region_free_ddsa_in_every_cell_and_the_papers_claim
     tables = (tmp_path / "tables.md").read_text()
     assert tables.count("2.02 ± 0.17 (median 2.05, n=4)") == 3 * 4  # DDSA, 3 cells, 4 metrics
     mw = (tmp_path / "mannwhitney.md").read_text()
-    assert "≈ +101 % (average)" in mw and "On average, MDBSA_{Distributed} collected around 101%" in mw
+    assert "+101.0 %" in mw and "On average, MDBSA_{Distributed} collected around 101%" in mw
     # MDBSA-D has twice DDSA's mean: +100 % in every cell; U = 16 (all of B above A) for n=4+4.
     assert "| 16 | DDSA | MDBSA-D | 2.05 | 4.10 | +100.0 % | 0.0 |" in mw
     assert "16: +100.0 %" in mw
@@ -209,11 +208,13 @@ def test_mann_whitney_marks_separated_groups_and_uses_dash_for_negligible():
 
 
 def test_claims_cover_the_cells_they_name():
-    by = {(c.experiment, c.metric, c.a, c.b, c.paper): c for c in PAPER_SPIRAL_CLAIMS}
-    c64 = by[(1, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −25 %")]
-    assert c64.covers(64) and not c64.covers(16)
-    c44 = by[(2, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −44 %")]
-    assert not c44.covers(8) and c44.covers(14) and c44.covers(32)
+    from swarm_controllers.spiral.claims import SPIRAL_CLAIMS
+
+    by = {c.id: c for claims in SPIRAL_CLAIMS.values() for c in claims}
+    assert by["exp1.C<DDSA.64"].cells == (64,) and by["exp1.C~DDSA"].cells == (4, 16)
+    assert 8 not in by["exp2.C<DDSA"].cells and {14, 32} <= set(by["exp2.C<DDSA"].cells)
+    assert by["exp2.C<DDSA"].limits() == (-44.0, -24.0)  # Figs. 8 and 9 state both sizes: one claim
+    assert len(by) == sum(len(c) for c in SPIRAL_CLAIMS.values())  # ids unique over the experiments
 
 
 # --------------------------------------------------------------------------- plans
@@ -445,9 +446,9 @@ def test_all_runs_every_comparison_and_writes_one_report(tmp_path):
         assert (tmp_path / sub).exists(), sub
     assert seen == [(tmp_path / "toy", 2)]
     report = (tmp_path / "REPORT.md").read_text()
-    assert "Rehearsal" in report and "## Headline claims" in report
-    assert "| queue | Q_MT collects the most resources of all strategies |" in report
-    assert "| spiral --experiment 2 |" in report and "| toy | (no headline claims declared) |" in report
+    assert "Rehearsal" in report and "## Verdicts" in report
+    assert "| queue | generic robot |" in report and "`order.Q_ME<Q_MT`: Q_MT collects more than Q_ME" in report
+    assert "`exp2.D>DDSA`" in report and "| toy |" not in report.split("## Levels")[0]  # the toy declares none
     assert "### Resource collection [%] (Table II layout)" in report  # the tables file, nested
     assert "![collected](queue/collected.png)" in report and "#### Toy tables" not in report
     assert "### Toy tables" in report
@@ -469,10 +470,11 @@ def test_all_without_a_robot_model_runs_both_and_puts_the_claims_side_by_side(tm
     for model in ("authors", "generic"):
         assert (tmp_path / model / "queue" / "table.md").exists()
     report = (tmp_path / "REPORT.md").read_text()
-    assert "| # | sweep | claim | paper | ours (authors' robots) | holds (authors' robots) | ours (generic robot) |" in report
-    row = next(line for line in report.splitlines() if "| Q_MT collects the most resources of all strategies |" in line)
-    assert row.startswith("| 1 | queue |") and row.count("|") == 9
+    assert "| queue | authors' robots |" in report and "| queue | generic robot |" in report
+    row = next(line for line in report.splitlines() if line.startswith("| `T2.Q_MT.48`"))
+    assert row.count("|") == 12  # claim, where, paper, then ours, n, ratio, verdict per model
     assert "authors' robots: " in report and "generic robot: " in report and "claims hold" in report
+    assert "`controller.queue.join_order`" in report  # text vs the authors' code
     assert "## Why claims do not hold" in report and "measured: the motion rule" in report
     assert "![collected](authors/queue/collected.png)" in report and "![collected](generic/queue/collected.png)" in report
     again = FakeRunner()  # the report alone, from what the results hold: nothing runs
@@ -482,29 +484,24 @@ def test_all_without_a_robot_model_runs_both_and_puts_the_claims_side_by_side(tm
     assert "(n=2)" in (tmp_path / "authors" / "queue" / "table.md").read_text()  # both seeds held, though --seeds 1
 
 
-def test_headlines_follow_the_means_and_the_tests():
-    rows = (rows_for("queue_qse", 48, [10, 11, 12]) + rows_for("queue_qst", 48, [20, 21, 22])
-            + rows_for("queue_qme", 48, [30, 31, 32]) + rows_for("queue_qmt", 48, [60, 61, 62])
-            + rows_for("queue_cpfa", 48, [40, 41, 42]))
-    from swarm_controllers.queue.comparison import queue_headlines
-    from swarm_controllers.spiral.comparison import spiral_headlines
+def test_the_queue_claims_follow_table_ii_and_the_tests():
+    from swarm_controllers.queue.claims import QUEUE_CLAIMS
+    from swarm_sim.compare.verdicts import CONTRADICTS, HOLDS, LEVEL, NA, evaluate
 
-    found = {h.claim: h for h in queue_headlines(rows, [48], QUEUE_STRATEGIES)}
-    assert found["Q_MT collects the most resources of all strategies"].holds is True
-    assert found["collection Q_SE < Q_ST < Q_ME < Q_MT"].holds is True
-    assert found["CPFA collects less with more robots"].holds is None  # one size cannot tell
-    assert found["CPFA has the highest collision time"].holds is False  # Q_MT's values are higher
-    spiral = (rows_for("ddsa", None, [10, 11, 12, 10, 11], SPIRAL_KEYS)
-              + rows_for("mdbsa_c", 4, [10, 12, 11, 10, 12], SPIRAL_KEYS)
-              + rows_for("mdbsa_d", 4, [20, 21, 22, 23, 24], SPIRAL_KEYS))
-    claims = spiral_headlines(spiral, 1, [4], SPIRAL_STRATEGIES)
-    similar = next(h for h in claims if h.paper.startswith("similar"))
-    above = next(h for h in claims if h.paper.startswith("≈ +101"))
-    assert similar.holds is True and above.holds is True and "4: +" in above.ours
+    assert len([c for c in QUEUE_CLAIMS if c.kind == LEVEL]) == 25 and len({c.id for c in QUEUE_CLAIMS}) == len(QUEUE_CLAIMS)
+    rng = np.random.default_rng(1)
+    means = {"queue_cpfa": 15.0, "queue_qse": 17.0, "queue_qst": 38.0, "queue_qme": 47.0, "queue_qmt": 63.0}
+    rows = [r for s, m in means.items() for r in rows_for(s, 48, rng.normal(m, 0.5, 10))]
+    found = {v.claim.id: v for v in evaluate(QUEUE_CLAIMS, rows)}
+    assert found["T2.Q_MT.48"].verdict == HOLDS and found["T2.Q_MT.64"].verdict == NA  # no runs at 64
+    assert found["order.Q_SE<Q_ST"].cells[0].verdict == HOLDS  # +124 % against Table II's +118 %
+    rows = [r for r in rows if r["strategy"] != "queue_cpfa"] + rows_for("queue_cpfa", 48, rng.normal(60, 0.5, 10))
+    found = {v.claim.id: v for v in evaluate(QUEUE_CLAIMS, rows)}
+    assert found["order.CPFA<Q_SE"].verdict == CONTRADICTS and found["T2.CPFA.48"].verdict == CONTRADICTS
 
 
 def test_table_ii_ordering_checked_pair_by_pair():
-    from swarm_controllers.queue.comparison import ordering_checks, queue_headlines
+    from swarm_controllers.queue.comparison import ordering_checks
 
     rng = np.random.default_rng(5)
     means = {"queue_cpfa": 60.0, "queue_qse": 17.0, "queue_qst": 34.0, "queue_qme": 50.0, "queue_qmt": 70.0}
@@ -514,9 +511,6 @@ def test_table_ii_ordering_checked_pair_by_pair():
     assert checks["Q_SE < Q_ST"][0][1].startswith("holds") and checks["Q_SE < Q_ST"][0][2] is True
     ratio = checks["Q_ST = 2 Q_SE (Table II: x1.9-2.4)"][0]
     assert ratio[2] is True and ratio[1].startswith("holds: x")
-    lines = {h.claim: h for h in queue_headlines(rows, [48], list(means))}
-    assert lines["collection Q_ME < Q_MT"].holds is True
-    assert lines["collection CPFA < Q_ME"].holds is False
 
 
 def test_a_t_test_between_groups_that_do_not_vary_is_not_applicable():
@@ -560,20 +554,6 @@ def test_factor_tables_put_each_factor_beside_the_baseline(tmp_path):
     assert factors_main([str(tmp_path)]) == 0
     assert "| baseline | 32.00 ± 2.83 (2) |" in (tmp_path / "FACTORS.md").read_text()  # compared on common seeds
     assert factors_main([str(tmp_path / "nothing")]) == 2
-
-
-def test_a_rank_test_that_cannot_reach_significance_tells_nothing():
-    """Two-sided Mann-Whitney U on 3 runs against 3 cannot give p < 0.05 (its smallest p is 0.1), so
-    a spiral claim of a difference is not "no" and one of similarity is not "yes" at 3 seeds."""
-    from swarm_controllers.spiral.comparison import spiral_headlines
-    from swarm_sim.compare.stats import u_can_reject
-
-    assert not u_can_reject(3, 3) and u_can_reject(4, 4) and not u_can_reject(0, 9) and u_can_reject(3, 6)
-    assert pair_test([1.0, 2.0, 3.0], [7.0, 8.0, 9.0], "u")[1] == pytest.approx(0.1)
-    few = (rows_for("ddsa", None, [10, 11, 12], SPIRAL_KEYS) + rows_for("mdbsa_c", 4, [10, 12, 11], SPIRAL_KEYS)
-           + rows_for("mdbsa_d", 4, [20, 21, 22], SPIRAL_KEYS))
-    claims = spiral_headlines(few, 1, [4], SPIRAL_STRATEGIES)
-    assert {h.holds for h in claims if "4:" in h.ours} == {None}
 
 
 def test_every_comparison_figure_says_which_robot_ran(tmp_path):

@@ -10,62 +10,27 @@ r = 0.3 m, M = 0.3 kg) is Table 1's step 0.5 row, case 1's rho = 8 row and case 
 from __future__ import annotations
 
 import argparse
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
-from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, md_table
-from swarm_sim.compare.stats import Stats, describe, pair_test, u_can_reject, values_of
+from swarm_controllers.caging.claims import (
+    CAGING_CLAIMS,
+    CELLS,
+    PAPER_NORMALISED_ERROR_PCT,
+    PAPER_TABLE1,
+    PAPER_TABLE2,
+    STRATEGY,
+)
+from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, md_table
+from swarm_sim.compare.stats import Stats, describe, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import level_marks
 
-STRATEGY = "caging"
 DURATION_S = 2400.0
 """Sim seconds a run may last: the transport follows the recruiter's whole random walk reversed,
 so a long search means a long transport (our longest runs end after ~1400 s). Runs end as soon as
 every robot is done (``sim.stop_when_finished``)."""
-
-
-@dataclass(frozen=True)
-class Cell:
-    number: int
-    step: float
-    """Landmark grid step [m]."""
-    robots: int
-    radius: float
-    """r [m]."""
-    mass: float
-    """M [kg]."""
-
-    @property
-    def overrides(self) -> tuple[str, ...]:
-        return (f"transport.landmarks.step={self.step}", f"robots.count={self.robots}",
-                f"transport.object.radius={self.radius}", f"transport.object.mass={self.mass}")
-
-    @property
-    def name(self) -> str:
-        return f"step {self.step:g} m, rho {self.robots}, r {self.radius:g} m, M {self.mass:g} kg"
-
-
-CELLS: tuple[Cell, ...] = (
-    Cell(0, 0.5, 8, 0.3, 0.3), Cell(1, 1.0, 8, 0.3, 0.3), Cell(2, 0.5, 6, 0.3, 0.3),
-    Cell(3, 0.5, 7, 0.3, 0.3), Cell(4, 0.5, 8, 0.4, 0.7), Cell(5, 0.5, 8, 0.45, 1.0),
-)
-
-PAPER_TABLE1: dict[tuple[str, float], float] = {
-    ("search_time_s", 0.5): 222.165, ("search_time_s", 1.0): 197.535,
-    ("recruitment_time_s", 0.5): 164.481, ("recruitment_time_s", 1.0): 164.481,
-}
-"""THE PAPER'S Table 1: mean time [s] by stage and landmark step (rho not stated)."""
-PAPER_TABLE2: dict[int, tuple[float, float, float]] = {
-    2: (4.3284, 0.1778, 215.07), 3: (4.7426, 0.1894, 239.35), 0: (3.9142, 0.1526, 244.79),
-    4: (4.3284, 0.1686, 282.47), 5: (4.7426, 0.1474, 258.62),
-}
-"""THE PAPER'S Table 2 by our cell: (path length [m], error [m], time [s]). The paper's rho = 8
-row of case 1 and its (0.3, 0.3) row of case 2 are the same run."""
-PAPER_NORMALISED_ERROR_PCT = 3.8
-"""Sec. 5: "For all cases, the average error in the trajectory is around 3.8%"."""
 
 TABLE2_METRICS: dict[str, str] = {
     "planned_path_m": "planned path [m]",
@@ -141,16 +106,25 @@ def caging_tables_md(rows: Sequence[dict]) -> str:
 
 
 def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
+    """tables.md and the box plots by cell, the paper's numbers (Tables 1-2, sec. 5) drawn on them."""
+
     out.mkdir(parents=True, exist_ok=True)
     tables = out / "tables.md"
     tables.write_text(caging_tables_md(rows))
     cells = [c.number for c in CELLS]
     labels = {STRATEGY: "ours"}
+    marks = {m: level_marks(CAGING_CLAIMS, m) for m in ("search_time_s", "recruitment_time_s", "transport_time_s",
+                                                         "planned_path_m", "trajectory_error_m")}
+    text = "paper (Tables 1-2) and its ±25 % band"
     written = [tables]
     written.append(boxplot_figure(
         [("search_time_s", "search time [s]"), ("recruitment_time_s", "recruitment time [s]"),
          ("transport_time_s", "transport time [s]")], rows, cells, [STRATEGY], labels,
-        "cell (see tables.md)", "Stage times by cell", out / "times.png"))
+        "cell (see tables.md)", "Stage times by cell", out / "times.png", paper=marks, paper_text=text))
+    written.append(boxplot_figure(
+        [("planned_path_m", "planned path length [m]"), ("trajectory_error_m", "trajectory error [m]")], rows, cells,
+        [STRATEGY], labels, "cell (see tables.md)", "Path length and error by cell (Table 2)", out / "path.png",
+        paper=marks, paper_text=text))
     written.append(boxplot_figure(
         [("trajectory_error_pct", "trajectory error [% of the planned path]"),
          ("max_path_deviation_m", "largest deviation from the planned path [m]")], rows, cells, [STRATEGY], labels,
@@ -158,50 +132,6 @@ def write_caging_report(rows: Sequence[dict], out: Path) -> list[Path]:
         references={"trajectory_error_pct": (PAPER_NORMALISED_ERROR_PCT,
                                              f"paper: around {PAPER_NORMALISED_ERROR_PCT} % (sec. 5)")}))
     return written
-
-
-ERROR_CLAIM_FACTOR = 2.0
-"""The error claim ("around 3.8 %") counts as holding when our mean normalised error is at most
-this many times the paper's: the paper gives no spread to test against."""
-
-
-def caging_headlines(rows: Sequence[dict]) -> list[Headline]:
-    """The paper's claims (sec. 5) checked on our cells; None where the cells they need were not run.
-
-    Recruitment "is not affected by the variation of the step" (Table 1: 164.5 s for both steps):
-    holds when a two-sided Mann-Whitney U test finds no difference (p >= 0.05). The coarser grid
-    searches faster (Table 1: 197.5 s against 222.2 s): holds when our mean is lower too. The
-    object follows the planned path with an error of about 3.8 %: see `ERROR_CLAIM_FACTOR`. Every
-    swarm size and object is transported with the cage holding (Table 2 has every case delivered).
-    """
-    def times(cell: int, metric: str) -> list[float]:
-        return values_of(rows, STRATEGY, cell, metric)
-
-    out = []
-    fine, coarse = times(0, "recruitment_time_s"), times(1, "recruitment_time_s")
-    _, p = pair_test(fine, coarse, "u")
-    out.append(Headline("recruitment time does not depend on the landmark step (Table 1)", "164.5 s for both",
-                        f"medians {_median(fine)} / {_median(coarse)} s, Mann-Whitney p = {fmt_p(p)}",
-                        None if math.isnan(p) or not u_can_reject(len(fine), len(coarse)) else p >= 0.05))
-    fine, coarse = describe(times(0, "search_time_s")).mean, describe(times(1, "search_time_s")).mean
-    known = math.isfinite(fine) and math.isfinite(coarse)
-    out.append(Headline("a 1 m landmark step makes the search faster than 0.5 m (Table 1)", "197.5 < 222.2 s",
-                        f"{fmt(coarse, 1)} vs {fmt(fine, 1)} s (means)" if known else "—",
-                        coarse < fine if known else None))
-    errors = _over_all_runs(rows, "trajectory_error_pct")
-    known = math.isfinite(errors.mean)
-    out.append(Headline("the object follows the planned path with an error around 3.8 % (sec. 5)",
-                        f"{PAPER_NORMALISED_ERROR_PCT} %", f"{fmt(errors.mean, 1)} % (mean of {errors.n})" if known else "—",
-                        errors.mean <= ERROR_CLAIM_FACTOR * PAPER_NORMALISED_ERROR_PCT if known else None))
-    runs = [r for r in rows if r.get("strategy") == STRATEGY]
-    held = sum(1 for r in runs if r.get("transport_time_s") is not None and r.get("cage_held") is True)
-    out.append(Headline("every swarm size (6-8) and object is caged and delivered (Table 2)", "all cases",
-                        f"{held}/{len(runs)} runs", held == len(runs) if runs else None))
-    return out
-
-
-def _median(values: Sequence[float]) -> str:
-    return fmt(describe(values).median, 0) if values else "—"
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -217,8 +147,8 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_caging_report(rows, out)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    return caging_headlines(rows)
+def _claims(args: argparse.Namespace) -> tuple:
+    return CAGING_CLAIMS
 
 
 CAGING_COMPARISON = Comparison(
@@ -229,5 +159,5 @@ CAGING_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
-    headlines=_headlines,
+    claims=_claims,
 )

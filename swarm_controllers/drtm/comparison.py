@@ -14,86 +14,26 @@ import argparse
 import json
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from swarm_controllers.drtm.claims import (
+    DRTM_CLAIMS,
+    DRTM_CONDITIONS,
+    DRTM_LABELS,
+    DRTM_METRICS,
+    DRTM_STRATEGIES,
+    PAPER,
+    PAPER_TTESTS,
+    Condition,
+)
 from swarm_controllers.drtm.config import NestConfig
-from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.report import cell_text, fmt, fmt_p, md_table, save_figure
 from swarm_sim.compare.stats import describe, mean_series, pair_test, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import level_marks
 from swarm_sim.scenario import load_scenario, scenario_to_dict
-
-DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
-DRTM_LABELS: dict[str, str] = {"drtm": "DRTM", "artm": "ARTM"}
-
-
-@dataclass(frozen=True)
-class Condition:
-    """One experiment of the paper: its section, the scenario that holds it, its figures."""
-
-    section: str
-    scenario: str
-    what: str
-    figures: str
-    table4: str = ""
-    """Its row label in the paper's Table 4 (which numbers Sec. 4's subsections 5.1-5.4)."""
-
-
-DRTM_CONDITIONS: tuple[Condition, ...] = (
-    Condition("3.1", "drtm", "N_f = 20, E_a = 10, N_r = 20, L = 4 m (comparison)", "Figs. 5-6"),
-    Condition("4.1", "drtm_nf25", "N_f = 25", "Figs. 10-11", "5.1"),
-    Condition("4.2", "drtm_ea20", "E_a = 20", "Figs. 12-13", "5.2"),
-    Condition("4.3", "drtm_nr30", "N_r = 30", "Figs. 14-15", "5.3"),
-    Condition("4.4", "drtm_l3", "L = 3 m, d = 1 m", "Figs. 16-17", "5.4"),
-)
-"""The cells of the sweep, in order (cell = index)."""
-
-DRTM_METRICS: dict[str, tuple[str, str, float]] = {
-    "food_deviation": ("V_f", "average deviation of food [tokens]", 1.0),
-    "energy_efficiency": ("E_e", "energy efficiency [%]", 100.0),
-    "oae_total": ("M_T", "obstacle-avoidance events, total", 1.0),
-    "oae_per_robot": ("M_v", "obstacle-avoidance events per robot", 1.0),
-    "food_collected": ("F_t", "food tokens collected", 1.0),
-    "nest_food_final": ("F(T)", "net food in the nest at the end [tokens]", 1.0),
-}
-"""JSON field -> (the paper's symbol, meaning, factor to the paper's unit)."""
-
-PAPER: dict[str, dict[str, dict[str, float]]] = {
-    "3.1": {"drtm": {"food_deviation": 2.55, "energy_efficiency": 11.99, "oae_total": 925.96, "oae_per_robot": 46.30,
-                     "food_collected": 173.76, "nest_food_final": 20.84},
-            "artm": {"food_deviation": 4.74, "energy_efficiency": 9.99, "oae_total": 1148.44, "oae_per_robot": 57.42,
-                     "food_collected": 183.46, "nest_food_final": 18.34}},
-    "4.1": {"drtm": {"food_deviation": 2.90, "energy_efficiency": 13.31, "oae_total": 760.22, "oae_per_robot": 38.01,
-                     "food_collected": 156.90, "nest_food_final": 20.88},
-            "artm": {"food_deviation": 2.92, "energy_efficiency": 11.06, "oae_total": 1053.20, "oae_per_robot": 52.66,
-                     "food_collected": 150.44, "nest_food_final": 16.63}},
-    "4.2": {"drtm": {"food_deviation": 3.06, "energy_efficiency": 10.78, "oae_total": 912.06, "oae_per_robot": 45.60,
-                     "food_collected": 189.14, "nest_food_final": 20.39},
-            "artm": {"food_deviation": 5.18, "energy_efficiency": 8.45, "oae_total": 1152.26, "oae_per_robot": 57.61,
-                     "food_collected": 189.32, "nest_food_final": 15.99}},
-    "4.3": {"drtm": {"food_deviation": 3.17, "energy_efficiency": 8.72, "oae_total": 1203.32, "oae_per_robot": 40.11,
-                     "food_collected": 229.44, "nest_food_final": 19.99},
-            "artm": {"food_deviation": 4.94, "energy_efficiency": 6.67, "oae_total": 1612.26, "oae_per_robot": 53.74,
-                     "food_collected": 236.40, "nest_food_final": 15.77}},
-    "4.4": {"drtm": {"food_deviation": 2.35, "energy_efficiency": 10.74, "oae_total": 1423.08, "oae_per_robot": 71.15,
-                     "food_collected": 165.32, "nest_food_final": 17.75},
-            "artm": {"food_deviation": 4.61, "energy_efficiency": 8.91, "oae_total": 1882.32, "oae_per_robot": 94.12,
-                     "food_collected": 170.90, "nest_food_final": 15.22}},
-}
-"""THE PAPER'S numbers, not ours: means over 50 ARGoS runs of 20 min (Secs. 3.1 and 4.1-4.4;
-E_e in %). Every E_e it gives equals F(T) / F_t."""
-
-PAPER_TTESTS: dict[str, dict[str, tuple[float, float]]] = {
-    "3.1": {"food_collected": (3.1918, 0.0019), "oae_total": (2.2899, 0.0242)},
-    "4.1": {"food_collected": (4.9663, 2.89e-6), "oae_total": (2.7761, 6.59e-3)},
-    "4.2": {"food_collected": (3.2744, 1.46e-3), "oae_total": (2.3803, 0.0192)},
-    "4.3": {"food_collected": (4.7869, 6.00e-6), "oae_total": (3.9267, 1.60e-4)},
-    "4.4": {"food_collected": (2.1899, 0.0310), "oae_total": (2.6984, 8.21e-3)},
-}
-"""THE PAPER'S Tables 2 and 4: (t, two-tailed p) of DRTM vs ARTM, 50 runs each (98 d.o.f.), all
-reported significant; the paper gives no sign convention and every t is positive."""
 
 SERIES: dict[str, str] = {
     "nest_food_series": "net food in the nest F(t) [tokens]",
@@ -218,9 +158,12 @@ def drtm_ttests_md(rows: Sequence[dict], conditions: Sequence[int]) -> str:
 
 
 def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: Sequence[str], key: str,
-                  path: Path, desired: dict[int, float] | None = None) -> Path:
+                  path: Path, desired: dict[int, float] | None = None,
+                  paper: tuple[str, dict] | None = None) -> Path:
     """One panel per condition: the mean of `key` over the seeds with a ±1 std band, one colour
-    per model, F_d dashed where given (Figs. 5-6, 10-17)."""
+    per model, F_d dashed where given (Figs. 5-6, 10-17); `paper`: (name, (strategy, cell) ->
+    (band low, value, band high)) of the paper's number at the run's end (M_T, F(T)), drawn as a
+    diamond with its band in the model's colour at the last time."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -237,6 +180,15 @@ def series_figure(rows: Sequence[dict], conditions: Sequence[int], strategies: S
                 ax.fill_between(t / 60.0, mean - std, mean + std, color=f"C{j}", alpha=0.2)
         if desired and cell in desired:
             ax.axhline(desired[cell], color="black", linestyle="--", linewidth=1, label="F_d")
+        end = max((t for r in rows if r.get("cell") == cell for t, _ in (r.get(key) or [])[-1:]), default=None)
+        for j, s in enumerate(strategies):
+            mark = paper[1].get((s, cell)) if paper and end is not None else None
+            if mark:
+                lo, value, hi = mark
+                x = end / 60.0 + 0.4 * j  # the models side by side at the end
+                ax.plot([x] * 2, [lo, hi], color=f"C{j}", lw=1.5, alpha=0.8)
+                ax.plot([x], [value], marker="D", markersize=6, color=f"C{j}", markeredgecolor="black",
+                        ls="none", label=f"paper {paper[0]} ({DRTM_LABELS.get(s, s)}) ±25 %")
         ax.set(title=f"Sec. {c.section}: {c.what.split(' (')[0]}", xlabel="time [min]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize="small")
@@ -256,37 +208,14 @@ def write_drtm_report(rows: Sequence[dict], out: Path, conditions: Sequence[int]
     written[0].write_text(drtm_table_md(rows, conditions, strategies))
     written[1].write_text(drtm_ttests_md(rows, conditions))
     desired = {c: NestConfig.of(load_scenario(DRTM_CONDITIONS[c].scenario)).desired_food for c in conditions}
+
+    paper = {"nest_food_series": ("F(T)", level_marks(DRTM_CLAIMS, "nest_food_final")),
+             "oae_series": ("M_T", level_marks(DRTM_CLAIMS, "oae_total"))}
     for name, key in (("food.png", "nest_food_series"), ("oae.png", "oae_series"),
                       ("active.png", "active_robots_series")):
         written.append(series_figure(rows, conditions, strategies, key, out / name,
-                                     desired if key == "nest_food_series" else None))
+                                     desired if key == "nest_food_series" else None, paper.get(key)))
     return written
-
-
-HEADLINES: tuple[tuple[str, str, str, bool], ...] = (
-    ("food_deviation", "DRTM keeps the food closer to F_d (V_f lower than ARTM's)", "Secs. 3.1, 4.1-4.4", True),
-    ("oae_total", "DRTM has fewer obstacle-avoidance events (M_T lower than ARTM's)", "Secs. 3.1, 4.1-4.4; t-tests", True),
-    ("energy_efficiency", "DRTM is more energy-efficient (E_e higher than ARTM's)", "Secs. 3.1, 4.1-4.4", False),
-)
-"""(field, claim, where the paper says it, DRTM better when lower): the paper's headline claims,
-each made for every condition."""
-
-
-def drtm_headlines(rows: Sequence[dict], conditions: Sequence[int]) -> list[Headline]:
-    """Each headline claim checked on the means of every condition run: it holds where DRTM beats
-    ARTM in all of them (None without both models' runs)."""
-    out = []
-    for metric, claim, where, lower in HEADLINES:
-        wins, seen = [], []
-        for cell in conditions:
-            a, b = (describe(values_of(rows, s, cell, metric)).mean for s in DRTM_STRATEGIES)
-            if math.isfinite(a) and math.isfinite(b):
-                seen.append(DRTM_CONDITIONS[cell].section)
-                if (a < b) == lower and a != b:
-                    wins.append(DRTM_CONDITIONS[cell].section)
-        ours = f"DRTM better in {len(wins)}/{len(seen)}: {', '.join(wins) or 'none'}" if seen else "—"
-        out.append(Headline(claim, f"all five ({where})", ours, len(wins) == len(seen) if seen else None))
-    return out
 
 
 def _sections(text: Sequence[str] | None) -> list[int]:
@@ -312,8 +241,8 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_drtm_report(rows, out, _sections(args.conditions), strategies)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    return drtm_headlines(rows, _sections(args.conditions))
+def _claims(args: argparse.Namespace) -> tuple:
+    return DRTM_CLAIMS
 
 
 DRTM_COMPARISON = Comparison(
@@ -324,5 +253,5 @@ DRTM_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
-    headlines=_headlines,
+    claims=_claims,
 )

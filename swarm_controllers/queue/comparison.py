@@ -8,29 +8,20 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
+from swarm_controllers.queue.claims import (
+    PAPER_TABLE_II,
+    QUEUE_CLAIMS,
+    QUEUE_LABELS,
+    QUEUE_SIZES,
+    QUEUE_STRATEGIES,
+)
 from swarm_sim.cli import scenario_fields
-from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_sim.compare.comparison import Comparison, Rule
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, label, md_table
 from swarm_sim.compare.stats import all_pairs, cells_of, describe, ordering, pair_test, pairwise_tests, stars, values_of
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import level_marks
 
-QUEUE_STRATEGIES: tuple[str, ...] = ("queue_cpfa", "queue_qse", "queue_qst", "queue_qme", "queue_qmt")
-"""Scenario names of the queue paper's five strategies, in the paper's Table II row order."""
-QUEUE_LABELS: dict[str, str] = {
-    "queue_cpfa": "CPFA", "queue_qse": "Q_SE", "queue_qst": "Q_ST", "queue_qme": "Q_ME", "queue_qmt": "Q_MT",
-}
-QUEUE_SIZES: tuple[int, ...] = (48, 64, 80, 96, 112)
-"""The paper's swarm sizes (Table I)."""
-
-PAPER_TABLE_II: dict[str, dict[int, float]] = {
-    "queue_cpfa": {48: 15.17, 64: 13.33, 80: 12.17, 96: 11.47, 112: 11.39},
-    "queue_qse": {48: 17.39, 64: 18.09, 80: 17.36, 96: 16.63, 112: 18.06},
-    "queue_qst": {48: 37.98, 64: 38.88, 80: 42.45, 96: 37.44, 112: 34.60},
-    "queue_qme": {48: 46.61, 64: 54.29, 80: 59.19, 96: 61.42, 112: 64.22},
-    "queue_qmt": {48: 62.94, 64: 71.93, 80: 76.39, 96: 82.31, 112: 82.39},
-}
-"""THE PAPER'S numbers, not ours: queue paper Table II, "Resource Collection (%)", mean over 50
-ARGoS runs of 18 min, 12 x 12 m arena, 320 resources in five 8 x 8 clusters."""
 PAPER_QUEUE_QUOTES = (
     "Given a total of 320 available resources, the average number of collected resources "
     "decreases from 49 with 48 robots to 37 with 112 robots. [CPFA]",
@@ -232,95 +223,16 @@ def write_queue_report(rows: Sequence[dict], out: Path, sizes: Sequence[int] | N
     written = [out / "table.md", out / "ttests.md"]
     written[0].write_text(queue_table_md(rows, sizes, strategies))
     written[1].write_text(queue_ttests_md(rows, sizes, strategies))
-    for name, metric, fig in (("collected.png", "resources_collected_pct", "Fig. 8"),
-                              ("collision_time.png", COLLISION_MIN, "Fig. 9"),
-                              ("dropoff_time.png", "dropoff_time_mean_s", "Fig. 10")):
+
+    paper = {"resources_collected_pct": level_marks(QUEUE_CLAIMS, "resources_collected_pct")}
+    for name, metric, fig in (("collected.png", "resources_collected_pct", "Fig. 8; paper: Table II"),
+                              ("collision_time.png", COLLISION_MIN, "Fig. 9; the paper prints no number"),
+                              ("dropoff_time.png", "dropoff_time_mean_s", "Fig. 10; the paper prints no number")):
         written.append(boxplot_figure([(metric, QUEUE_METRICS[metric])], rows, sizes, strategies,
                                       QUEUE_LABELS, "number of robots",
-                                      f"{QUEUE_METRICS[metric]} (cf. queue paper {fig})", out / name))
+                                      f"{QUEUE_METRICS[metric]} (cf. queue paper {fig})", out / name, paper=paper,
+                                      paper_text="paper (Table II) and its ±25 % band"))
     return written
-
-
-def _means(rows: Sequence[dict], strategies: Sequence[str], cell: int, metric: str) -> dict[str, float]:
-    """Mean `metric` per strategy with data in `cell`."""
-    out = {s: describe(values_of(rows, s, cell, metric)).mean for s in strategies}
-    return {s: m for s, m in out.items() if math.isfinite(m)}
-
-
-def _extreme(rows: Sequence[dict], strategies: Sequence[str], sizes: Sequence[int], metric: str, who: str,
-             highest: bool) -> tuple[str, bool | None]:
-    """Is `who` the strategy with the highest (lowest) mean `metric` at every size? (ours, holds)"""
-    found = []
-    for c in sizes:
-        means = _means(rows, strategies, c, metric)
-        if who not in means or len(means) < 2 or len(set(means.values())) == 1:
-            return "—" if who not in means else "no differences", None
-        found.append((c, (max if highest else min)(means, key=means.get)))
-    text = ", ".join(f"{c}: {label(s, QUEUE_LABELS)}" for c, s in found)
-    return text, all(s == who for _, s in found)
-
-
-def _trend(rows: Sequence[dict], who: str, sizes: Sequence[int], metric: str, rising: bool) -> tuple[str, bool | None]:
-    """Does `who`'s mean `metric` rise (fall) from the smallest to the largest size?"""
-    if len(sizes) < 2:
-        return "one swarm size only", None
-    lo = describe(values_of(rows, who, min(sizes), metric)).mean
-    hi = describe(values_of(rows, who, max(sizes), metric)).mean
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        return "—", None
-    return f"{fmt(lo, 1)} -> {fmt(hi, 1)}", None if hi == lo else (hi > lo) if rising else (hi < lo)
-
-
-def queue_headlines(rows: Sequence[dict], sizes: Sequence[int], strategies: Sequence[str]) -> list[Headline]:
-    """The queue paper's headline claims (sec. VII and Table II) checked on the means per size; sizes
-    without runs are left out (a sweep cut short judges the sizes it has, and its cells say which)."""
-    rows = with_minutes(rows)
-    held = {r.get("cell") for r in rows}
-    sizes = [c for c in sizes if c in held]
-    out = []
-    pct, col, drop = "resources_collected_pct", COLLISION_MIN, "dropoff_time_mean_s"
-    ours, holds = _extreme(rows, strategies, sizes, pct, "queue_qmt", highest=True)
-    out.append(Headline("Q_MT collects the most resources of all strategies", "Table II: every size", ours, holds))
-    queue_order = [s for s in ("queue_qse", "queue_qst", "queue_qme", "queue_qmt") if s in strategies]
-    found, holds_order = [], True if len(queue_order) == 4 else None
-    for c in sizes:
-        means = _means(rows, queue_order, c, pct)
-        order = sorted(means, key=means.get)
-        found.append(f"{c}: {' < '.join(label(s, QUEUE_LABELS) for s in order)}")
-        if len(set(means.values())) < len(means):  # ties: no strict order to compare
-            holds_order = None
-        if holds_order and order != queue_order:
-            holds_order = False
-    out.append(Headline("collection Q_SE < Q_ST < Q_ME < Q_MT", "Table II: every size", "; ".join(found) or "—",
-                        holds_order if found else None))
-    for s, rising, text in (("queue_qmt", True, "Q_MT collects more with more robots"),
-                            ("queue_qme", True, "Q_ME collects more with more robots"),
-                            ("queue_cpfa", False, "CPFA collects less with more robots")):
-        ours, holds = _trend(rows, s, sizes, pct, rising) if s in strategies else ("—", None)
-        paper = PAPER_TABLE_II[s]
-        out.append(Headline(text, f"{fmt(paper[min(paper)], 1)} -> {fmt(paper[max(paper)], 1)} % (48 -> 112)",
-                            ours + (" %" if holds is not None else ""), holds))
-    ours, holds = _extreme(rows, strategies, sizes, col, "queue_cpfa", highest=True)
-    out.append(Headline("CPFA has the highest collision time", "Fig. 9", ours, holds))
-    if len(sizes) >= 2 and "queue_qse" in strategies:
-        growth = {s: describe(values_of(rows, s, max(sizes), col)).mean - describe(values_of(rows, s, min(sizes), col)).mean
-                  for s in strategies}
-        growth = {s: g for s, g in growth.items() if math.isfinite(g)}
-        fastest = max(growth, key=growth.get) if growth else None
-        out.append(Headline("Q_SE's collision time grows fastest with swarm size", "Fig. 9",
-                            f"fastest: {label(fastest, QUEUE_LABELS)} (+{fmt(growth[fastest], 2)} min)" if fastest else "—",
-                            fastest == "queue_qse" if fastest else None))
-    ours, holds = _extreme(rows, strategies, sizes, drop, "queue_qse", highest=True)
-    out.append(Headline("Q_SE has the highest drop-off time (above CPFA's)", "Fig. 10", ours, holds))
-    ours, holds = _extreme(rows, strategies, sizes, drop, "queue_qmt", highest=False)
-    out.append(Headline("Q_MT has the lowest drop-off time", "Fig. 10: all experiments", ours, holds))
-    for name, cells in ordering_checks(rows, sizes, strategies):
-        verdicts = [h for _, _, h in cells]
-        ours = "; ".join(f"{c}: {text}" for c, text, _ in cells) or "—"
-        holds = None if not verdicts or None in verdicts else all(verdicts)
-        paper = "Table II, every size" if "<" in name else "Table II"
-        out.append(Headline(f"collection {name}", paper, ours, holds))
-    return out
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -336,8 +248,21 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_queue_report(rows, out, args.robots, strategies)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list:
-    return queue_headlines(rows, args.robots, strategies)
+def _claims(args: argparse.Namespace) -> tuple:
+    return QUEUE_CLAIMS
+
+
+QUEUE_RULES: tuple[Rule, ...] = (
+    Rule("queue_qst", "controller.queue.join_order",
+         "Sec. V-B: a seeker that finds the tail \"will simply join the queue behind it\" (`behind_tail`)",
+         "Tameem786/Collision_Free_CPFA branch CPFA-2.0, `CPFA_controller::Returning`: a carrier boards the spiral "
+         "at the innermost lane it crossed once blocked (`anywhere`); its logged runs match Table II's Q_ST",
+         "text", "the code's rule: `--set controller.queue.join_order=anywhere` (factor `qst_join_anywhere`); "
+                 "the committed runs use the text's"),
+    Rule("queue_qst", "controller.queue.seek_timeout",
+         "no give-up", "no give-up", "neither",
+         "ours: a seeker falls back to the entry point after 120 s (factor `qst_no_give_up`)"),
+)
 
 
 QUEUE_COMPARISON = Comparison(
@@ -348,5 +273,6 @@ QUEUE_COMPARISON = Comparison(
     add_arguments=_add_arguments,
     plans=_plans,
     write_report=_write_report,
-    headlines=_headlines,
+    claims=_claims,
+    rules=QUEUE_RULES,
 )

@@ -11,20 +11,20 @@ from pathlib import Path
 
 import numpy as np
 
-from swarm_sim.compare.comparison import Comparison, Headline
+from swarm_controllers.spiral.claims import SPIRAL_CLAIMS
+from swarm_sim.compare.comparison import Comparison, Rule
 from swarm_sim.compare.report import boxplot_figure, cell_text, fmt, fmt_p, fmt_pct, label, md_table, save_figure
 from swarm_sim.compare.stats import (
     cells_of,
     describe,
     mean_series,
-    pair_test,
     pairwise_tests,
     pct_change,
     stars,
-    u_can_reject,
     values_of,
 )
 from swarm_sim.compare.sweep import RunPlan, frozen_fields
+from swarm_sim.compare.verdicts import relation_marks
 
 SPIRAL_STRATEGIES: tuple[str, ...] = ("ddsa", "mdbsa_c", "mdbsa_d")
 SPIRAL_LABELS: dict[str, str] = {"ddsa": "DDSA", "mdbsa_c": "MDBSA-C", "mdbsa_d": "MDBSA-D"}
@@ -76,92 +76,11 @@ SPIRAL_EXPERIMENTS: dict[int, SpiralExperiment] = {
 }
 
 
-@dataclass(frozen=True)
-class PaperClaim:
-    """A difference the MDBSA paper reports: metric of `b` relative to `a`."""
-
-    experiment: int
-    metric: str
-    a: str
-    b: str
-    paper: str
-    """The paper's number in short, e.g. "≈ +101 % (average)"."""
-    quote: str
-    cells: tuple[int, ...] | None = None
-    """The cells the claim is about; None: every cell."""
-    min_cell: int | None = None
-    """Alternatively: every cell >= this."""
-    sign: int = 1
-    """The direction the paper reports: +1 (B above A), -1 (below) or 0 (no difference)."""
-
-    def covers(self, cell: int) -> bool:
-        if self.cells is not None:
-            return cell in self.cells
-        return self.min_cell is None or cell >= self.min_cell
-
-
-_C, _D = "MDBSA_{Centralized}", "MDBSA_{Distributed}"
 _EXP3_COLLECTION_QUOTE = (
-    f"As the total number of resources increases, {_D} demonstrates an almost 100% collection rate "
+    "As the total number of resources increases, MDBSA_{Distributed} demonstrates an almost 100% collection rate "
     "on average with a ≈60% to ≈350% improvement in the number of collected resources as the number "
     "of robots increases in comparison to DDSA."
 )
-PAPER_SPIRAL_CLAIMS: tuple[PaperClaim, ...] = (
-    # ---- experiment 1 (Fig. 6, Fig. 7)
-    PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_c", "similar (≈ 0 %)",
-               f"When using 4 and 16 regions, {_C} achieved similar performance to DDSA regarding "
-               "the number of collected resources.", cells=(4, 16), sign=0),
-    PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −25 %",
-               "However, we observed a decrease of approximately 25% in the number of collected "
-               "resources using 64 regions. [baseline not stated; compared here with DDSA]", cells=(64,), sign=-1),
-    PaperClaim(1, "resources_per_robot", "ddsa", "mdbsa_d", "≈ +101 % (average)",
-               f"On average, {_D} collected around 101% more resources than DDSA and around 112% "
-               f"more resources than {_C}."),
-    PaperClaim(1, "resources_per_robot", "mdbsa_c", "mdbsa_d", "≈ +112 % (average)",
-               f"On average, {_D} collected around 101% more resources than DDSA and around 112% "
-               f"more resources than {_C}."),
-    PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −33 %",
-               f"When using 4 and 64 regions, {_D} has approximately 33% less time in collisions "
-               "than DDSA, and around 72% less time when using 16 regions.", cells=(4, 64), sign=-1),
-    PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −72 %",
-               f"When using 4 and 64 regions, {_D} has approximately 33% less time in collisions "
-               "than DDSA, and around 72% less time when using 16 regions.", cells=(16,), sign=-1),
-    PaperClaim(1, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0, highest, grows with regions",
-               f"The collision time in {_C} increased as the number of regions increased, with both "
-               "collision time and standard deviation being the highest among all algorithms."),
-    PaperClaim(1, "foraging_rate_per_min", "ddsa", "mdbsa_d", "> 0 (Fig. 7 per-minute curves)",
-               f"The results show that {_D} outperforms both {_C} and DDSA consistently."),
-    PaperClaim(1, "foraging_rate_per_min", "mdbsa_c", "mdbsa_d", "> 0 (Fig. 7 per-minute curves)",
-               f"The results show that {_D} outperforms both {_C} and DDSA consistently."),
-    # ---- experiment 2 (Fig. 8, Fig. 9)
-    PaperClaim(2, "resources_per_robot", "ddsa", "mdbsa_d", "≈ +100 % … +200 %, growing with robots",
-               f"Specifically, {_D} outperforms DDSA by ≈100% to ≈200% in terms of the number of "
-               "resources collected per robot as the number of robots increases."),
-    PaperClaim(2, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −44 %",
-               f"On the other hand, {_C} collects ≈44% fewer resources than DDSA as the number of "
-               "robots increases from 14 to 32.", min_cell=14, sign=-1),
-    PaperClaim(2, "collision_time_per_robot_s", "ddsa", "mdbsa_d", "≈ −21 % … −58 %",
-               f"As the number of robots increases, {_D} spends the least amount of time in "
-               "collisions, achieving ≈21% to ≈58% less collision time than DDSA.", sign=-1),
-    PaperClaim(2, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0, rising sharply with robots",
-               f"Increasing the number of robots has a significant effect on the collision times for "
-               f"{_C}, with the collision time increasing sharply compared to DDSA."),
-    PaperClaim(2, "foraging_rate_per_min", "ddsa", "mdbsa_c", "≈ −24 % (Fig. 9)",
-               f"In simulations with 16 or more robots, robots collect ≈24% fewer resources than DDSA "
-               f"in {_C}.", min_cell=16, sign=-1),
-    # ---- experiment 3 (Fig. 10)
-    PaperClaim(3, "resources_per_robot", "ddsa", "mdbsa_c", "≈ −30.4 %",
-               f"Lastly, Fig. 10 displays the results for Experiment 3. {_C} collects ≈30.4% fewer "
-               "resources than DDSA.", sign=-1),
-    PaperClaim(3, "resources_per_robot", "ddsa", "mdbsa_d", "≈ +60 % … +350 %", _EXP3_COLLECTION_QUOTE),
-    PaperClaim(3, "collision_time_per_robot_s", "ddsa", "mdbsa_c", "> 0 (highest of the three)",
-               f"{_C} displays an upward trend with decreasing momentum in the collision time as the "
-               "number of resources increases. It contains the highest collision time per bot in "
-               "comparison to the others."),
-)
-"""THE PAPER'S reported differences (quoted from mdbsa_spiral_search.md, Sec. VI), not ours."""
-
-
 def resource_layout(count: int, layout: str = LAYOUTS[0]) -> tuple[str, ...]:
     """``--set`` overrides placing `count` resources in "clusters of different sizes".
 
@@ -302,7 +221,7 @@ def per_minute_figure(rows: Sequence[dict], experiment: int, cells: Sequence[int
 def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence[int],
                           strategies: Sequence[str]) -> str:
     exp = SPIRAL_EXPERIMENTS[experiment]
-    claims = [c for c in PAPER_SPIRAL_CLAIMS if c.experiment == experiment]
+    claims = [c for c in SPIRAL_CLAIMS[experiment] if c.b]
     pairs = [(a, b) for a, b in SPIRAL_PAIRS if a in strategies and b in strategies]
     lines = [f"# MDBSA paper comparison: Mann-Whitney U, experiment {experiment}", "",
              "scipy.stats.mannwhitneyu, two-sided, between each pair per cell. Marks as in the paper: "
@@ -315,8 +234,8 @@ def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence
         lines += [f"## {title}", ""]
         body = []
         for t in pairwise_tests(rows, metric, cells, pairs, "u"):
-            paper = "; ".join(c.paper for c in claims
-                              if c.metric == metric and (c.a, c.b) == (t.a, t.b) and c.covers(t.cell))
+            paper = "; ".join(c.paper_text() for c in claims
+                              if c.measure == metric and (c.a, c.b) == (t.a, t.b) and t.cell in c.cells)
             body.append([str(t.cell), label(t.a, SPIRAL_LABELS), label(t.b, SPIRAL_LABELS),
                          fmt(t.stats_a.median), fmt(t.stats_b.median),
                          fmt_pct(pct_change(t.stats_a.mean, t.stats_b.mean)),
@@ -325,18 +244,18 @@ def spiral_mannwhitney_md(rows: Sequence[dict], experiment: int, cells: Sequence
         lines += [""]
     lines += ["## The paper's reported differences, and ours", ""]
     for c in claims:
-        covered = [cell for cell in cells if c.covers(cell)]
+        covered = [cell for cell in cells if cell in c.cells]
         ours = []
         for cell in covered:
-            a = describe(values_of(rows, c.a, cell, c.metric)).mean
-            b = describe(values_of(rows, c.b, cell, c.metric)).mean
+            a = describe(values_of(rows, c.a, cell, c.measure)).mean
+            b = describe(values_of(rows, c.b, cell, c.measure)).mean
             ours.append(pct_change(a, b))
         finite = [x for x in ours if math.isfinite(x)]
         per_cell = ", ".join(f"{cell}: {fmt_pct(x)}" for cell, x in zip(covered, ours)) or "no cell covered"
         avg = f"; mean over these cells {fmt_pct(float(np.mean(finite)))}" if len(finite) > 1 else ""
-        lines += [f"- **{SPIRAL_METRICS.get(c.metric, c.metric)}, {label(c.b, SPIRAL_LABELS)} vs "
-                  f"{label(c.a, SPIRAL_LABELS)}** — paper: {c.paper}; ours ({exp.vary}) {per_cell}{avg}.",
-                  f"  > {c.quote}"]
+        lines += [f"- **{SPIRAL_METRICS.get(c.measure, c.measure)}, {label(c.b, SPIRAL_LABELS)} vs "
+                  f"{label(c.a, SPIRAL_LABELS)}** — paper: {c.paper_text()}; ours ({exp.vary}) {per_cell}{avg}."]
+        lines += [f"  > {c.note}"] if c.note else []
     lines += [""]
     return "\n".join(lines)
 
@@ -355,48 +274,17 @@ def write_spiral_report(rows: Sequence[dict], out: Path, experiment: int, cells:
     xlabel = f"number of {exp.vary}"
     panels = [(m, SPIRAL_METRICS[m]) for m in ("resources_per_robot", "collision_time_per_robot_s")]
     fig = {1: "Fig. 6", 2: "Fig. 8", 3: "Fig. 10"}[experiment]
+    paper = {m: relation_marks(SPIRAL_CLAIMS[experiment], m, rows) for m, _ in panels}
     written.append(boxplot_figure(panels, rows, cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment} (cf. MDBSA paper {fig})",
-                                  out / "resources_collision.png", notch=True))
+                                  out / "resources_collision.png", notch=True, paper=paper,
+                                  paper_text="paper: our A's mean x (1 + its stated difference), band"))
     written.append(boxplot_figure([("foraging_rate_per_min", SPIRAL_METRICS["foraging_rate_per_min"])], rows,
                                   cells, strategies, SPIRAL_LABELS, xlabel,
                                   f"Experiment {experiment}: whole-run foraging rate",
                                   out / "foraging_rate.png", notch=True))
     written.append(per_minute_figure(rows, experiment, cells, strategies, out / "foraging_rate_per_minute.png"))
     return written
-
-
-def spiral_headlines(rows: Sequence[dict], experiment: int, cells: Sequence[int],
-                     strategies: Sequence[str]) -> list[Headline]:
-    """The paper's reported differences for `experiment`, each checked in every cell it covers
-    with the paper's own test (two-sided Mann-Whitney U, p < 0.05): a claimed rise or fall holds
-    when every covered cell moves that way significantly, "similar" when no cell differs; a cell
-    with too few runs for the test to reach p < 0.05 cannot tell (`u_can_reject`)."""
-    out = []
-    for c in PAPER_SPIRAL_CLAIMS:
-        if c.experiment != experiment:
-            continue
-        claim = (f"{SPIRAL_METRICS.get(c.metric, c.metric)}: {label(c.b, SPIRAL_LABELS)} vs "
-                 f"{label(c.a, SPIRAL_LABELS)}")
-        covered = [cell for cell in cells if c.covers(cell)]
-        if c.a not in strategies or c.b not in strategies or not covered:
-            out.append(Headline(claim, c.paper, "not run", None))
-            continue
-        parts, verdicts = [], []
-        for cell in covered:
-            va, vb = values_of(rows, c.a, cell, c.metric), values_of(rows, c.b, cell, c.metric)
-            _, p = pair_test(va, vb, "u")
-            diff = pct_change(describe(va).mean, describe(vb).mean)
-            parts.append(f"{cell}: {fmt_pct(diff)} {stars(p, ns='-')}")
-            if not (math.isfinite(p) and math.isfinite(diff)) or not u_can_reject(len(va), len(vb)):
-                verdicts.append(None)  # (too few runs for the test to tell: see u_can_reject)
-            elif c.sign == 0:
-                verdicts.append(p >= 0.05)
-            else:
-                verdicts.append(p < 0.05 and diff * c.sign > 0)
-        holds = None if None in verdicts else all(verdicts)
-        out.append(Headline(claim, c.paper, f"({SPIRAL_EXPERIMENTS[experiment].vary}) " + ", ".join(parts), holds))
-    return out
 
 
 def _add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -424,9 +312,26 @@ def _write_report(rows: Sequence[dict], out: Path, args: argparse.Namespace, str
     return write_spiral_report(rows, out, args.experiment, args.values or exp.values, strategies)
 
 
-def _headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    exp = SPIRAL_EXPERIMENTS[args.experiment]
-    return spiral_headlines(rows, args.experiment, args.values or exp.values, strategies)
+def _claims(args: argparse.Namespace) -> tuple:
+    return SPIRAL_CLAIMS[args.experiment]
+
+
+SPIRAL_RULES: tuple[Rule, ...] = (
+    Rule("mdbsa_c, mdbsa_d", "sensors.proximity_ring.ahead", "not stated",
+         "-80..80 deg (`BaseController.cpp:38`, Centralized and Distributed)", "code"),
+    Rule("mdbsa_c, mdbsa_d", "regions.order", "not stated",
+         "nearest the nest first (`DSA_loop_functions::calRegions`): `nearest_first`", "code"),
+    Rule("ddsa", "robots.stop_turn_go.collision_turn", "not stated",
+         "away from the readings by 37.5 deg plus their angle (DDSA `BaseController.cpp`): `away`", "code"),
+    Rule("mdbsa_c, mdbsa_d", "controller.spiral.partner_radio",
+         "Sec. IV: a robot \"can communicate with another robot in the same region\"; they meet (Fig. 5)",
+         "partners compare their next points in shared memory (`DSA_controller::ReachSpiralTargets`): `true`",
+         "code"),
+    Rule("mdbsa_c, mdbsa_d", "controller.spiral.waypoint_gaps", "not stated",
+         "a point every 3 search gaps (`generateSpiralPath`): `3`", "code"),
+    Rule("mdbsa_c, mdbsa_d", "controller.spiral.next_walk_at", "not stated",
+         "a new walk by way of (0.1, 0.1) (`SetTarget(CVector2(0.1, 0.1))`): `depot`", "code"),
+)
 
 
 SPIRAL_COMPARISON = Comparison(
@@ -439,5 +344,6 @@ SPIRAL_COMPARISON = Comparison(
     write_report=_write_report,
     out_dir=_out_dir,
     reproduce=tuple(("--experiment", str(n)) for n in sorted(SPIRAL_EXPERIMENTS)),
-    headlines=_headlines,
+    claims=_claims,
+    rules=SPIRAL_RULES,
 )

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from swarm_sim.compare.sweep import RunPlan
+from swarm_sim.compare.verdicts import Claim
 
 
 def given_out(args: argparse.Namespace) -> Path:
@@ -16,21 +17,25 @@ def given_out(args: argparse.Namespace) -> Path:
 
 
 @dataclass(frozen=True)
-class Headline:
-    """One headline claim of a paper and whether our runs bear it out (REPORT.md's summary)."""
+class Rule:
+    """A rule on which a paper's text and its authors' published code disagree, and which one a
+    shipped scenario follows (REPORT.md's *Text vs the authors' code*)."""
 
-    claim: str
-    """The paper's claim, in its words or close to them."""
-    paper: str
-    """The paper's number or statement, short."""
-    ours: str
-    """What our runs give, short."""
-    holds: bool | None
-    """True / False; None when our runs cannot tell (a strategy or cell missing)."""
+    scenarios: str
+    """The shipped scenarios concerned."""
+    key: str
+    """The scenario key that switches it (``controller.queue.join_order``)."""
+    text: str
+    """What the paper's text says (and the key's value that reads it so, if any)."""
+    code: str
+    """What the authors' code does (and the key's value that does it), with the file."""
+    shipped: str
+    """``text``, ``code`` or ``neither``: which one the shipped scenario follows."""
+    note: str = ""
 
 
-def no_headlines(rows: Sequence[dict], args: argparse.Namespace, strategies: list[str]) -> list[Headline]:
-    return []
+def no_claims(args: argparse.Namespace) -> tuple[Claim, ...]:
+    return ()
 
 
 @dataclass(frozen=True)
@@ -62,5 +67,8 @@ class Comparison:
     """The subcommand's own options, one tuple per sweep, that together reproduce the paper
     (``swarm-compare all`` runs each; e.g. one per experiment). Default: one sweep with the
     defaults."""
-    headlines: Callable[[Sequence[dict], argparse.Namespace, list[str]], list[Headline]] = no_headlines
-    """(rows, args, strategies) -> the paper's headline claims checked on one sweep's rows."""
+    claims: Callable[[argparse.Namespace], Sequence[Claim]] = no_claims
+    """args -> the paper's claims one sweep's rows decide (`swarm_sim.compare.verdicts`); ids
+    unique over all the comparison's sweeps, since they are judged (Holm) together."""
+    rules: tuple[Rule, ...] = ()
+    """Where the paper's text and its authors' code disagree, and which rule each scenario runs."""

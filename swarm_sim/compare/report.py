@@ -101,6 +101,27 @@ def grouped_boxplot(
     ax.grid(axis="y", alpha=0.3)
 
 
+PaperMarks = dict[tuple[str, Any], tuple[float, float, float]]
+"""(strategy, cell) -> (low, value, high) of a paper's number: its band, drawn at that box."""
+PAPER_LABEL = "paper"
+
+
+def paper_marks(ax: Any, marks: PaperMarks, cells: Sequence[Any], strategies: Sequence[str],
+                text: str = PAPER_LABEL) -> Any:
+    """The paper's numbers on a `grouped_boxplot`: a black diamond beside each (strategy, cell) box
+    with an error bar over its band (a stated range, or the ±25 % a verdict allows); returns the
+    legend handle."""
+    width = 0.8 / max(len(strategies), 1)
+    handle = None
+    for (s, cell), (lo, mid, hi) in marks.items():
+        if s not in strategies or cell not in cells:
+            continue
+        x = cells.index(cell) - 0.4 + width * (strategies.index(s) + 0.85)  # beside its box, not on its whiskers
+        handle = ax.errorbar([x], [mid], yerr=[[mid - lo], [hi - mid]], fmt="D", color="black", markersize=4,
+                             capsize=3, elinewidth=1.0, zorder=6, label=text)
+    return handle
+
+
 def boxplot_figure(
     panels: Sequence[tuple[str, str]],
     rows: Sequence[dict],
@@ -112,9 +133,12 @@ def boxplot_figure(
     path: Path,
     notch: bool = False,
     references: dict[str, tuple[float, str]] | None = None,
+    paper: dict[str, PaperMarks] | None = None,
+    paper_text: str = PAPER_LABEL,
 ) -> Path:
     """A PNG at `path` with one `grouped_boxplot` per (metric, y label) panel, side by side;
-    `references`: metric -> (value, label) of a paper's single number, drawn across its panel."""
+    `references`: metric -> (value, label) of a paper's single number, drawn across its panel;
+    `paper`: metric -> the paper's numbers per box (`paper_marks`, labelled `paper_text`)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -126,11 +150,16 @@ def boxplot_figure(
             warnings.simplefilter("ignore")  # notches wider than the box with few runs
             grouped_boxplot(ax, rows, metric, cells, strategies, labels, notch=notch)
         ax.set(xlabel=xlabel, ylabel=ylabel)
+        extra = []
         if references and metric in references:
-            value, label = references[metric]
-            line = ax.axhline(value, color="black", ls="--", lw=1.0, label=label)
-            boxes = ax.get_legend()  # grouped_boxplot's strategies, kept beside the line
-            ax.legend(handles=[*(boxes.legend_handles if boxes else []), line], fontsize="small")
+            value, text = references[metric]
+            extra.append(ax.axhline(value, color="black", ls="--", lw=1.0, label=text))
+        if paper and metric in paper:
+            handle = paper_marks(ax, paper[metric], list(cells), list(strategies), paper_text)
+            extra += [handle] if handle else []
+        if extra:
+            boxes = ax.get_legend()  # grouped_boxplot's strategies, kept beside the paper's
+            ax.legend(handles=[*(boxes.legend_handles if boxes else []), *extra], fontsize="small")
     fig.suptitle(title)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)

@@ -4,15 +4,19 @@ The comparisons come from the registry (`swarm_sim.compare.comparisons`), so a p
 algorithm registers a `Comparison` is picked up without a change here. Each comparison's
 `reproduce` option sets are run as its own subcommand would run them, into ``OUT/<name>/``
 (the ``results/queue``, ``results/spiral/exp1`` ... layout), on one shared executor. REPORT.md then
-gathers, per comparison and sweep, the markdown files it wrote (its tables next to the paper's
-numbers and its statistics) and its plots, after a summary table of the papers' headline claims
-and whether our runs bear them out.
+opens with the verdicts on every claim each paper's package declares (`swarm_sim.compare.verdicts`,
+`report_verdicts`): the count per verdict class for each paper and robot model, every level cell,
+the relations and trends, the causes of what does not hold with their grades, and where a paper's
+text and its authors' code disagree which rule each scenario follows; then, per comparison and
+sweep, the markdown files it wrote and its plots.
 
 Without ``--robot-model``, every sweep runs twice: on each algorithm's authors' robot
 (``--robot-model authors``, into ``OUT/authors/``) and on today's generic robot (``OUT/generic/``),
 and REPORT.md puts each claim's result on both side by side, with the count of claims holding for
-each, then includes ``OUT/CAUSES.md`` (the measured causes of the claims that do not hold, written
-from the one-factor-at-a-time sweeps) when there is one.
+each, then includes ``OUT/CAUSES.md`` (the evidence behind the causes, written from the
+one-factor-at-a-time sweeps) when there is one. Where ``OUT/reference/<comparison>/results.jsonl``
+holds runs of the authors' own code (same fields as ours, plus ``reference: true``), every level cell
+also shows them and our runs judged against them.
 """
 
 from __future__ import annotations
@@ -26,9 +30,10 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from swarm_sim.compare.commands import AUTHORS, build_parser, plans_of, run_comparison
-from swarm_sim.compare.comparison import Comparison, Headline
-from swarm_sim.compare.report import md_table
+from swarm_sim.compare.comparison import Comparison
 from swarm_sim.compare.sweep import RESULTS, RunFunction, read_results
+from swarm_sim.compare.verdict_report import common_fields, report_verdicts
+from swarm_sim.compare.verdicts import Claim
 from swarm_sim.executors import Executor, executor_from_args
 from swarm_sim.robots import GENERIC
 
@@ -49,7 +54,10 @@ class SweepReport:
     out: Path
     status: int
     written: list[Path] = field(default_factory=list)
-    headlines: list[Headline] = field(default_factory=list)
+    claims: tuple[Claim, ...] = ()
+    rows: list[dict] = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+    """The fields every run of the sweep carries alike (``experiment``): reference runs match on them."""
     runs: int = 0
     error: str = ""
 
@@ -107,11 +115,11 @@ def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], 
             strategies = list(comparison.strategies)
             report = SweepReport(comparison, tuple(options), comparison.out_dir(sub), 0)
             try:
+                report.claims = tuple(comparison.claims(sub))  # first: a failed sweep's claims read n/a
                 report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
                                                                executor=ex)
-                rows = _rows(report.out, comparison, sub, strategies)
-                report.runs = len(rows)
-                report.headlines = comparison.headlines(rows, sub, strategies)
+                report.rows, report.extra = _rows(report.out, comparison, sub, strategies)
+                report.runs = len(report.rows)
             except KeyboardInterrupt:
                 raise
             except Exception as exc:  # one paper's broken report must not lose the others
@@ -123,14 +131,14 @@ def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], 
     return reports
 
 
-def _rows(out: Path, comparison: Comparison, args: argparse.Namespace, strategies: list[str]) -> list[dict]:
-    """This sweep's rows from its results file (the plans' strategies and settings only)."""
-    keys = {(p.strategy, p.settings) for p in plans_of(comparison, args, strategies)}
-    return [r for r in read_results(out / RESULTS) if (r.get("strategy"), r.get("settings")) in keys]
-
-
-def _holds(value: bool | None) -> str:
-    return {True: "yes", False: "**no**", None: "n/a"}[value]
+def _rows(out: Path, comparison: Comparison, args: argparse.Namespace, strategies: list[str]
+          ) -> tuple[list[dict], dict]:
+    """This sweep's rows from its results file (the plans' strategies and settings only), and the
+    fields all its plans add alike."""
+    plans = plans_of(comparison, args, strategies)
+    keys = {(p.strategy, p.settings) for p in plans}
+    rows = [r for r in read_results(out / RESULTS) if (r.get("strategy"), r.get("settings")) in keys]
+    return rows, common_fields([dict(p.extra) for p in plans])
 
 
 def _demote(text: str, levels: int) -> list[str]:
@@ -139,8 +147,9 @@ def _demote(text: str, levels: int) -> list[str]:
 
 
 def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.Namespace) -> Path:
-    """REPORT.md: the headline claims (on each robot model side by side when there are two), the
-    causes of the failing ones (``OUT/CAUSES.md``), then every sweep's tables and plots."""
+    """REPORT.md: the verdicts on every claim (`report_verdicts`, on each robot model side by side
+    when there are two), the evidence behind the causes (``OUT/CAUSES.md``), then every sweep's
+    tables and plots."""
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     models = list(by_model)
@@ -165,20 +174,7 @@ def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.N
     if args.duration is not None:
         lines += [f"> **Rehearsal:** every run was cut to {args.duration:g} s of sim time, so these numbers "
                   "are not comparable with the papers'.", ""]
-    lines += ["## Headline claims", "",
-              "Each claim checked on our runs (means per cell; the tests behind them are in each section). "
-              "*holds*: yes / **no** / n/a (our runs cannot tell).", ""]
-    rows = _claim_rows(by_model)
-    header = ["#", "sweep", "claim", "paper"]
-    for m in models:
-        title = MODEL_TITLES.get(m, m)
-        header += [f"ours ({title})" if len(models) > 1 else "ours", f"holds ({title})" if len(models) > 1 else "holds"]
-    lines += md_table(header, ([str(i + 1), *row] for i, row in enumerate(rows))) + [""]
-    for m in models:
-        held = [h.holds for r in by_model[m] for h in r.headlines]
-        who = f"{MODEL_TITLES.get(m, m)}: " if len(models) > 1 else ""
-        lines += [f"{who}{held.count(True)} of {len(held)} claims hold, {held.count(False)} do not, "
-                  f"{held.count(None)} cannot be told.", ""]
+    lines += report_verdicts(by_model, out, MODEL_TITLES)
     causes = out / CAUSES
     if causes.is_file():
         lines += _demote(causes.read_text(), 1) + [""]
@@ -200,29 +196,6 @@ def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.N
     path = out / REPORT
     path.write_text("\n".join(lines))
     return path
-
-
-def _claim_rows(by_model: Mapping[str, Sequence[SweepReport]]) -> list[list[str]]:
-    """One row per claim: sweep, claim, paper, then (ours, holds) per model; a claim is matched
-    across models by its sweep and its words (a sweep that failed on one model shows its error)."""
-    models = list(by_model)
-    first = by_model[models[0]]
-    rows = []
-    for i, r in enumerate(first):
-        where = f"{r.comparison.name} {' '.join(r.options)}".strip()
-        others = [by_model[m][i] if i < len(by_model[m]) else None for m in models[1:]]
-        if not r.headlines:
-            rows.append([where, "(no headline claims declared)" if not r.error else f"failed: {r.error}", "",
-                         *["", "n/a"] * len(models)])
-            continue
-        for h in r.headlines:
-            row = [where, h.claim, h.paper, h.ours, _holds(h.holds)]
-            for o in others:
-                match = next((g for g in (o.headlines if o else ()) if (g.claim, g.paper) == (h.claim, h.paper)), None)
-                row += [match.ours, _holds(match.holds)] if match else [f"failed: {o.error}" if o and o.error else "—",
-                                                                         "n/a"]
-            rows.append(row)
-    return rows
 
 
 def _rel(path: Path, root: Path) -> str:

@@ -93,13 +93,6 @@ def pair_test(a: Sequence[float], b: Sequence[float], test: str) -> tuple[float,
     return float(r.statistic), float(r.pvalue)
 
 
-def u_can_reject(na: int, nb: int, alpha: float = 0.05) -> bool:
-    """Whether a two-sided Mann-Whitney U test on `na` and `nb` runs can reach p < `alpha` at all:
-    its smallest p is 2 / C(na + nb, na) (3 runs against 3: 0.1), so with fewer runs a claim of a
-    difference cannot hold and one of no difference holds whatever the data: neither is told."""
-    return na > 0 and nb > 0 and 2.0 / math.comb(na + nb, na) < alpha
-
-
 def pairwise_tests(
     rows: Sequence[dict],
     metric: str,

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from swarm_controllers.caging.comparison import (
     CELLS,
-    caging_headlines,
     caging_plans,
     caging_tables_md,
     write_caging_report,
@@ -45,21 +44,23 @@ def test_the_report_puts_our_cells_next_to_the_papers_numbers(tmp_path):
     assert "3/4 transported, cage held in 3" in text  # the run that never delivered counts
     assert "(paper: about 3.8 %)" in text
     written = write_caging_report(rows, tmp_path)
-    assert [p.name for p in written] == ["tables.md", "times.png", "error.png"]
+    assert [p.name for p in written] == ["tables.md", "times.png", "path.png", "error.png"]
 
 
-def test_headlines_check_the_papers_claims_on_our_cells():
+def test_every_number_of_both_tables_is_a_claim_judged_on_our_cells():
+    from swarm_controllers.caging.claims import CAGING_CLAIMS
+    from swarm_controllers.caging.comparison import PAPER_TABLE1, PAPER_TABLE2
+    from swarm_sim.compare.verdicts import HOLDS, LEVEL, NOT_SHOWN, evaluate
+
+    levels = [c for c in CAGING_CLAIMS if c.kind == LEVEL]
+    assert len(levels) == len(PAPER_TABLE1) + 3 * len(PAPER_TABLE2) + 1  # and the 3.8 %
+    assert len({c.id for c in CAGING_CLAIMS}) == len(CAGING_CLAIMS)
+    printed = {v for v in PAPER_TABLE1.values()} | {v for t in PAPER_TABLE2.values() for v in t}
+    assert printed <= {c.value for c in levels}
     rows = [_row(c.number, s) for c in CELLS for s in range(4)]
     rows += [_row(1, 4 + s, search_time_s=10.0) for s in range(4)]  # the coarse grid searches faster
-    found = {h.claim: h for h in caging_headlines(rows)}
-    recruitment, search, error, delivered = found.values()
-    assert recruitment.holds is True  # 150 s at both steps
-    assert search.holds is True and "vs" in search.ours
-    assert error.holds is False and error.ours.startswith("10.0 %")  # more than twice 3.8 %
-    assert delivered.holds is True and delivered.ours == f"{len(rows)}/{len(rows)} runs"
-    slower = [_row(0, s, recruitment_time_s=100.0 + s) for s in range(6)] + [_row(1, s, recruitment_time_s=300.0 + s)
-                                                                            for s in range(6)]
-    assert caging_headlines(slower)[0].holds is False
-    rows[0] = _row(0, 0, transport_time_s=None, cage_held=False, trajectory_error_pct=None)
-    assert caging_headlines(rows)[3].holds is False
-    assert [h.holds for h in caging_headlines([])] == [None, None, None, None]
+    found = {v.claim.id: v for v in evaluate(CAGING_CLAIMS, rows)}
+    assert found["step.recruitment"].verdict == HOLDS  # 150 s at both steps
+    assert found["T1.recruitment.0.5"].verdict == HOLDS  # 150 s against 164.5 s, no spread
+    assert found["error.pct"].verdict != HOLDS  # 10 % against 3.8 %
+    assert found["step.search"].verdict in (HOLDS, NOT_SHOWN) and found["step.search"].cells[0].effect < 0

@@ -9,7 +9,6 @@ from swarm_controllers.drtm.comparison import (
     DRTM_CONDITIONS,
     PAPER,
     condition_overrides,
-    drtm_headlines,
     drtm_plans,
     write_drtm_report,
 )
@@ -90,11 +89,18 @@ def test_cli_runs_the_drtm_comparison_with_a_fake_run(tmp_path):
     assert "## Sec. 4.2: E_a = 20" in (tmp_path / "table.md").read_text()
 
 
-def test_headlines_count_the_conditions_drtm_wins():
-    rows = [_row(s, c, seed, shift) for c in (0, 1) for s, shift in (("drtm", 0.0), ("artm", 1.0)) for seed in range(3)]
-    rows += [_row("drtm", 2, 0, 1.0), _row("artm", 2, 0, 0.0)]  # condition 4.2: ARTM better
-    found = {h.claim.split(" (")[0]: h for h in drtm_headlines(rows, [0, 1, 2, 3])}
-    assert found["DRTM keeps the food closer to F_d"].ours == "DRTM better in 2/3: 3.1, 4.1"
-    assert found["DRTM keeps the food closer to F_d"].holds is False
-    assert found["DRTM is more energy-efficient"].ours == "DRTM better in 1/3: 4.2"
-    assert drtm_headlines([], [0])[0].holds is None
+def test_every_number_of_the_paper_is_a_level_and_drtm_against_artm_is_judged_per_condition():
+    from swarm_controllers.drtm.claims import DRTM_CLAIMS
+    from swarm_sim.compare.verdicts import CONTRADICTS, LEVEL, evaluate
+
+    levels = [c for c in DRTM_CLAIMS if c.kind == LEVEL]
+    assert len(levels) == sum(len(m) for s in PAPER.values() for m in s.values())
+    assert len({c.id for c in DRTM_CLAIMS}) == len(DRTM_CLAIMS)
+    rows = [_row(s, c, seed, shift) for c in (0, 1, 2, 3, 4) for s, shift in (("drtm", 0.0), ("artm", 1.0))
+            for seed in range(3)]
+    found = {v.claim.id: v for v in evaluate(DRTM_CLAIMS, rows)}
+    vf = found["DRTM<ARTM.V_f"]
+    assert [c.cell for c in vf.cells] == [0, 2, 3, 4]  # 4.1: both near F_d, a claim of its own
+    assert found["DRTM=ARTM.V_f.4.1"].cells[0].cell == 1
+    assert all(c.effect < 0 for c in vf.cells) and vf.verdict != CONTRADICTS
+    assert found["F_t.3.1"].claim.sign == -1 and found["F_t.4.1"].claim.sign == 1  # the paper's means

@@ -1,0 +1,295 @@
+"""REPORT.md's opening: every paper's claims judged on every robot model (`swarm_sim.compare.verdicts`).
+
+It leads with the truth: per paper and robot model the count of claims in each verdict class, then
+every level cell (the paper's number, ours ± 95 % interval, n, the ratio), then the relations and
+trends, then each claim that does not hold with its cause and the cause's grade, then where a
+paper's text and its authors' code disagree, which rule each scenario follows. Where
+``OUT/reference/<comparison>/results.jsonl`` holds runs of the authors' code, each level cell also
+shows them and a verdict of ours against them. Nothing here knows a paper: the claims, rows and
+rules come from each comparison's sweeps.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from swarm_sim.compare.report import fmt_p, md_table
+from swarm_sim.compare.sweep import RESULTS, ResultsFileError, read_results
+from swarm_sim.compare.verdicts import (
+    ALPHA,
+    BOOTSTRAP,
+    GRADES,
+    HOLDS,
+    LEVEL,
+    LEVEL_BAND,
+    NOT_SHOWN,
+    OPEN,
+    POWER,
+    VERDICTS,
+    CellVerdict,
+    Verdict,
+    counts,
+    evaluate,
+    evaluate_reference,
+)
+
+REFERENCE = "reference"
+"""``OUT/reference/<comparison>/results.jsonl``: the authors' code's runs (issue 37), if any."""
+
+
+def _num(x: float, digits: int = 3) -> str:
+    if x is None or not math.isfinite(x):
+        return "—"
+    return f"{x:.{digits}g}" if abs(x) < 10 ** digits else f"{x:.0f}"
+
+
+def _ci(cv: CellVerdict) -> str:
+    """``mean ± half-width`` of a level cell's 95 % interval."""
+    if not math.isfinite(cv.effect):
+        return "—"
+    return f"{_num(cv.effect)} ± {_num((cv.ci[1] - cv.ci[0]) / 2, 2)}"
+
+
+def _verdict(cv: CellVerdict) -> str:
+    text = cv.verdict if cv.verdict != "n/a" else f"n/a: {cv.reason}"
+    if cv.verdict == NOT_SHOWN:
+        text += f" (n ≈ {cv.seeds})" if cv.seeds else " (no size to power)"
+    return text
+
+
+def _bold(verdict: str) -> str:
+    return verdict if verdict == HOLDS else f"**{verdict}**"
+
+
+def _effect(cv: CellVerdict) -> str:
+    """``cell: +12.3 % [+5.0, +20.1], p = 0.01, verdict``."""
+    if not math.isfinite(cv.effect):
+        return f"{cv.cell}: {_verdict(cv)}"
+    return (f"{cv.cell}: {cv.effect:+.1f} % [{cv.ci[0]:+.1f}, {cv.ci[1]:+.1f}], p = {fmt_p(cv.p_adj)}, "
+            f"{_verdict(cv)}")
+
+
+def common_fields(pairs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The fields every one of a sweep's plans shares (``experiment``), by which reference runs are
+    matched to it."""
+    if not pairs:
+        return {}
+    out = dict(pairs[0])
+    for p in pairs[1:]:
+        out = {k: v for k, v in out.items() if p.get(k) == v}
+    return out
+
+
+def _reference(out: Path, name: str) -> list[dict] | None:
+    path = out / REFERENCE / name / RESULTS
+    if not path.is_file():
+        return None
+    try:
+        return [r for r in read_results(path) if r.get(REFERENCE) is True]
+    except ResultsFileError as exc:
+        print(f"swarm-compare all: {exc}: the authors' code's runs left out")
+        return None
+
+
+def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[str, tuple[list[Verdict], dict]]]:
+    """comparison -> model -> (its verdicts, (claim id, cell) -> ours against the authors' code).
+    `by_model`: model -> the sweeps of ``all`` (each with ``comparison``, ``claims``, ``rows``,
+    ``extra``); one paper's claims on one model are judged together (one Holm family)."""
+    result: dict[str, dict[str, tuple[list[Verdict], dict]]] = {}
+    for model, sweeps in by_model.items():
+        names = list(dict.fromkeys(r.comparison.name for r in sweeps))
+        for name in names:
+            mine = [r for r in sweeps if r.comparison.name == name]
+            claims = [c for r in mine for c in r.claims]
+            ids = [c.id for c in claims]
+            if len(set(ids)) != len(ids):
+                raise ValueError(f"{name}: claim ids repeat: {sorted({i for i in ids if ids.count(i) > 1})}")
+            rows = {c.id: r.rows for r in mine for c in r.claims}
+            if not claims:  # a comparison that declares none has nothing to judge
+                continue
+            verdicts = evaluate(claims, rows)
+            reference = _reference(out, name)
+            against = {}
+            if reference is not None:
+                ref_rows = {c.id: [x for x in reference if all(x.get(k) == v for k, v in r.extra.items())]
+                            for r in mine for c in r.claims}
+                against = {}
+                for r in mine:
+                    found = evaluate_reference(r.claims, rows, ref_rows[r.claims[0].id]) if r.claims else {}
+                    against.update(found)
+            result.setdefault(name, {})[model] = (verdicts, against)
+    return result
+
+
+def report_verdicts(by_model: Mapping[str, Sequence[Any]], out: Path, titles: Mapping[str, str]) -> list[str]:
+    """The markdown lines of REPORT.md's verdicts (`judged`)."""
+    models = list(by_model)
+    title = {m: titles.get(m, m) for m in models}
+    papers = judged(by_model, out)
+    helps = {r.comparison.name: r.comparison.help for m in models for r in by_model[m]}
+    rules = {r.comparison.name: r.comparison.rules for m in models for r in by_model[m]}
+    lines = ["## Verdicts", "",
+             "Every number and stated relation of each paper's results is a claim (`claims.py` in its package): a "
+             "*level* (a table cell or a number in the text), a *relation* (B against A, with the paper's size) or a "
+             "*trend* (one strategy from its first to its last cell). One scale for all "
+             "(`swarm_sim.compare.verdicts`): *holds*: the direction is right, the difference significant and its "
+             "size within the band; *direction only*: right and significant, the size outside the band; *not "
+             "shown*: not significant (n ≈ the runs per group a power calculation says would show the paper's "
+             f"effect at our spread, two-sided α = {ALPHA}, power {POWER:.0%}; for a level, the runs that would put "
+             "its interval on one side of the band's nearer edge at our mean; none where the paper states no "
+             "size); *contradicts*: significant the "
+             "other way; *n/a*: too few runs. A level holds when its 95 % interval lies within the band, "
+             "contradicts when it lies wholly outside. The band: the paper's stated range, else "
+             f"±{LEVEL_BAND:.0%} of its number. One test everywhere: Welch's t, two-sided (one-sample against a "
+             "level's band), every p-value of a paper on a robot model Holm-corrected together; effects with 95 % "
+             f"intervals (a level's from t, a relation's by a seeded bootstrap of {BOOTSTRAP} resamples). The "
+             "intervals shown are the plain 95 % ones; the verdicts use the Holm-corrected p, so an interval just "
+             "clear of a band can still read *not shown*. A claim over several cells takes its worst cell.", ""]
+    header = ["paper", "robot model", *VERDICTS, "claims"]
+    body, totals = [], {m: dict.fromkeys(VERDICTS, 0) for m in models}
+    for name, per in papers.items():
+        for m in models:
+            if m not in per:
+                continue
+            c = counts(per[m][0])
+            for k, v in c.items():
+                totals[m][k] += v
+            body.append([name, title[m], *(str(c[v]) for v in VERDICTS), str(sum(c.values()))])
+    for m in models:
+        body.append(["**all**", title[m], *(f"**{totals[m][v]}**" for v in VERDICTS), f"**{sum(totals[m].values())}**"])
+    lines += md_table(header, body) + [""]
+    for m in models:
+        levels = [cv for per in papers.values() if m in per for v in per[m][0] if v.claim.kind == LEVEL
+                  for cv in v.cells]
+        within = sum(1 for cv in levels if math.isfinite(cv.effect) and cv.reason == "inside")
+        lines.append(f"{title[m]}: {totals[m][HOLDS]} of {sum(totals[m].values())} claims hold; level cells whose "
+                     f"mean lies within the band: {within} of {len(levels)} (holding: "
+                     f"{sum(1 for cv in levels if cv.verdict == HOLDS)}).")
+        lines.append("")
+    lines += _levels(papers, models, title, helps)
+    lines += _relations(papers, models, title)
+    lines += _causes(papers, models, title)
+    lines += _rules(rules)
+    return lines
+
+
+def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps: Mapping[str, str]) -> list[str]:
+    lines = ["## Levels: every number the papers print", "",
+             "`paper`: the paper's number (the band ±25 % unless the claim says); `ours`: mean ± the half-width of "
+             "its 95 % interval (n runs); `ratio`: ours / paper.", ""]
+    for name, per in papers.items():
+        lines += [f"### {name}: {helps.get(name, '')}", ""]
+        for m in models:
+            cells = [cv for v in per.get(m, ([], {}))[0] if v.claim.kind == LEVEL for cv in v.cells]
+            lines.append(f"- {title[m]}: mean within the band in {sum(cv.reason == 'inside' for cv in cells)} of "
+                         f"{len(cells)} cells, holding (the interval within) in "
+                         f"{sum(cv.verdict == HOLDS for cv in cells)}.")
+        lines.append("")
+        ref = any(per[m][1] for m in models if m in per)
+        header = ["claim", "where", "paper"]
+        for m in models:
+            header += [f"ours ({title[m]})", "n", "ratio", f"verdict ({title[m]})"]
+            if ref:
+                header += [f"authors' code here ({title[m]})", "ours vs authors' code"]
+        first = per[models[0]][0] if models[0] in per else []
+        body = []
+        for i, v in enumerate(first):
+            if v.claim.kind != LEVEL:
+                continue
+            for j, cv in enumerate(v.cells):
+                cell = "" if len(v.cells) == 1 else f" ({cv.cell})"
+                row = [f"`{v.claim.id}`{cell}: {v.claim.text}" + (f" ({v.claim.note})" if v.claim.note else ""),
+                       v.claim.where, v.claim.paper_text()]
+                for m in models:
+                    if m not in per:
+                        row += ["—"] * (6 if ref else 4)
+                        continue
+                    mine = per[m][0][i].cells[j]
+                    ratio = mine.effect / mine.means[1] if mine.means[1] and math.isfinite(mine.effect) else math.nan
+                    row += [_ci(mine), str(mine.n[0]), _num(ratio, 2), _bold(_verdict(mine))]
+                    if ref:
+                        against = per[m][1].get((v.claim.id, cv.cell))
+                        row += ([f"{_num(against.means[1])} (n={against.n[1]})",
+                                 f"{against.effect:+.1f} % [{against.ci[0]:+.1f}, {against.ci[1]:+.1f}]: "
+                                 f"{_verdict(against)}"] if against else ["—", "—"])
+                body.append(row)
+        lines += md_table(header, body) + [""]
+    return lines
+
+
+def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
+    lines = ["## Relations and trends", "",
+             "Each cell: B against A in % of A [95 % bootstrap interval], the Holm-corrected p, the cell's verdict; "
+             "a trend's cell is its first → last.", ""]
+    for name, per in papers.items():
+        lines += [f"### {name}", ""]
+        header = ["claim", "where", "kind", "paper"]
+        for m in models:
+            header += [f"ours ({title[m]})", f"verdict ({title[m]})"]
+        first = per[models[0]][0] if models[0] in per else []
+        body = []
+        for i, v in enumerate(first):
+            if v.claim.kind == LEVEL:
+                continue
+            c = v.claim
+            who = f"{c.b} vs {c.a}" if c.b else c.a
+            row = [f"`{c.id}`: {c.text} ({who})", c.where, c.kind, c.paper_text()]
+            for m in models:
+                if m not in per:
+                    row += ["—", "—"]
+                    continue
+                mine = per[m][0][i]
+                row += ["; ".join(_effect(cv) for cv in mine.cells), _bold(mine.verdict)]
+            body.append(row)
+        lines += md_table(header, body) + [""]
+    return lines
+
+
+def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
+    lines = ["## Causes of the claims that do not hold", "",
+             "Each claim that does not hold on a robot model, with its cause and the cause's grade: "
+             f"*{GRADES['measured']}* (that factor alone switched, at least 10 seeds, the gap closes by half or the "
+             f"verdict flips; numbers in FACTORS.md), *{GRADES['partial']}* (a factor sweep points to it, with fewer "
+             f"seeds or without closing the gap), *{GRADES['open']}* (not measured; what the text says is a lead, "
+             "not a cause). The evidence is in CAUSES.md below.", ""]
+    for name, per in papers.items():
+        body, grades = [], {}
+        first = per[models[0]][0] if models[0] in per else []
+        for i, v in enumerate(first):
+            mine = {m: per[m][0][i] for m in models if m in per}
+            failing = [m for m, x in mine.items() if x.verdict != HOLDS]
+            if not failing:
+                continue
+            causes = {m: v.claim.cause(m) for m in failing}
+            for m, cause in causes.items():
+                grade = cause.grade if cause else OPEN
+                grades[(m, grade)] = grades.get((m, grade), 0) + 1
+            texts = {}
+            for m, cause in causes.items():  # one line per distinct cause, naming its models
+                key = (cause.grade, cause.text) if cause else (OPEN, "no cause named")
+                texts.setdefault(key, []).append(title[m])
+            cause_text = "<br>".join((f"{', '.join(who)}: " if len(texts) > 1 else "") + f"*{GRADES[g]}*: {t}"
+                                     for (g, t), who in texts.items())
+            body.append([f"`{v.claim.id}`", *(mine[m].verdict if m in mine else "—" for m in models), cause_text])
+        if not body:
+            continue
+        summary = "; ".join(f"{title[m]}: " + ", ".join(f"{grades.get((m, g), 0)} {GRADES[g]}" for g in GRADES)
+                            for m in models)
+        lines += [f"### {name}", "", f"Claims not holding, by the grade of their cause: {summary}.", ""]
+        lines += md_table(["claim", *(f"verdict ({title[m]})" for m in models), "cause (grade)"], body) + [""]
+    return lines
+
+
+def _rules(rules: Mapping[str, Sequence[Any]]) -> list[str]:
+    body = [[name, r.scenarios, f"`{r.key}`", r.text, r.code, f"**{r.shipped}**", r.note]
+            for name, found in rules.items() for r in found]
+    lines = ["## Text vs the authors' code", "",
+             "Where a paper's text and its authors' published code disagree (or the text is silent and the code "
+             "decides), the rule each shipped scenario follows and the key that switches it.", ""]
+    if not body:
+        return lines + ["No comparison declares one.", ""]
+    return lines + md_table(["paper", "scenarios", "key", "the text", "the authors' code", "shipped follows", "note"],
+                            body) + [""]
