@@ -168,7 +168,7 @@ def write_report(by_model: Mapping[str, Sequence[SweepReport]], args: argparse.N
              + ": each section gives its run count). Every number labelled *paper* is the paper's, hard-coded from "
              "its text; every other number is ours, from `results.jsonl` beside each section's files.", ""]
     if len(models) > 1:
-        lines += ["Every sweep ran on two robot models (`swarm_sim.robots`, README *Robot models*): "
+        lines += ["Every sweep ran on two robot models (`swarm_sim.robots`, [docs/robot_models.md](../docs/robot_models.md)): "
                   + "; ".join(f"*{MODEL_TITLES.get(m, m)}* (`--robot-model {m}`, in `{m}/`)" for m in models)
                   + ".", ""]
     if args.duration is not None:
