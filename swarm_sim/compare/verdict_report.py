@@ -212,12 +212,21 @@ def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps:
                     row += [_ci(mine), str(mine.n[0]), _num(ratio, 2), _bold(_verdict(mine))]
                     if ref:
                         against = per[m][1].get((v.claim.id, cv.cell))
-                        row += ([f"{_num(against.means[1])} (n={against.n[1]})",
-                                 f"{against.effect:+.1f} % [{against.ci[0]:+.1f}, {against.ci[1]:+.1f}]: "
-                                 f"{_verdict(against)}"] if against else ["—", "—"])
+                        row += _against(against)
                 body.append(row)
         lines += md_table(header, body) + [""]
     return lines
+
+
+def _against(cv: CellVerdict | None) -> list[str]:
+    """The authors' code's cell and ours against it: its mean (n), our difference in % of it with
+    its interval and the verdict; a cell without enough runs for a test says only that."""
+    if cv is None:
+        return ["—", "—"]
+    mean = f"{_num(cv.means[1])} (n={cv.n[1]})"
+    if not math.isfinite(cv.effect):
+        return [mean, _verdict(cv)]
+    return [mean, f"{cv.effect:+.1f} % [{cv.ci[0]:+.1f}, {cv.ci[1]:+.1f}]: {_verdict(cv)}"]
 
 
 def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:

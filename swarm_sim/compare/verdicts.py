@@ -424,7 +424,9 @@ def against_reference(claim: Claim, ours: Sequence[float], reference: Sequence[f
     """Our runs against the authors' code's runs of the same cell, with a level's rule: the
     difference in % of the reference within ±`LEVEL_BAND` (Welch's two one-sided tests)."""
     if min(len(ours), len(reference)) < 2:
-        return _na(cell, (len(ours), len(reference)), f"{len(ours)} / {len(reference)} runs: no test")
+        means = tuple(float(np.mean(x)) if len(x) else math.nan for x in (ours, reference))
+        return replace(_na(cell, (len(ours), len(reference)), f"{len(ours)} / {len(reference)} runs: no test"),
+                       means=means)
     d, se, df = _welch(reference, ours)
     ref = float(np.mean(reference))
     if ref == 0:
