@@ -31,13 +31,13 @@ from typing import Any
 
 import numpy as np
 
-from swarm_msgs_py.server_outputs import outputs_of
+from swarm_msgs_py.types import Command
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch
+from swarm_sim.outputs import outputs_of
 from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
-from swarm_sim.types import Command
 from swarm_sim.world import World
 
 ROS_BLOCKER = textwrap.dedent(

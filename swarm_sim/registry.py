@@ -43,9 +43,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from swarm_msgs_py.topics import heard
+from swarm_msgs_py.types import robot_index
 from swarm_sim.presentation import Measure, Panel
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import robot_index
 
 if TYPE_CHECKING:
     from swarm_sim.protocol import Server
@@ -68,7 +68,7 @@ class ServerSpec:
     """``module:FAMILY``: the message family (`swarm_msgs_py.records.MessageFamily`) it speaks
     with the robots: it hears the family's messages on its channel and sends the others."""
     outputs: str | None = None
-    """``module:OUTPUTS`` (`swarm_msgs_py.server_outputs.ServerOutputs`): what its node publishes
+    """``module:OUTPUTS`` (`swarm_sim.outputs.ServerOutputs`): what its node publishes
     besides the family's messages (state topics, markers) and the run trace's time series read
     off what it publishes, the same in batch runs and bag replays (None: nothing)."""
     name: str = ""
@@ -199,7 +199,7 @@ class Algorithm:
     """The paper's own measures, as a run's text summary shows them (after its task's)."""
     progress: str | None = None
     """``module:function`` ``(statuses) -> str``: what the world node's progress line says of the
-    run, from every robot's last reported status (`swarm_sim.types.BehaviourStatus`, by robot;
+    run, from every robot's last reported status (`swarm_msgs_py.types.BehaviourStatus`, by robot;
     e.g. the caging stage); None: its world task's ``progress()`` (deliveries)."""
     panels: tuple[Panel, ...] = ()
     """Its own panels of a run's summary figure (after its task's): e.g. its servers' series."""

@@ -14,8 +14,8 @@ import pytest
 from depot_manager.codec import DEPOT_GRANTS, DEPOT_REPORTS, RADIO_TOPIC
 from swarm_controllers.cpfa.codec import PHEROMONES_TOPIC
 from swarm_msgs_py import topics
-from swarm_msgs_py.server_outputs import Series, SeriesLog, ServerOutputs
 from swarm_sim import registry
+from swarm_sim.outputs import Series, SeriesLog, ServerOutputs
 from swarm_sim.scenario import ScenarioError, load_scenario
 
 REPO = Path(__file__).resolve().parents[1]

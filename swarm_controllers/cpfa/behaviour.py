@@ -96,10 +96,10 @@ from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.motion import Avoidance, Drive, drive_for
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.messaging import per_inbox
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, slot_constructor
 
 _TWO_PI = 2.0 * math.pi
 _IDLE = (0.0, 0.0)

@@ -64,10 +64,10 @@ from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
 from swarm_controllers.motion import drive_for
+from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.messaging import per_inbox
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 
 _new_status = slot_constructor(BehaviourStatus)
 

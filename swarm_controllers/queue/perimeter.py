@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from swarm_msgs_py.types import NS_PER_S, DropEvent, RobotId
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import NS_PER_S, DropEvent, RobotId
 
 PROBE = "perimeter"
 """The probe's name: its crossings are ``RunTrace.probes["perimeter"]``."""

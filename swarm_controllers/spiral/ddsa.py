@@ -94,7 +94,7 @@ from swarm_controllers.motion import Drive, drive_for
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.geometry import SpiralPath, ddsa_path
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import (
+from swarm_msgs_py.types import (
     STOP,
     BehaviourStatus,
     Command,

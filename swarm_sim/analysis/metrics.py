@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 from swarm_sim import registry
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 
 @dataclass

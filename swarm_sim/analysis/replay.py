@@ -23,15 +23,15 @@ import numpy as np
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, scan, topics
-from swarm_msgs_py.server_outputs import SeriesLog
+from swarm_msgs_py.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
 from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.inbound import Bounds, Inbound, Rejections
 from swarm_sim.messaging import delivery_order
+from swarm_sim.outputs import SeriesLog
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
-from swarm_sim.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
 
 
 class MalformedMessageWarning(UserWarning):

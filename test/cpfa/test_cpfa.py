@@ -25,11 +25,11 @@ from swarm_controllers.cpfa.behaviour import (
 )
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.messages import PheromoneMessage
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("cpfa")

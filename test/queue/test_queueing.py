@@ -24,9 +24,9 @@ from swarm_controllers.queue.behaviour import (
     QueueBehaviour,
     _segment_hits_disc,
 )
+from swarm_msgs_py.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
-from swarm_sim.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROBOTS = 16
@@ -114,7 +114,7 @@ def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
 def test_a_non_carrier_is_steered_out_of_the_perimeter():
     scenario = generic_scenario("queue_qmt", ["robots.count=1"])
     b = QueueBehaviour(scenario, "robot_0", np.random.default_rng(0))
-    from swarm_sim.types import Observation, Pose2D
+    from swarm_msgs_py.types import Observation, Pose2D
 
     ranges = np.full(scenario.sensors.scan.rays, np.inf, dtype=np.float32)
     obs = Observation("robot_0", 0, Pose2D(1.0, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), False))
@@ -169,7 +169,7 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
 def test_dropoff_time_stops_at_the_dock_before_t_unload():
     from swarm_controllers.queue.perimeter import PROBE, Crossings, dock_arrival_s, dropoff_times
     from swarm_sim.analysis.metrics import RunTrace
-    from swarm_sim.types import DropEvent
+    from swarm_msgs_py.types import DropEvent
 
     s = generic_scenario("queue_qmt")
     drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)

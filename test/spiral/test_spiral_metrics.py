@@ -5,10 +5,10 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from swarm_controllers.spiral.metrics import resources_per_robot_per_min
+from swarm_msgs_py.types import NS_PER_S, DropEvent
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NS_PER_S, DropEvent
 
 
 def trace(drop_times_s, seconds=180.0, robots=4):
