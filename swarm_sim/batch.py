@@ -74,9 +74,9 @@ def _few_collections() -> Iterator[None]:
 
 
 def make_probes(scenario: Scenario, robots: tuple[str, ...]) -> dict[str, Any]:
-    """The observers of the probes that measure the run's task (`swarm_sim.registry.Probe`), by
-    name; each is fed the odometry positions at the start of every tick and after the last."""
-    return {p.name: resolve(p.observer)(scenario, robots) for p in registered_probes(of(scenario).task)}
+    """The observers of the probes the run asks for (`swarm_sim.registry.Probe`), by name; each is
+    fed the odometry positions at the start of every tick and after the last."""
+    return {p.name: resolve(p.observer)(scenario, robots) for p in registered_probes(scenario)}
 
 
 def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:

@@ -204,7 +204,7 @@ def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch
     graph = json.loads(result.stdout.strip().splitlines()[-1])
     for key in (*GRAPH_COMPARED, *(field for p in registry.probes() for field, _ in p.details)):
         if key not in graph and key not in batch_summary:
-            continue  # a probe of another world task
+            continue  # a probe this run does not ask for
         if graph.get(key) != batch_summary.get(key):
             _fail("graph_equals_batch", f"{key}: graph {graph.get(key)!r} != batch {batch_summary.get(key)!r}")
     odometry = load_odometry(bag)

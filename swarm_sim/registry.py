@@ -98,8 +98,7 @@ class TaskSpec:
     headline: tuple[Measure, ...] = ()
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
     extends: str | None = None
-    """The task it builds on (the DRTM nest is the foraging task with food and a light): the
-    probes of that task measure its runs too."""
+    """The task it builds on (the DRTM nest is the foraging task with food and a light)."""
     panels: tuple[Panel, ...] = ()
     """Its panels of a run's summary figure (before its algorithm's)."""
     bodies: str | None = None
@@ -112,14 +111,12 @@ class TaskSpec:
 
 @dataclass(frozen=True)
 class Probe:
-    """A measurement a package makes in every run of the world tasks it names, beyond the tasks'
-    own metrics (the queue paper's perimeter crossings, which it reports for every foraging run):
-    an observer of the robots' odometry positions, fed every tick by the batch runner as they
-    are stepped and by the bag replay as they were recorded, and the result fields it yields."""
+    """A measurement a package makes beyond the world task's own metrics, in the runs that ask
+    for it (their delivery kind names it, `DeliveryKind.probes`): an observer of the robots'
+    odometry positions, fed every tick by the batch runner as they are stepped and by the bag
+    replay as they were recorded, and the result fields it yields."""
 
     name: str
-    tasks: tuple[str, ...]
-    """The world tasks whose runs it measures."""
     observer: str
     """``module:Class`` built as ``Class(scenario, robots)``; ``update(t [s], xy)`` with the
     (robots, 2) odometry positions [m, world frame] every tick; ``result()`` -> what its metrics
@@ -146,16 +143,20 @@ class DeliveryKind:
     checks: tuple[str, ...] = ()
     """``module:function`` ``(scenario) -> None`` raising ValueError naming the key at fault:
     what a scenario delivering this way must satisfy."""
+    world: tuple[tuple[str, str], ...] = ()
+    """(section, ``module:Dataclass``): the world facts its zones are made of, each a top-level
+    scenario section (a `swarm_sim.scenario.WorldSection`)."""
+    probes: tuple[str, ...] = ()
+    """The probes (`Probe`) that measure the runs delivering this way."""
 
 
 @dataclass(frozen=True)
 class Metric:
-    """A JSON result field an algorithm adds; runs of other algorithms report `default`."""
+    """A JSON result field an algorithm adds; only its own runs' rows carry it."""
 
     name: str
     function: str
     """``module:function`` ``(trace) -> value``."""
-    default: Any = None
 
 
 @dataclass(frozen=True)
@@ -306,9 +307,11 @@ def register_task(task: TaskSpec) -> TaskSpec:
 
 
 def register_delivery(kind: DeliveryKind) -> DeliveryKind:
-    """Make delivery kind `kind` known; refuses a second record of the same name."""
+    """Make delivery kind `kind` known; refuses a second record of the same name or a world
+    section already declared with another dataclass."""
     if kind.name in _DELIVERIES:
         raise ValueError(f"delivery kind {kind.name!r} is already registered")
+    _refuse_redeclared(kind.world, _declared_world(), "")
     _DELIVERIES[kind.name] = kind
     return kind
 
@@ -321,15 +324,13 @@ def register_probe(probe: Probe) -> Probe:
     return probe
 
 
-def probes(task_name: str | None = None) -> tuple[Probe, ...]:
-    """The probes that measure runs of world task `task_name` or of a task it extends (None:
-    every probe)."""
+def probes(scenario: Scenario | None = None) -> tuple[Probe, ...]:
+    """The probes that measure runs of `scenario`: those its delivery kind asks for (None: every
+    probe)."""
     _load_entries()
-    lineage = set()
-    while task_name is not None and task_name not in lineage:
-        lineage.add(task_name)
-        task_name = _TASKS[task_name].extends if task_name in _TASKS else None
-    return tuple(p for p in _PROBES.values() if not lineage or lineage & set(p.tasks))
+    if scenario is None:
+        return tuple(_PROBES.values())
+    return tuple(_PROBES[name] for name in delivery_kind(scenario.depot.delivery).probes)
 
 
 def register_default_scenario(name: str) -> None:
@@ -393,7 +394,7 @@ def _declared_config() -> dict[str, str]:
 
 
 def _declared_world() -> dict[str, str]:
-    records = (*_TASKS.values(), *_ALGORITHMS.values())
+    records = (*_TASKS.values(), *_ALGORITHMS.values(), *_DELIVERIES.values())
     return {name: path for r in records for name, path in r.world}
 
 

@@ -135,7 +135,7 @@ def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_pa
 
 def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(launch, tmp_path):
     run = launch("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", "--controller-processes", "0",
-                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "depot.unload_time=20.0", "robots.model=generic"]))
+                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "docking.unload_time=20.0", "robots.model=generic"]))
     run.wait_until(lambda: _dock_occupant(run.bag), timeout=120, what="a robot at a dock")
     victim = _dock_occupant(run.bag)
     os.kill(run.child("swarm_sim.nodes.controller_node", victim), signal.SIGKILL)

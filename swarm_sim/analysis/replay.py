@@ -226,7 +226,7 @@ def _probes(trace: RunTrace, positions: dict[int, np.ndarray]) -> dict[str, Any]
     """Replay the recorded odometry through the probes the batch runner feeds live
     (`swarm_sim.registry.Probe`; a robot missing from a tick keeps its previous position)."""
     observers = {p.name: registry.resolve(p.observer)(trace.config, trace.robots)
-                 for p in registry.probes(registry.of(trace.config).task)}
+                 for p in registry.probes(trace.config)}
     previous = np.full((len(trace.robots), 2), np.inf)
     for stamp in sorted(positions):
         xy = positions[stamp]

@@ -13,7 +13,7 @@ from generic_robot import generic_scenario
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from depot_manager.config import QueueConfig
+from depot_manager.config import DockingConfig, QueueConfig
 from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
 from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.queue.behaviour import (
@@ -64,7 +64,7 @@ def test_only_carriers_enter_the_perimeter(run):
     scenario, result = run
     poses, trace = result.poses, result.trace
     dt = scenario.sim.dt
-    R = scenario.depot.perimeter_radius - scenario.robots.diameter / 2
+    R = DockingConfig.of(scenario).perimeter_radius - scenario.robots.diameter / 2
     r = np.hypot(poses[..., 0], poses[..., 1])
     for i, robot in enumerate(trace.robots):
         picks = sorted(p.stamp_ns / NS_PER_S for p in trace.pickups if p.robot == robot)
@@ -83,7 +83,7 @@ def test_only_carriers_enter_the_perimeter(run):
 
 def test_queue_lengths_are_recorded(run):
     scenario, result = run
-    lines = 1 if QueueConfig.of(scenario).wrapping == "single" else scenario.depot.docks
+    lines = 1 if QueueConfig.of(scenario).wrapping == "single" else DockingConfig.of(scenario).docks
     assert result.trace.series["queue_lengths"], "the depot server recorded no queue lengths"
     assert all(len(q) == lines for _, q in result.trace.series["queue_lengths"])
 
@@ -176,8 +176,8 @@ def test_dropoff_time_stops_at_the_dock_before_t_unload():
     trace = RunTrace("queue_qmt", 0, ("robot_0",), 120.0, 1.0, 320, "batch", drops=[drop], config=s,
                      probes={PROBE: Crossings(entries={"robot_0": [10.0, 40.0]})})
     # the foraging task drops on the first tick the carrier has been inside for T_unload
-    assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - s.depot.unload_time)
-    assert dropoff_times(trace) == [pytest.approx(100.0 - s.depot.unload_time - 40.0)]
+    assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - DockingConfig.of(s).unload_time)
+    assert dropoff_times(trace) == [pytest.approx(100.0 - DockingConfig.of(s).unload_time - 40.0)]
 
 
 class _Everyone:
@@ -318,7 +318,7 @@ def test_a_tail_seeker_falls_back_to_entry_joining_after_seek_timeout(timeout):
     assert QueueConfig.of(s).seek_timeout == timeout
     b = make_behaviour(s, "robot_0", np.random.default_rng(0))
     ranges = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
-    x = s.depot.perimeter_radius - 0.1  # inside the perimeter, carrying: it starts seeking
+    x = DockingConfig.of(s).perimeter_radius - 0.1  # inside the perimeter, carrying: it starts seeking
     phases = []
     for k in range(40):  # 4 s, standing where it is (nobody answers)
         b.step(Observation("robot_0", k * s.dt_ns, Pose2D(x, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), True)))
