@@ -257,8 +257,9 @@ def _load_entries() -> None:
 
 
 def origin(kind: str, name: str) -> str:
-    """The entry point (a package's registration) that registered algorithm or task `name`
-    (`kind` ``algorithm`` or ``task``); empty if it was registered by a direct call."""
+    """The entry point (a package's registration) that registered algorithm, task or delivery
+    kind `name` (`kind` ``algorithm``, ``task`` or ``delivery``); empty if it was registered by a
+    direct call."""
     _load_entries()
     return _ORIGINS.get(f"{kind}:{name}", "")
 
@@ -313,6 +314,7 @@ def register_delivery(kind: DeliveryKind) -> DeliveryKind:
         raise ValueError(f"delivery kind {kind.name!r} is already registered")
     _refuse_redeclared(kind.world, _declared_world(), "")
     _DELIVERIES[kind.name] = kind
+    _ORIGINS[f"delivery:{kind.name}"] = _loading
     return kind
 
 

@@ -9,14 +9,18 @@ new module is checked without being listed."""
 from __future__ import annotations
 
 import ast
+import dataclasses
 import io
+import re
 import tokenize
-from collections.abc import Iterator
+import typing
+from collections.abc import Iterable, Iterator
 from importlib.metadata import entry_points
 from pathlib import Path
 
 from swarm_sim import registry
 from swarm_sim.outputs import outputs_of
+from swarm_sim.scenario import Scenario
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("swarm_sim", "swarm_controllers", "swarm_msgs_py", "depot_manager", "launch_py")
@@ -168,16 +172,37 @@ def test_function_local_imports_of_project_modules_say_why():
     assert unexplained == []
 
 
+def _field_names(cls: type) -> set[str]:
+    """The field names of a section's dataclass and of the dataclasses among its fields' types."""
+    hints = typing.get_type_hints(cls)
+    out = set()
+    for f in dataclasses.fields(cls):
+        out.add(f.name)
+        for tp in (hints[f.name], *typing.get_args(hints[f.name])):
+            if isinstance(tp, type) and dataclasses.is_dataclass(tp):
+                out |= _field_names(tp)
+    return out
+
+
+CORE_FIELDS = _field_names(Scenario)
+"""The shared scenario's own field names: a paper's section may reuse them (a ``radius``)."""
+
+
 def _paper_names() -> dict[str, tuple[set[str], set[str]]]:
     """Per paper (the entry point that registers it), the names only it may use: (names code may
-    not spell as a string: its algorithms, world tasks, config sections, server channels and
-    absolute topics; names it may not use at all: its metric fields). Channels and sections are
-    often plain words (a server's ``center``), so only a string can switch on them."""
+    not spell as a string: its algorithms, world tasks, config and world sections, server
+    channels and absolute topics; names it may not use at all: its metric fields). Channels and
+    sections are often plain words (a server's ``center``), so only a string can switch on them."""
     names: dict[str, tuple[set[str], set[str]]] = {}
+
+    def add_sections(paper: str, sections: Iterable[tuple[str, str]]) -> None:
+        names.setdefault(paper, (set(), set()))[0].update(section for section, _ in sections)
+
     for a in registry.algorithms():
         paper = registry.origin("algorithm", a.name)
         strings, fields = names.setdefault(paper, (set(), set()))
-        strings |= {a.name, *(s for s, _ in a.config), *(s.channel for s in a.servers)}
+        strings |= {a.name, *(s.channel for s in a.servers)}
+        add_sections(paper, (*a.config, *a.world))
         fields |= {m.name for m in a.metrics}
         families = [registry.resolve(f) for f in (*a.peers, *(s.family for s in a.servers))]
         strings |= {t for f in families for t in f.topics.values()}
@@ -187,8 +212,29 @@ def _paper_names() -> dict[str, tuple[set[str], set[str]]]:
             task = registry.task(a.task)
             strings.add(task.name)
             strings |= {t.topic for t in registry.resolve(task.state)} if task.state else set()
+            add_sections(paper, task.world)
+    for kind in map(registry.delivery_kind, registry.delivery_kinds()):
+        if registry.origin("delivery", kind.name) in names:
+            add_sections(registry.origin("delivery", kind.name), kind.world)
     assert "core" not in names, f"the core registers algorithms: {names.get('core')}"
     return names
+
+
+def _section_fields() -> dict[str, set[str]]:
+    """Per paper, the field names of its config and world sections that shared code may use
+    nowhere, docstrings and comments included: those of more than one word (a bare ``step`` or
+    ``order`` is everyone's word), the shared scenario's own left out."""
+    out: dict[str, set[str]] = {}
+    records = [(registry.origin("algorithm", a.name), (*a.config, *a.world)) for a in registry.algorithms()]
+    records += [(registry.origin("task", t.name), t.world) for t in {registry.task(a.task) for a in registry.algorithms()}]
+    records += [(registry.origin("delivery", k.name), k.world)
+                for k in map(registry.delivery_kind, registry.delivery_kinds())]
+    for paper, sections in records:
+        for _, path in sections:
+            fields = _field_names(registry.resolve(path)) - CORE_FIELDS
+            out.setdefault(paper, set()).update(f for f in fields if "_" in f)
+    out.pop("core", None)
+    return out
 
 
 def _code_words(path: Path) -> tuple[set[str], set[str]]:
@@ -216,8 +262,21 @@ def _code_words(path: Path) -> tuple[set[str], set[str]]:
     return names, strings
 
 
+def _doc_words(path: Path) -> set[str]:
+    """The words of a file's docstrings and comments."""
+    source = path.read_text()
+    texts = [node.value.value for node in ast.walk(ast.parse(source))
+             if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)]
+    texts += [tok.string for tok in tokenize.generate_tokens(io.StringIO(source).readline) if tok.type == tokenize.COMMENT]
+    return set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", " ".join(texts)))
+
+
 def test_no_paper_name_outside_its_package():
-    papers = _paper_names()
+    """Shared code spells no paper's names, uses none of its metric fields, and names none of its
+    sections' fields, not even in a docstring or a comment (the queue paper's docks once sat in
+    the shared depot section)."""
+    papers, sections = _paper_names(), _section_fields()
+    assert {"dock_radius", "perimeter_radius", "lane_spacing"} <= sections["queue"]
     assert {"cpfa", "queue", "spiral", "drtm", "caging"} <= set(papers)
     found = []
     for module, path in MODULES.items():
@@ -225,8 +284,9 @@ def test_no_paper_name_outside_its_package():
         if not shared:
             continue
         identifiers, strings = _code_words(path)
+        words = identifiers | strings | _doc_words(path)
         for paper, (spelt, fields) in papers.items():
-            hits = ((spelt | fields) & strings | fields & identifiers) - set(COMMON_WORDS)
+            hits = ((spelt | fields) & strings | fields & identifiers | sections.get(paper, set()) & words) - set(COMMON_WORDS)
             # an absolute topic inside a longer string too (a script, a command line)
             hits |= {t for t in spelt if t.startswith("/") for text in strings if t in text}
             if hits:
@@ -281,6 +341,7 @@ def test_the_checks_can_fail(tmp_path):
     bad = tmp_path / "bad.py"
     bad.write_text('"""doc queue"""\nx = "queue"  # depot\n')
     assert _code_words(bad) == ({"x"}, {"queue"})
+    assert _doc_words(bad) == {"doc", "queue", "depot"}
     ros = tmp_path / "ros.py"
     ros.write_text("import os\ndef f():\n    from std_msgs.msg import Header\n    import rclpy.node\n")
     assert _ros_imports(ros) == ["std_msgs.msg", "rclpy.node"]
