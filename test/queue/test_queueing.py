@@ -168,8 +168,8 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
 
 def test_dropoff_time_stops_at_the_dock_before_t_unload():
     from swarm_controllers.queue.perimeter import PROBE, Crossings, dock_arrival_s, dropoff_times
-    from swarm_sim.analysis.metrics import RunTrace
     from swarm_msgs_py.types import DropEvent
+    from swarm_sim.analysis.metrics import RunTrace
 
     s = generic_scenario("queue_qmt")
     drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)
