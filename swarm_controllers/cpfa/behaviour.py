@@ -207,10 +207,9 @@ class CpfaBehaviour:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
         give-up return ends at its edge. None: the depot disc (the plain CPFA). perimeter [m]: the
-        queue strategies' perimeter radius, with keep_out: a give-up return's blind leg ends
-        `RIM_MARGIN` outside it. drive: the robot's
-        motion layer when another behaviour owns it (the queue strategies'; default: the robot
-        model's, `swarm_controllers.motion.drive_for`)."""
+        queue strategies' perimeter radius, given with keep_out: a give-up return's blind leg ends
+        `RIM_MARGIN` outside it. drive: the robot's motion layer when another behaviour owns it
+        (the queue strategies'; default: the robot model's, `swarm_controllers.motion.drive_for`)."""
         cfg = CpfaConfig.of(scenario)
         dt = scenario.sim.dt
         self.robot = robot
