@@ -26,10 +26,10 @@ import numpy as np
 from profile_batch import scaled_fields
 
 import swarm_sim.batch as batch
+from swarm_msgs_py.types import Observation, Pose2D
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import Observation, Pose2D
 
 
 def _scenario(name: str, robots: int, duration: float, seed: int) -> Scenario:

@@ -30,9 +30,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import rclpy  # noqa: E402
 
-from swarm_controllers.controller_node import ControllerConfig, ControllerNode  # noqa: E402
 from swarm_msgs_py import topics  # noqa: E402
-from swarm_msgs_py.executor import share_sim_time  # noqa: E402
+from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode  # noqa: E402
+from swarm_sim.nodes.executor import share_sim_time  # noqa: E402
 from swarm_sim.recording import bag_info, read_bag  # noqa: E402
 from swarm_sim.scenario import scenario_from_dict  # noqa: E402
 

@@ -29,9 +29,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from swarm_msgs_py.types import Command  # noqa: E402
 from swarm_sim.registry import task_factory  # noqa: E402
 from swarm_sim.scenario import load_scenario  # noqa: E402
-from swarm_sim.types import Command  # noqa: E402
 from swarm_sim.world import World  # noqa: E402
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet  # noqa: E402
 
@@ -195,7 +195,7 @@ def bench_raycast(repeats: int = 200) -> None:
 
 
 def _pose(xy, yaw):
-    from swarm_sim.types import Pose2D
+    from swarm_msgs_py.types import Pose2D
 
     return Pose2D(float(xy[0]), float(xy[1]), float(yaw))
 

@@ -8,6 +8,11 @@ before and after a change must be identical line for line:
     .venv/bin/python benchmarks/results_fingerprint.py --out before.jsonl
     ... change ...
     .venv/bin/python benchmarks/results_fingerprint.py --compare before.jsonl
+
+--compare judges the poses hash and every field present on both sides. A field on one side only
+is not a change of result: a row carries only its own paper's fields (issue 38), so a file
+written before that holds other papers' fields as None. Those are counted as padding; any other
+one-sided field is named (a probe the run no longer asks for, say).
 """
 
 from __future__ import annotations
@@ -58,10 +63,15 @@ def main(argv: list[str] | None = None) -> int:
             if keys or not old:
                 changed.append(new["scenario"])
                 print(f"CHANGED {new['scenario']}: {', '.join(keys) or 'not in the earlier file'}", file=sys.stderr)
-            elif set(old) != set(new):  # a field another registered algorithm adds is not a change of result
-                print(f"{new['scenario']}: fields only before {sorted(set(old) - set(new))}, "
-                      f"only now {sorted(set(new) - set(old))}", file=sys.stderr)
-        print(f"{len(rows) - len(changed)}/{len(rows)} scenarios identical", file=sys.stderr)
+            elif set(old) != set(new):
+                padding = [k for k in set(old) ^ set(new) if {**old, **new}[k] is None]
+                only_before = sorted(k for k in set(old) - set(new) if k not in padding)
+                only_now = sorted(k for k in set(new) - set(old) if k not in padding)
+                print(f"{new['scenario']}: identical on the {len(set(old) & set(new))} fields of both; "
+                      f"{len(padding)} None fields on one side only; other fields only before {only_before}, "
+                      f"only now {only_now}", file=sys.stderr)
+        print(f"{len(rows) - len(changed)}/{len(rows)} scenarios identical (poses and every field of both)",
+              file=sys.stderr)
         return 1 if changed else 0
     return 0
 

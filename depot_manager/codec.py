@@ -20,7 +20,7 @@ from depot_manager.server import MARKER_PERIOD, draw
 from depot_manager.state import DepotView, decode_depot_state, encode_depot_state
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
-from swarm_msgs_py.server_outputs import LivePlot, Series, ServerMarkers, ServerOutputs, ServerState
+from swarm_sim.outputs import LivePlot, Series, ServerMarkers, ServerOutputs, ServerState
 
 DEPOT_REPORTS = "/depot/reports"
 DEPOT_GRANTS = "/depot/grants"

@@ -1,13 +1,15 @@
-"""The queue strategies' scenario section (``controller.queue``), read by the depot manager and
-by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII); its check, that
-the layout fits the depot, is `depot_manager.geometry.check_queue`."""
+"""The queue paper's scenario sections: the queue strategies' (``controller.queue``), read by the
+depot manager and by the robots' queue behaviour alike (queue_depot_traffic.md secs. IV, V, VII;
+its check, that the layout fits the depot, is `depot_manager.geometry.check_queue`), and the
+perimeter and docks around the depot (``docking``, a world section)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
-from swarm_sim.scenario.schema import Section
+from swarm_sim.scenario.schema import Section, WorldSection
 
 
 @dataclass(frozen=True)
@@ -43,3 +45,44 @@ class QueueConfig(Section):
 
     SECTION: ClassVar[str] = "queue"
 
+
+
+@dataclass(frozen=True)
+class DockingConfig(WorldSection):
+    """The depot's surroundings in the queue paper (sec. III, Fig. 2): the perimeter (red circle)
+    around the depot and the K docks on its boundary; the scenario's ``docking`` section, declared
+    by the ``docks`` delivery kind (`swarm_controllers.queue.registration`). Its checks against the
+    depot and the arena are `depot_manager.docks.check_docks`.
+
+    Bags recorded before this section existed carry its fields under ``depot``; `MOVED` names
+    them, and the loader of a recorded scenario carries them here
+    (`swarm_sim.scenario.scenario_from_dict`)."""
+
+    perimeter_radius: float = 2.0
+    """Radius of the perimeter (red circle) [m] around the depot; the paper's drop-off time runs
+    from a carrier's entry into it."""
+    docks: int = 4
+    """Number K of docks on the depot boundary."""
+    unload_time: float = 5.0
+    """T_unload: a robot stays at its dock this long before its resource is dropped [s]. The
+    paper gives no value; 5 s is our choice."""
+    dock_radius: float = 0.06
+    """A robot unloads while its centre is within this distance of the dock stop [m]."""
+    dock_distance: float | None = None
+    """Distance of the dock stops from the depot centre [m]; None: one robot radius outside
+    the depot disc (where the queue layouts end)."""
+
+    SECTION: ClassVar[str] = "docking"
+    MOVED: ClassVar[Mapping[str, str]] = {
+        f"depot.{name}": name for name in ("perimeter_radius", "docks", "unload_time", "dock_radius", "dock_distance")
+    }
+
+    def check(self) -> None:
+        if self.unload_time < 0:
+            raise ValueError("docking.unload_time: must not be negative")
+        if self.dock_radius <= 0:
+            raise ValueError("docking.dock_radius: must be positive")
+        if self.docks < 1:
+            raise ValueError("docking.docks: need at least one dock")
+        if self.dock_distance is not None and self.dock_distance <= 0:
+            raise ValueError("docking.dock_distance: must be positive")

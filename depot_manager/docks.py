@@ -2,8 +2,8 @@
 delivery kind they make (registered in `swarm_controllers.queue.registration`): resources are
 delivered only at a dock, after T_unload there.
 
-ROS-free world facts computed from the scenario's ``depot`` section (``docks``, ``dock_radius``,
-``dock_distance``, ``unload_time``, ``perimeter_radius``); the queue geometry
+ROS-free world facts computed from the scenario's ``depot`` disc and its ``docking`` section
+(`depot_manager.config.DockingConfig`); the queue geometry
 (`depot_manager.geometry`), the CPFA baseline's carriers (through their drop zones) and the
 metrics take their docks from here.
 """
@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from depot_manager.config import DockingConfig
 from swarm_sim.scenario.schema import DropZoneConfig, Scenario
 
 
@@ -42,7 +43,7 @@ def docks(center: tuple[float, float], depot_radius: float, robot_diameter: floa
           stop_radius: float | None = None) -> tuple[Dock, ...]:
     """`count` docks evenly spaced on the depot boundary, CCW from +x (queue paper Fig. 2); a
     robot unloads with its centre one robot radius outside the boundary, or `stop_radius` [m]
-    from the centre when given (``depot.dock_distance``)."""
+    from the centre when given (``docking.dock_distance``)."""
     c = np.asarray(center, dtype=float)
     if stop_radius is None:
         stop_radius = depot_radius + robot_diameter / 2.0
@@ -54,24 +55,30 @@ def docks(center: tuple[float, float], depot_radius: float, robot_diameter: floa
 
 
 def scenario_docks(scenario: Scenario) -> tuple[Dock, ...]:
-    """The scenario's docks (``depot.docks`` on the depot disc)."""
-    d = scenario.depot
-    return docks(d.center, d.radius, scenario.robots.diameter, d.docks, d.dock_distance)
+    """The scenario's docks (``docking.docks`` on the depot disc)."""
+    d, k = scenario.depot, DockingConfig.of(scenario)
+    return docks(d.center, d.radius, scenario.robots.diameter, k.docks, k.dock_distance)
 
 
 def dock_zones(scenario: Scenario) -> tuple[DropZoneConfig, ...]:
-    """The ``docks`` delivery kind's zones: one per dock stop, of radius ``depot.dock_radius``,
-    where a carrier stays ``depot.unload_time`` before its resource is dropped."""
-    d = scenario.depot
+    """The ``docks`` delivery kind's zones: one per dock stop, of radius ``docking.dock_radius``,
+    where a carrier stays ``docking.unload_time`` before its resource is dropped."""
+    k = DockingConfig.of(scenario)
     return tuple(
-        DropZoneConfig(f"dock_{k.index}", (float(k.stop[0]), float(k.stop[1])), d.dock_radius, d.unload_time, "dock")
-        for k in scenario_docks(scenario)
+        DropZoneConfig(f"dock_{d.index}", (float(d.stop[0]), float(d.stop[1])), k.dock_radius, k.unload_time, "dock")
+        for d in scenario_docks(scenario)
     )
 
 
 def check_docks(scenario: Scenario) -> None:
-    """A scenario delivering at the docks needs its perimeter inside the arena (ValueError
-    naming the key)."""
-    d, half = scenario.depot, scenario.arena.size / 2
-    if not (abs(d.center[0]) + d.perimeter_radius <= half and abs(d.center[1]) + d.perimeter_radius <= half):
-        raise ValueError(f"depot.perimeter_radius: a perimeter of {d.perimeter_radius} m does not fit in the arena")
+    """A scenario delivering at the docks needs its docks side by side around the depot and its
+    perimeter around the depot and inside the arena (ValueError naming the key)."""
+    d, k, half = scenario.depot, DockingConfig.of(scenario), scenario.arena.size / 2
+    diameter = scenario.robots.diameter
+    stop = d.radius + diameter / 2 if k.dock_distance is None else k.dock_distance
+    if k.docks > 1 and 2 * stop * math.sin(math.pi / k.docks) < diameter:
+        raise ValueError(f"docking.docks: {k.docks} docks do not fit side by side {stop} m from the depot centre")
+    if k.perimeter_radius <= d.radius:
+        raise ValueError("docking.perimeter_radius: must exceed depot.radius")
+    if not (abs(d.center[0]) + k.perimeter_radius <= half and abs(d.center[1]) + k.perimeter_radius <= half):
+        raise ValueError(f"docking.perimeter_radius: a perimeter of {k.perimeter_radius} m does not fit in the arena")

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from depot_manager.config import QueueConfig
+from depot_manager.config import DockingConfig, QueueConfig
 from depot_manager.docks import Dock, docks
 
 if TYPE_CHECKING:
@@ -65,10 +65,10 @@ class DepotGeometryConfig:
 
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> DepotGeometryConfig:
-        d = scenario.depot
+        d, k = scenario.depot, DockingConfig.of(scenario)
         return cls(
-            depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=d.perimeter_radius,
-            docks=d.docks, lane_spacing=QueueConfig.of(scenario).lane_spacing,
+            depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=k.perimeter_radius,
+            docks=k.docks, lane_spacing=QueueConfig.of(scenario).lane_spacing,
             robot_diameter=scenario.robots.diameter,
         )
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import ClassVar
 
+from swarm_msgs_py.types import Coordinate, RobotId
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import Coordinate, RobotId
 
 DEPOT = "depot"
 """The depot manager's channel."""

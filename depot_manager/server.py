@@ -25,9 +25,9 @@ from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
 from depot_manager.state import DepotView
+from swarm_msgs_py.types import NS_PER_S
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.protocol import Drawing, Lines, Points
-from swarm_sim.types import NS_PER_S
 
 MARKER_PERIOD = 1.0
 """Sim seconds between slot-occupancy marker updates."""

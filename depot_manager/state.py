@@ -1,7 +1,7 @@
 """`/depot/state`: the depot manager's queues and docks as diagnostic_msgs/msg/DiagnosticArray.
 
 Published reliable + transient-local whenever it changes, so a late joiner (RViz, `ros2 topic
-echo`, the recorder) has the current state at once (`swarm_msgs_py.server_outputs.ServerState`:
+echo`, the recorder) has the current state at once (`swarm_sim.outputs.ServerState`:
 the value is a `DepotView`, decoded back exactly). One status ``queues`` whose values are each
 entry line's queue length, one status ``docks`` with each dock's occupant ('' if free), one status
 ``inner_queues`` with the robots on each inner queue (single-queue wrapping), and one status

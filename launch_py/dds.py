@@ -176,7 +176,7 @@ def with_shared_memory(profile: str) -> str:
 def remove_dead_shm_files(directory: Path = Path("/dev/shm")) -> int:
     """Remove Fast DDS's shared-memory files whose owner is gone (as ``fastdds shm clean``): a live
     owner holds a lock on the segment's or port's ``_el``/``_sl`` file; robot processes leave
-    without tearing down (`swarm_controllers.controller_node.serve_forked`) and killed ones cannot,
+    without tearing down (`swarm_sim.nodes.controller_node.serve_forked`) and killed ones cannot,
     so each run's launcher sweeps before and after. Returns the files removed."""
     removed = 0
     try:

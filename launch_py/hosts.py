@@ -238,7 +238,7 @@ def _remove(path: Path, owner: int) -> None:
 NODES = {
     "world": ("server", "swarm_sim.nodes.world_node", "swarm-world"),
     "server": ("client", "swarm_sim.nodes.server_node", "swarm-server"),
-    "controllers": ("robot", "swarm_controllers.controller_node", "swarm-controllers"),
+    "controllers": ("robot", "swarm_sim.nodes.controller_node", "swarm-controllers"),
 }
 """The node commands that take ``--bind``/``--discovery-server``: (role, module, program)."""
 

@@ -324,11 +324,11 @@ def main(argv: list[str] | None = None) -> int:
         world_cmd += ["--plain-twist", *(r for robots in remote.values() for r in robots)]
     if args.controller_processes == 0:  # one process per robot, forked after the imports
         controllers = [("controller processes (one per robot)",
-                        [*python, "swarm_controllers.controller_node", "--fork", *options, "--robots",
+                        [*python, "swarm_sim.nodes.controller_node", "--fork", *options, "--robots",
                          *scenario.robot_names])]
     else:
         controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
-                        [*python, "swarm_controllers.controller_node", *options, "--robots", *g]) for g in groups]
+                        [*python, "swarm_sim.nodes.controller_node", *options, "--robots", *g]) for g in groups]
     controllers = [(label, [*cmd, "--mode", args.mode]) for label, cmd in controllers]
     children: list[tuple[str, subprocess.Popen]] = []
     world: subprocess.Popen | None = None

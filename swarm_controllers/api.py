@@ -8,7 +8,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from swarm_sim.types import Command, slot_constructor
+from swarm_msgs_py.types import Command, slot_constructor
 
 _TWO_POW_MINUS_53 = 1.0 / 9007199254740992.0
 

@@ -21,9 +21,9 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from swarm_sim.geometry import wrap_angle
+from swarm_msgs_py.geometry import wrap_angle
+from swarm_msgs_py.types import Command
 from swarm_sim.scenario import AvoidanceConfig, ScanConfig, Scenario
-from swarm_sim.types import Command
 
 _FULL_CIRCLE_TOLERANCE = 1e-9
 

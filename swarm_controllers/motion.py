@@ -36,11 +36,11 @@ from typing import Protocol
 import numpy as np
 
 from swarm_controllers.avoidance import AvoidThenEscape
-from swarm_sim.geometry import wrap_angle
+from swarm_msgs_py.geometry import wrap_angle
+from swarm_msgs_py.types import Command, Pose2D
 from swarm_sim.registry import resolve
 from swarm_sim.robots import model_of
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import Command, Pose2D
 
 _TWO_PI = 2.0 * math.pi
 

@@ -26,7 +26,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import NamedTuple
 
 from swarm_msgs_py.cdr import Reader, Writer, codec
-from swarm_sim.types import NODE_KINDS, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
+from swarm_msgs_py.types import NODE_KINDS, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 TYPE_NAME = "diagnostic_msgs/msg/DiagnosticArray"
 

@@ -1,7 +1,7 @@
 """`/<robot>/odom`: nav_msgs/msg/Odometry <-> planar pose and body velocities.
 
 Mapping: header.frame_id ``world``, child_frame_id ``<robot>/base_link``; position (x, y, 0);
-orientation = `swarm_sim.geometry.yaw_to_quaternion(yaw)`; twist.linear.x = forward speed,
+orientation = `swarm_msgs_py.geometry.yaw_to_quaternion(yaw)`; twist.linear.x = forward speed,
 twist.angular.z = turn rate, other twist components 0; both covariances all zero.
 Decoding yields ``Pose2D(x, y, wire_yaw(yaw))`` exactly, which the world core already feeds
 its batch-run observations so graph and batch runs see identical inputs.
@@ -23,8 +23,8 @@ from swarm_msgs_py.cdr import (
     skip_string,
     split_stamp,
 )
-from swarm_sim.geometry import quaternion_to_yaw, yaw_to_quaternion
-from swarm_sim.types import Pose2D, RobotId
+from swarm_msgs_py.geometry import quaternion_to_yaw, yaw_to_quaternion
+from swarm_msgs_py.types import Pose2D, RobotId
 
 TYPE_NAME = "nav_msgs/msg/Odometry"
 WORLD_FRAME = "world"

@@ -153,7 +153,7 @@ class RecordFamily:
         self.topics = dict(topics)
         self.latched = frozenset(latched)
         """Topics published reliable + transient-local (a stream of states: a late joiner gets
-        the latest at once); the others are volatile (`swarm_msgs_py.qos.family_qos`)."""
+        the latest at once); the others are volatile (`swarm_sim.nodes.qos.family_qos`)."""
         unknown = self.latched - set(self.topics.values())
         if unknown:
             raise ValueError(f"{name}: latched topics {sorted(unknown)} are not topics of the family")

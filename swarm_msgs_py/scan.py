@@ -3,7 +3,7 @@
 Mapping: header.frame_id ``<robot>/base_link``; angle_min = -fov/2; angle_increment =
 fov/rays for a full circle (so the first and last rays do not coincide), else fov/(rays-1);
 angle_max = angle_min + (rays-1)*angle_increment; time_increment = scan_time = 0 (the whole
-scan is taken at the stamp); range_min/range_max from `ScanConfig`; intensities empty.
+scan is taken at the stamp); range_min/range_max from the scenario's `ScanConfig`; intensities empty.
 Ranges travel as float32 (the world core already rounds them), ``inf`` for no return.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import functools
 import math
 import struct
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -25,8 +25,7 @@ from swarm_msgs_py.cdr import (
     skip_header,
     split_stamp,
 )
-from swarm_sim.scenario import ScanConfig
-from swarm_sim.types import RobotId
+from swarm_msgs_py.types import RobotId
 
 TYPE_NAME = "sensor_msgs/msg/LaserScan"
 
@@ -41,15 +40,29 @@ class ScanData(NamedTuple):
     """[m], float32, ray i at angle_min + i * angle_increment from the heading."""
 
 
+class ScanShape(Protocol):
+    """What the codec reads of a scan's shape: the scenario's scan section
+    (`swarm_sim.scenario.ScanConfig`) is one; named here so the wire sits below the scenario."""
+
+    @property
+    def rays(self) -> int: ...
+    @property
+    def fov(self) -> float: ...
+    @property
+    def range_min(self) -> float: ...
+    @property
+    def range_max(self) -> float: ...
+
+
 class ScanGeometry(NamedTuple):
-    """The LaserScan angle fields for a `ScanConfig` [rad, body frame]."""
+    """The LaserScan angle fields for a `ScanShape` [rad, body frame]."""
 
     angle_min: float
     angle_max: float
     angle_increment: float
 
 
-def scan_geometry(config: ScanConfig) -> ScanGeometry:
+def scan_geometry(config: ScanShape) -> ScanGeometry:
     full_circle = config.fov >= 2 * math.pi - 1e-9
     if full_circle or config.rays == 1:
         increment = config.fov / config.rays
@@ -60,7 +73,7 @@ def scan_geometry(config: ScanConfig) -> ScanGeometry:
 
 
 @functools.lru_cache(maxsize=4096)
-def _layout(robot: RobotId, config: ScanConfig) -> tuple[struct.Struct, bytes]:
+def _layout(robot: RobotId, config: ScanShape) -> tuple[struct.Struct, bytes]:
     """Everything before the ranges except the stamp is constant per robot and config."""
     g = scan_geometry(config)
     fields = _SEVEN_F32.pack(
@@ -70,7 +83,7 @@ def _layout(robot: RobotId, config: ScanConfig) -> tuple[struct.Struct, bytes]:
     return struct.Struct(f"<4siI{len(const)}sI"), const
 
 
-def encode_scan(robot: RobotId, stamp_ns: int, ranges: np.ndarray, config: ScanConfig) -> bytes:
+def encode_scan(robot: RobotId, stamp_ns: int, ranges: np.ndarray, config: ScanShape) -> bytes:
     """`ranges` [m]: one per ray (``config.rays``), rounded to float32 on the wire."""
     try:
         ranges = np.asarray(ranges)

@@ -2,7 +2,7 @@
 paper's server encodes and decodes its own state (e.g. `depot_manager.state`) with these helpers.
 
 Published reliable + transient-local whenever it changes, so a late joiner (RViz, `ros2 topic
-echo`, the recorder) has the current state at once (`swarm_msgs_py.server_outputs.ServerState`).
+echo`, the recorder) has the current state at once (`swarm_sim.outputs.ServerState`).
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ import importlib
 from collections.abc import Iterable
 from typing import Any
 
-from swarm_sim.types import RobotId
+from swarm_msgs_py.types import RobotId
 
 # Relative names under a robot's namespace.
 ODOM = "odom"

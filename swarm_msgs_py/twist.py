@@ -21,7 +21,7 @@ from swarm_msgs_py.cdr import (
     skip_header,
     split_stamp,
 )
-from swarm_sim.types import RobotId
+from swarm_msgs_py.types import RobotId
 
 TYPE_NAME = "geometry_msgs/msg/TwistStamped"
 

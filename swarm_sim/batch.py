@@ -7,7 +7,7 @@ handle their messages stamped before k, the world steps. Same scenario and seed 
 graph run -> same trajectories and metrics (tested in test/test_determinism.py). With
 ``sim.stop_when_finished`` a run ends early once every behaviour says it is finished (sweeps). The
 world task's state is kept every tick as the trace's series, and the servers' series are read off
-what they publish, as a bag replay reads them (`swarm_msgs_py.server_outputs.SeriesLog`).
+what they publish, as a bag replay reads them (`swarm_sim.outputs.SeriesLog`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm_msgs_py.server_outputs import SeriesLog, StateWatch, outputs_of
+from swarm_msgs_py.types import FINISHED, NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.analysis.text import summary_line
@@ -35,11 +35,11 @@ from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
+from swarm_sim.outputs import SeriesLog, StateWatch, outputs_of
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task, task_factory
 from swarm_sim.registry import probes as registered_probes
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import FINISHED, NS_PER_S, DropEvent, PickupEvent
 from swarm_sim.world import World
 from swarm_sim.world.observations import with_messages
 
@@ -74,9 +74,9 @@ def _few_collections() -> Iterator[None]:
 
 
 def make_probes(scenario: Scenario, robots: tuple[str, ...]) -> dict[str, Any]:
-    """The observers of the probes that measure the run's task (`swarm_sim.registry.Probe`), by
-    name; each is fed the odometry positions at the start of every tick and after the last."""
-    return {p.name: resolve(p.observer)(scenario, robots) for p in registered_probes(of(scenario).task)}
+    """The observers of the probes the run asks for (`swarm_sim.registry.Probe`), by name; each is
+    fed the odometry positions at the start of every tick and after the last."""
+    return {p.name: resolve(p.observer)(scenario, robots) for p in registered_probes(scenario)}
 
 
 def run_batch(scenario: Scenario, *, record_poses: bool = False) -> BatchRun:

@@ -13,7 +13,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId, robot_index
+from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, robot_index
 
 
 @runtime_checkable

@@ -31,13 +31,13 @@ from typing import Any
 
 import numpy as np
 
-from swarm_msgs_py.server_outputs import outputs_of
+from swarm_msgs_py.types import Command
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch
+from swarm_sim.outputs import outputs_of
 from swarm_sim.scenario import Scenario, load_scenario, scenario_to_dict
-from swarm_sim.types import Command
 from swarm_sim.world import World
 
 ROS_BLOCKER = textwrap.dedent(
@@ -204,7 +204,7 @@ def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch
     graph = json.loads(result.stdout.strip().splitlines()[-1])
     for key in (*GRAPH_COMPARED, *(field for p in registry.probes() for field, _ in p.details)):
         if key not in graph and key not in batch_summary:
-            continue  # a probe of another world task
+            continue  # a probe this run does not ask for
         if graph.get(key) != batch_summary.get(key):
             _fail("graph_equals_batch", f"{key}: graph {graph.get(key)!r} != batch {batch_summary.get(key)!r}")
     odometry = load_odometry(bag)

@@ -5,8 +5,8 @@ other work: a message longer than its topic's cap (`Bounds`) is refused unread (
 took 1.5 s to decode in every robot node), then it is decoded, and whatever the decoder raises
 is a refusal, never an exception in the node's callback. A decoded message is then checked before
 its core sees it: a message of another node (`Inbound.admit`) must name robots of this run in
-every field annotated `swarm_sim.types.RobotId`, hold coordinates within the arena in every field
-annotated `swarm_sim.types.Coordinate`, and be stamped for a tick the node can still take
+every field annotated `swarm_msgs_py.types.RobotId`, hold coordinates within the arena in every field
+annotated `swarm_msgs_py.types.Coordinate`, and be stamped for a tick the node can still take
 (`swarm_sim.messaging`: a message sent at tick k is taken at tick k+1); an observation from the
 world (`Inbound.sense_guard`) must be stamped on a tick of the run and hold finite numbers within
 the arena and the robots' limits (`Bounds`). Numbers are checked before a core computes with
@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm_sim.types import COORDINATE, ROBOT_ID
+from swarm_msgs_py.types import COORDINATE, ROBOT_ID
 
 
 class Reason(str, Enum):

@@ -12,7 +12,7 @@ stamped before k and answers with messages stamped k, which the robots see at ti
 robot's request therefore gets its answer two ticks after it was sent. What a server publishes
 besides its messages (its ``state()`` on state topics, what it draws as `Lines` and `Points`)
 and the run-trace series read off it are declared with its registry record
-(`swarm_msgs_py.server_outputs.ServerOutputs`).
+(`swarm_sim.outputs.ServerOutputs`).
 """
 
 from __future__ import annotations

@@ -43,9 +43,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from swarm_msgs_py.topics import heard
+from swarm_msgs_py.types import robot_index
 from swarm_sim.presentation import Measure, Panel
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import robot_index
 
 if TYPE_CHECKING:
     from swarm_sim.protocol import Server
@@ -68,7 +68,7 @@ class ServerSpec:
     """``module:FAMILY``: the message family (`swarm_msgs_py.records.MessageFamily`) it speaks
     with the robots: it hears the family's messages on its channel and sends the others."""
     outputs: str | None = None
-    """``module:OUTPUTS`` (`swarm_msgs_py.server_outputs.ServerOutputs`): what its node publishes
+    """``module:OUTPUTS`` (`swarm_sim.outputs.ServerOutputs`): what its node publishes
     besides the family's messages (state topics, markers) and the run trace's time series read
     off what it publishes, the same in batch runs and bag replays (None: nothing)."""
     name: str = ""
@@ -98,8 +98,7 @@ class TaskSpec:
     headline: tuple[Measure, ...] = ()
     """What a run's text summary shows of the task's own fields (before its algorithm's)."""
     extends: str | None = None
-    """The task it builds on (the DRTM nest is the foraging task with food and a light): the
-    probes of that task measure its runs too."""
+    """The task it builds on (the DRTM nest is the foraging task with food and a light)."""
     panels: tuple[Panel, ...] = ()
     """Its panels of a run's summary figure (before its algorithm's)."""
     bodies: str | None = None
@@ -112,14 +111,12 @@ class TaskSpec:
 
 @dataclass(frozen=True)
 class Probe:
-    """A measurement a package makes in every run of the world tasks it names, beyond the tasks'
-    own metrics (the queue paper's perimeter crossings, which it reports for every foraging run):
-    an observer of the robots' odometry positions, fed every tick by the batch runner as they
-    are stepped and by the bag replay as they were recorded, and the result fields it yields."""
+    """A measurement a package makes beyond the world task's own metrics, in the runs that ask
+    for it (their delivery kind names it, `DeliveryKind.probes`): an observer of the robots'
+    odometry positions, fed every tick by the batch runner as they are stepped and by the bag
+    replay as they were recorded, and the result fields it yields."""
 
     name: str
-    tasks: tuple[str, ...]
-    """The world tasks whose runs it measures."""
     observer: str
     """``module:Class`` built as ``Class(scenario, robots)``; ``update(t [s], xy)`` with the
     (robots, 2) odometry positions [m, world frame] every tick; ``result()`` -> what its metrics
@@ -146,16 +143,20 @@ class DeliveryKind:
     checks: tuple[str, ...] = ()
     """``module:function`` ``(scenario) -> None`` raising ValueError naming the key at fault:
     what a scenario delivering this way must satisfy."""
+    world: tuple[tuple[str, str], ...] = ()
+    """(section, ``module:Dataclass``): the world facts its zones are made of, each a top-level
+    scenario section (a `swarm_sim.scenario.WorldSection`)."""
+    probes: tuple[str, ...] = ()
+    """The probes (`Probe`) that measure the runs delivering this way."""
 
 
 @dataclass(frozen=True)
 class Metric:
-    """A JSON result field an algorithm adds; runs of other algorithms report `default`."""
+    """A JSON result field an algorithm adds; only its own runs' rows carry it."""
 
     name: str
     function: str
     """``module:function`` ``(trace) -> value``."""
-    default: Any = None
 
 
 @dataclass(frozen=True)
@@ -199,7 +200,7 @@ class Algorithm:
     """The paper's own measures, as a run's text summary shows them (after its task's)."""
     progress: str | None = None
     """``module:function`` ``(statuses) -> str``: what the world node's progress line says of the
-    run, from every robot's last reported status (`swarm_sim.types.BehaviourStatus`, by robot;
+    run, from every robot's last reported status (`swarm_msgs_py.types.BehaviourStatus`, by robot;
     e.g. the caging stage); None: its world task's ``progress()`` (deliveries)."""
     panels: tuple[Panel, ...] = ()
     """Its own panels of a run's summary figure (after its task's): e.g. its servers' series."""
@@ -256,8 +257,9 @@ def _load_entries() -> None:
 
 
 def origin(kind: str, name: str) -> str:
-    """The entry point (a package's registration) that registered algorithm or task `name`
-    (`kind` ``algorithm`` or ``task``); empty if it was registered by a direct call."""
+    """The entry point (a package's registration) that registered algorithm, task or delivery
+    kind `name` (`kind` ``algorithm``, ``task`` or ``delivery``); empty if it was registered by a
+    direct call."""
     _load_entries()
     return _ORIGINS.get(f"{kind}:{name}", "")
 
@@ -306,10 +308,13 @@ def register_task(task: TaskSpec) -> TaskSpec:
 
 
 def register_delivery(kind: DeliveryKind) -> DeliveryKind:
-    """Make delivery kind `kind` known; refuses a second record of the same name."""
+    """Make delivery kind `kind` known; refuses a second record of the same name or a world
+    section already declared with another dataclass."""
     if kind.name in _DELIVERIES:
         raise ValueError(f"delivery kind {kind.name!r} is already registered")
+    _refuse_redeclared(kind.world, _declared_world(), "")
     _DELIVERIES[kind.name] = kind
+    _ORIGINS[f"delivery:{kind.name}"] = _loading
     return kind
 
 
@@ -321,15 +326,13 @@ def register_probe(probe: Probe) -> Probe:
     return probe
 
 
-def probes(task_name: str | None = None) -> tuple[Probe, ...]:
-    """The probes that measure runs of world task `task_name` or of a task it extends (None:
-    every probe)."""
+def probes(scenario: Scenario | None = None) -> tuple[Probe, ...]:
+    """The probes that measure runs of `scenario`: those its delivery kind asks for (None: every
+    probe)."""
     _load_entries()
-    lineage = set()
-    while task_name is not None and task_name not in lineage:
-        lineage.add(task_name)
-        task_name = _TASKS[task_name].extends if task_name in _TASKS else None
-    return tuple(p for p in _PROBES.values() if not lineage or lineage & set(p.tasks))
+    if scenario is None:
+        return tuple(_PROBES.values())
+    return tuple(_PROBES[name] for name in delivery_kind(scenario.depot.delivery).probes)
 
 
 def register_default_scenario(name: str) -> None:
@@ -393,7 +396,7 @@ def _declared_config() -> dict[str, str]:
 
 
 def _declared_world() -> dict[str, str]:
-    records = (*_TASKS.values(), *_ALGORITHMS.values())
+    records = (*_TASKS.values(), *_ALGORITHMS.values(), *_DELIVERIES.values())
     return {name: path for r in records for name, path in r.world}
 
 

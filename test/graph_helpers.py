@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from swarm_msgs_py.types import NS_PER_S
 from swarm_sim.recording import BagTruncatedWarning, bag_info
-from swarm_sim.types import NS_PER_S
 
 REPO = Path(__file__).resolve().parents[1]
 

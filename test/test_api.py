@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.cpfa.messages import PheromoneMessage
-from swarm_sim.types import Command
+from swarm_msgs_py.types import Command
 
 speeds = st.floats(allow_nan=True, allow_infinity=True)
 messages = st.lists(

@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 
 from swarm_msgs_py import clock, diagnostics
+from swarm_msgs_py.types import DropEvent
 from swarm_sim.recording import BagWriter
 from swarm_sim.scenario import load_scenario, scenario_to_dict
-from swarm_sim.types import DropEvent
 
 REPO = Path(__file__).resolve().parents[1]
 HUGE = "9" * 5000

@@ -552,10 +552,10 @@ def test_analysis_skips_and_counts_malformed_messages_and_keeps_the_rest(tmp_pat
     import json
 
     from swarm_msgs_py import clock, diagnostics
+    from swarm_msgs_py.types import DropEvent
     from swarm_sim.analysis.metrics import summarize
     from swarm_sim.analysis.replay import MalformedMessageWarning, load_run
     from swarm_sim.scenario import load_scenario, scenario_to_dict
-    from swarm_sim.types import DropEvent
 
     scenario = load_scenario("cpfa", ["robots.count=2", "sim.duration=1"])
     bag = tmp_path / "hostile"
@@ -592,11 +592,11 @@ def test_analysis_takes_no_more_than_the_live_graph(tmp_path: Path) -> None:
     import json
 
     from swarm_msgs_py import clock, diagnostics
+    from swarm_msgs_py.types import BehaviourStatus
     from swarm_sim.analysis.cli import main as analyze
     from swarm_sim.analysis.metrics import summarize
     from swarm_sim.analysis.replay import load_run
     from swarm_sim.scenario import load_scenario, scenario_to_dict
-    from swarm_sim.types import BehaviourStatus
 
     scenario = load_scenario("cpfa", ["robots.count=2", "sim.duration=1"])
     bag = tmp_path / "forged"

@@ -35,21 +35,21 @@ from swarm_msgs_py import clock, diagnostics, gripper, odometry, resources, scan
 from swarm_msgs_py import topics as topic_names
 from swarm_msgs_py.cdr import CodecError, Reader, Writer
 from swarm_msgs_py.diagnostics import Status
-from swarm_msgs_py.markers import encode_markers, encode_static_markers
+from swarm_msgs_py.geometry import wire_yaw, yaw_to_quaternion
 from swarm_msgs_py.topics import all_topics, split_robot_topic, topic_type, type_of
-from swarm_sim.geometry import wire_yaw, yaw_to_quaternion
-from swarm_sim.scenario import (
-    DropZoneConfig,
-    ObstacleConfig,
-    ScanConfig,
-    Scenario,
-)
-from swarm_sim.types import (
+from swarm_msgs_py.types import (
     BehaviourStatus,
     DropEvent,
     PickupEvent,
     Pose2D,
     RobotStats,
+)
+from swarm_sim.nodes.markers import encode_markers, encode_static_markers
+from swarm_sim.scenario import (
+    DropZoneConfig,
+    ObstacleConfig,
+    ScanConfig,
+    Scenario,
 )
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)

@@ -6,17 +6,12 @@ import subprocess
 import sys
 import textwrap
 
-ROS_ADAPTERS = ("swarm_msgs_py.markers", "swarm_msgs_py.qos", "swarm_msgs_py.executor", "swarm_msgs_py.params",
-                "swarm_sim.nodes.world_node", "swarm_sim.nodes.server_node", "swarm_sim.nodes.recorder",
-                "swarm_sim.nodes.endpoint", "swarm_sim.nodes.world_loop", "swarm_sim.nodes.world_outputs",
-                "swarm_sim.nodes.world_recording", "swarm_sim.nodes.peer_relay", "swarm_sim.nodes.status_watch")
-"""The only modules allowed to import rclpy or message packages: the nodes (also every
-``*_node`` module) and the codecs that build rclpy message objects."""
+from test_layout import EDGE  # the ROS edge, one folder: the only modules not run here
 
 
 def core_modules() -> list[str]:
-    """Every module of our packages that is not a ROS adapter: found by walking the packages,
-    so a new core module is checked without being listed."""
+    """Every module of our packages outside the ROS edge: found by walking the packages, so a new
+    core module is checked without being listed."""
     import pkgutil
 
     import depot_manager
@@ -27,7 +22,7 @@ def core_modules() -> list[str]:
     out = []
     for package in (swarm_sim, swarm_controllers, depot_manager, swarm_msgs_py):
         for info in pkgutil.walk_packages(package.__path__, package.__name__ + "."):
-            if info.name not in ROS_ADAPTERS and not info.name.rpartition(".")[2].endswith("node"):
+            if not (info.name == EDGE or info.name.startswith(EDGE + ".")):
                 out.append(info.name)
     return out
 

@@ -24,10 +24,10 @@ from depot_manager.codec import DEPOT, DEPOT_REPORTS, DEPOT_STATE, RADIO, RADIO_
 from depot_manager.protocol import DepotReport, RadioReply, ReportKind
 from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, server_state, topics, twist
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.types import NS_PER_S, NodeDownEvent
 from swarm_sim.analysis.replay import load_odometry
+from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.recording import BagError, BagTruncatedWarning, bag_info, read_bag
-from swarm_sim.types import NS_PER_S, NodeDownEvent
 
 REPO = Path(__file__).resolve().parents[1]
 # Q_MT in a 7 x 7 m arena with 200 uniform resources: the first deliveries within a minute.
@@ -135,10 +135,10 @@ def test_hostile_messages_are_rejected_counted_and_change_nothing(launch, tmp_pa
 
 def test_a_killed_controller_holding_a_dock_is_declared_dead_and_its_dock_freed(launch, tmp_path):
     run = launch("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", "--controller-processes", "0",
-                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "depot.unload_time=20.0", "robots.model=generic"]))
+                 "--tick-timeout", "0.5", *overrides([*BUSY_DEPOT, "docking.unload_time=20.0", "robots.model=generic"]))
     run.wait_until(lambda: _dock_occupant(run.bag), timeout=120, what="a robot at a dock")
     victim = _dock_occupant(run.bag)
-    os.kill(run.child("swarm_controllers.controller_node", victim), signal.SIGKILL)
+    os.kill(run.child("swarm_sim.nodes.controller_node", victim), signal.SIGKILL)
     code, summary, err = run.finish()
     assert code == 4, err[-3000:]
     assert summary["dead_nodes"] == [victim] and f"declared dead during the run: {victim}" in err

@@ -25,10 +25,10 @@ from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_REPORTS, RADIO, RADIO
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKind
 from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, clock, diagnostics, odometry, topics, twist
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_msgs_py.types import BehaviourStatus, NodeDownEvent, Pose2D
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
-from swarm_sim.types import BehaviourStatus, NodeDownEvent, Pose2D
+from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 
 BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
 QUEUE = ("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", *overrides(BUSY_DEPOT))

@@ -15,9 +15,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from launch_py import dds, hosts
+from swarm_msgs_py.types import Command
 from swarm_sim.nodes import endpoint
 from swarm_sim.nodes.command_watch import CommandWatch
-from swarm_sim.types import Command
 
 REPO = Path(__file__).resolve().parents[1]
 DT = 100_000_000

@@ -15,9 +15,9 @@ from swarm_controllers.spiral.center import CenterServer
 from swarm_controllers.spiral.protocol import ProgressReport
 from swarm_msgs_py import diagnostics
 from swarm_msgs_py.diagnostics import OK, encode_diagnostics
+from swarm_msgs_py.types import NodeDownEvent
 from swarm_sim.inbound import Inbound, Reason, Rejections, merged, robot_fields
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NodeDownEvent
 
 DT = 100_000_000
 ROBOTS = ("robot_0", "robot_1")
@@ -172,7 +172,7 @@ def test_coordinates_beyond_the_arena_are_refused_before_any_core_computes_with_
 
 
 def test_observations_are_checked_for_their_tick_and_their_numbers():
-    from swarm_sim.types import Pose2D
+    from swarm_msgs_py.types import Pose2D
 
     gate, scenario, _ = _guarded()
     dt, b = scenario.dt_ns, gate.bounds
@@ -206,7 +206,7 @@ def test_observations_are_checked_for_their_tick_and_their_numbers():
 
 def test_the_sense_guard_decodes_and_checks_in_one_call():
     from swarm_msgs_py import gripper, odometry, resources, scan
-    from swarm_sim.types import Pose2D
+    from swarm_msgs_py.types import Pose2D
 
     gate, scenario, _ = _guarded()
     dt, sc = scenario.dt_ns, scenario.sensors.scan

@@ -30,11 +30,11 @@ from websockets.sync.client import connect
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import odometry, scan
+from swarm_msgs_py.types import Pose2D
 from swarm_sim.nodes.live_view import LiveView
 from swarm_sim.nodes.ws_proxy import CLASSIC, SDK, check_port
 from swarm_sim.recording import read_bag
 from swarm_sim.recording.metadata import _msgdef
-from swarm_sim.types import Pose2D
 
 WANTED = ("/clock", "/robot_0/odom", "/robot_1/scan", "/world/markers", "/center/markers")
 MESSAGE_DATA, TIME = 1, 2

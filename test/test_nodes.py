@@ -10,19 +10,19 @@ import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
-from swarm_controllers.controller_node import ControllerConfig, ControllerNode
 from swarm_controllers.cpfa import codec as pheromone
 from swarm_controllers.cpfa.codec import PHEROMONES, PHEROMONES_TOPIC
 from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_msgs_py import diagnostics, gripper, odometry, resources, scan, topics, twist
-from swarm_msgs_py.executor import share_sim_time
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.types import Pose2D
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.inbound import Reason
+from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode
+from swarm_sim.nodes.executor import share_sim_time
+from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import Pose2D
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")

@@ -10,7 +10,7 @@ from rclpy.node import Node
 from rclpy.parameter_client import AsyncParameterClient
 from test_nodes import SMALL
 
-from swarm_controllers.controller_node import ControllerConfig, ControllerNode
+from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode
 from swarm_sim.nodes.server_node import ServerNode, ServerNodeConfig
 
 

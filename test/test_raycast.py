@@ -11,9 +11,9 @@ from generic_robot import generic_scenario
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from swarm_msgs_py.types import Pose2D
 from swarm_sim.registry import task_factory
 from swarm_sim.scenario import ObstacleConfig, ScanConfig
-from swarm_sim.types import Pose2D
 from swarm_sim.world import World
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet, nearest_hits, scan_angles
 

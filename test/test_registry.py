@@ -14,8 +14,8 @@ import pytest
 from depot_manager.codec import DEPOT_GRANTS, DEPOT_REPORTS, RADIO_TOPIC
 from swarm_controllers.cpfa.codec import PHEROMONES_TOPIC
 from swarm_msgs_py import topics
-from swarm_msgs_py.server_outputs import Series, SeriesLog, ServerOutputs
 from swarm_sim import registry
+from swarm_sim.outputs import Series, SeriesLog, ServerOutputs
 from swarm_sim.scenario import ScenarioError, load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
@@ -92,7 +92,7 @@ def test_plugin_algorithm_is_found_by_its_entry_point_and_runs():
         assert not scenario_file.is_relative_to(REPO / package)
     result = summarize(run_batch(load_scenario("dummy", ["sim.duration=20.0"])).trace)
     assert result["pings_heard"] == 4 * 10  # 4 robots ping every 2 s for 20 s
-    assert result["queue_length_max"] == 0 and result["regions"] is None  # other algorithms' defaults
+    assert "queue_length_max" not in result and "regions" not in result  # other algorithms' fields
 
 
 def test_world_sections_are_named_once_and_declared_once(monkeypatch):
@@ -122,12 +122,14 @@ def test_a_server_is_found_by_its_channel_and_built_from_its_record():
 _BAD_OUTPUTS = ServerOutputs(series=(Series("/nowhere", lambda value: {}),))
 
 
-def test_a_probe_measures_its_tasks_and_the_tasks_that_extend_them():
-    """The queue paper's perimeter crossings are measured in every foraging run (the DRTM nest
-    extends the foraging task), not in the transport task's; a second record is refused."""
-    (perimeter,) = registry.probes("foraging")
-    assert perimeter.name == "perimeter" and registry.probes("nest") == (perimeter,)
-    assert registry.probes("transport") == () and registry.probes("beacon") == ()
+def test_a_probe_measures_the_runs_that_ask_for_it():
+    """The queue paper's perimeter crossings are measured in the runs delivering at its docks
+    (its strategies and its CPFA baseline), not in a plain CPFA, spiral, DRTM or caging run; a
+    second record is refused."""
+    (perimeter,) = registry.probes()
+    assert registry.probes(load_scenario("queue_cpfa")) == (perimeter,) == registry.probes(load_scenario("queue_qmt"))
+    for name in ("cpfa", "mdbsa_d", "drtm", "caging"):
+        assert registry.probes(load_scenario(name)) == (), name
     with pytest.raises(ValueError, match="probe 'perimeter' is already registered"):
         registry.register_probe(perimeter)
     from swarm_sim.analysis.metrics import summarize
@@ -135,4 +137,18 @@ def test_a_probe_measures_its_tasks_and_the_tasks_that_extend_them():
 
     caging = summarize(run_batch(load_scenario("caging", ["sim.duration=1.0"])).trace)
     drtm = summarize(run_batch(load_scenario("drtm", ["sim.duration=1.0"])).trace)
-    assert "dropoff_times_s" not in caging and drtm["dropoff_times_s"] == []
+    queue = summarize(run_batch(load_scenario("queue_cpfa", ["sim.duration=1.0", "robots.count=4"])).trace)
+    assert "dropoff_times_s" not in caging and "dropoff_times_s" not in drtm and queue["dropoff_times_s"] == []
+
+
+def test_a_row_carries_the_core_its_task_and_its_own_algorithm_only():
+    """No padding: a DRTM row has no caging or queue field, a caging row no DRTM one."""
+    from swarm_sim.analysis.metrics import summarize
+    from swarm_sim.batch import run_batch
+
+    rows = {name: summarize(run_batch(load_scenario(name, ["sim.duration=1.0"])).trace) for name in ("drtm", "caging")}
+    fields = {a.name: {m.name for m in a.metrics} for a in registry.algorithms()}
+    for name, row in rows.items():
+        mine = fields[registry.of(load_scenario(name)).name]
+        others = set().union(*(f for a, f in fields.items() if not f <= mine)) - mine
+        assert mine <= set(row) and not others & set(row), (name, sorted(others & set(row)))

@@ -19,11 +19,11 @@ import pytest
 from swarm_controllers.motion import ContinuousDrive, drive_for
 from swarm_controllers.robots.stop_turn_go import PLAN_TIME, StopTurnGo
 from swarm_controllers.robots.wheel_turning import WheelTurning
+from swarm_msgs_py.types import Command, Pose2D
 from swarm_sim import registry
 from swarm_sim.registry import task_factory
 from swarm_sim.robots import footbot
 from swarm_sim.scenario import ScenarioError, load_scenario, scenario_from_dict, scenario_to_dict
-from swarm_sim.types import Command, Pose2D
 from swarm_sim.world import World
 
 DT = 0.1

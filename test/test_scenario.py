@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
+from depot_manager.config import DockingConfig
 from swarm_sim import registry
 from swarm_sim.scenario import (
     ControllerConfig,
@@ -181,16 +182,19 @@ def test_the_shipped_scenarios_are_listed(capsys):
 # --------------------------------------------------------------------------- declared world sections
 
 
-def test_world_sections_are_declared_by_their_task_or_algorithm():
-    """``transport`` belongs to the caging paper's task, ``regions`` to the MDBSA records; the
-    loader builds them from their top-level keys and ``of`` reads them back (defaults if absent)."""
+def test_world_sections_are_declared_by_their_task_algorithm_or_delivery_kind():
+    """``transport`` belongs to the caging paper's task, ``regions`` to the MDBSA records,
+    ``docking`` to the queue paper's docks delivery; the loader builds them from their top-level
+    keys and ``of`` reads them back (defaults if absent)."""
     from swarm_controllers.caging.world_config import TransportConfig
     from swarm_controllers.spiral.regions import RegionConfig
 
     assert registry.world_sections() == {
+        "docking": "depot_manager.config:DockingConfig",
         "regions": "swarm_controllers.spiral.regions:RegionConfig",
         "transport": "swarm_controllers.caging.world_config:TransportConfig",
     }
+    assert dict(registry.delivery_kind("docks").world) == {"docking": registry.world_sections()["docking"]}
     assert dict(registry.task("transport").world) == {"transport": registry.world_sections()["transport"]}
     assert {name for name in ("mdbsa_c", "mdbsa_d", "ddsa") if registry.algorithm(name).world} == {"mdbsa_c", "mdbsa_d"}
     caging = load_scenario("caging", ["transport.object.radius=0.35"])
@@ -217,7 +221,7 @@ def test_world_sections_are_declared_by_their_task_or_algorithm():
     ("mdbsa_d", "regions.count=5", "regions.count: 5 is not a power of 4"),
     ("cpfa", "regions.count=5", "regions.count: 5 is not a power of 4"),
     ("mdbsa_c", "regions.center_radius=0", "regions.center_radius: must be positive"),
-    ("cpfa", "region.count=4", "unknown key region (known keys: arena, controller, depot, drop_zones, "
+    ("cpfa", "region.count=4", "unknown key region (known keys: arena, controller, depot, docking, drop_zones, "
                                "name, obstacles, regions, resources, robots, seed, sensors, sim, transport)"),
     ("cpfa", "sections=[]", "unknown key sections"),
 ])
@@ -251,7 +255,8 @@ def test_delivery_kinds_are_registered_by_whoever_provides_them():
     s = load_scenario("queue_cpfa")
     zones = drop_zones(s)
     assert [z.name for z in zones] == [f"dock_{k}" for k in range(4)]
-    assert all((z.radius, z.dwell) == (s.depot.dock_radius, s.depot.unload_time) for z in zones)
+    docking = DockingConfig.of(s)
+    assert all((z.radius, z.dwell) == (docking.dock_radius, docking.unload_time) for z in zones)
     assert [z.name for z in registry.delivery_zones(load_scenario("cpfa"), "docks")] == [f"dock_{k}" for k in range(4)]
 
 
@@ -272,6 +277,32 @@ def test_an_unknown_or_unsuitable_delivery_kind_is_refused_naming_the_key(overri
 
 def test_a_delivery_kinds_own_checks_run():
     """The docks kind needs its perimeter inside the arena; the depot kind does not."""
-    with pytest.raises(ScenarioError, match="depot.perimeter_radius: a perimeter of 6.5 m does not fit"):
-        load_scenario("queue_cpfa", ["depot.perimeter_radius=6.5"])
-    assert load_scenario("cpfa", ["depot.perimeter_radius=6.5"]).depot.perimeter_radius == 6.5
+    with pytest.raises(ScenarioError, match="docking.perimeter_radius: a perimeter of 6.5 m does not fit"):
+        load_scenario("queue_cpfa", ["docking.perimeter_radius=6.5"])
+    assert DockingConfig.of(load_scenario("cpfa", ["docking.perimeter_radius=6.5"])).perimeter_radius == 6.5
+
+
+@pytest.mark.parametrize(("override", "message"), [
+    ("docking.docks=0", "docking.docks: need at least one dock"),
+    ("docking.dock_radius=0", "docking.dock_radius: must be positive"),
+    ("docking.unload_time=-1", "docking.unload_time: must not be negative"),
+    ("docking.dock_distance=0", "docking.dock_distance: must be positive"),
+    ("docking.docks=40", "docking.docks: 40 docks do not fit side by side"),
+    ("docking.perimeter_radius=0.4", "docking.perimeter_radius: must exceed depot.radius"),
+    ("depot.docks=4", "depot.docks: moved to docking.docks"),
+])
+def test_the_docking_section_is_checked_naming_the_key(override, message):
+    with pytest.raises(ScenarioError) as info:
+        load_scenario("queue_cpfa", [override])
+    assert str(info.value).startswith(message), str(info.value)
+
+
+def test_a_recorded_scenario_with_the_docks_under_depot_still_loads():
+    """Bags recorded before the ``docking`` section kept its fields under ``depot``: the loader
+    of a recorded scenario carries them over (`DockingConfig.MOVED`), and they keep their values."""
+    s = load_scenario("queue_cpfa", ["docking.unload_time=7.0"])
+    old = scenario_to_dict(s)
+    old["depot"].update(old.pop("docking"))
+    assert "docking" not in old and old["depot"]["unload_time"] == 7.0
+    assert scenario_from_dict(old) == s
+    assert DockingConfig.of(scenario_from_dict(old)).unload_time == 7.0

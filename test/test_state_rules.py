@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
+from swarm_msgs_py.types import BehaviourStatus
 from swarm_sim.analysis.state_rules import RuleLog, StatusLog, events_by_state
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import BehaviourStatus
 
 
 def _status(state: str, stamp: int = 0, oae: int = 0, robot: str = "robot_0", **extra: str) -> BehaviourStatus:

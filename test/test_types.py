@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from swarm_controllers.cpfa.messages import PheromoneMessage
-from swarm_sim.types import Command, Observation, Pose2D, slot_constructor, slot_setters
+from swarm_msgs_py.types import Command, Observation, Pose2D, slot_constructor, slot_setters
 
 
 def _same(fast: object, slow: object) -> None:

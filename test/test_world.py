@@ -12,7 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_controllers.cpfa.messages import PheromoneMessage
-from swarm_sim.geometry import wire_yaw, wrap_angle
+from swarm_msgs_py.geometry import wire_yaw, wrap_angle
+from swarm_msgs_py.types import Command, DropEvent, Observation, PickupEvent, Pose2D
 from swarm_sim.registry import task_factory
 from swarm_sim.scenario import (
     DropZoneConfig,
@@ -21,7 +22,6 @@ from swarm_sim.scenario import (
     Scenario,
     ScenarioError,
 )
-from swarm_sim.types import Command, DropEvent, Observation, PickupEvent, Pose2D
 from swarm_sim.world import World
 from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.observations import with_messages

@@ -47,8 +47,8 @@ from swarm_controllers.caging.motion import Formation, GoTo, Limits, Motion, Nei
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_controllers.caging.task import OBJECT
 from swarm_controllers.caging.world_config import TransportConfig
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, robot_index
 
 Point = tuple[float, float]
 

@@ -12,7 +12,7 @@ destination, payload>.
 | 3 | Oriented | /caging/type3_oriented | leg |
 | 4 | Reached | /caging/type4_reached | leg |
 
-Reliable, deep, volatile (`swarm_msgs_py.qos.EVENTS`); delivered one tick later like every peer
+Reliable, deep, volatile (`swarm_sim.nodes.qos.EVENTS`); delivered one tick later like every peer
 message (`swarm_sim.messaging`).
 """
 

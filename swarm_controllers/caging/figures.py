@@ -13,8 +13,8 @@ import numpy as np
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.metrics import caging_report, distance_to_polyline, series_of, transport_stage
 from swarm_controllers.caging.world_config import TransportConfig
+from swarm_msgs_py.types import robot_index
 from swarm_sim.compare.report import save_figure
-from swarm_sim.types import robot_index
 
 SNAPSHOTS = 6
 

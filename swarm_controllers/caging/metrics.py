@@ -32,7 +32,7 @@ from swarm_controllers.caging.config import CagingConfig
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_controllers.caging.world_config import TransportConfig
-from swarm_sim.types import NS_PER_S, robot_index
+from swarm_msgs_py.types import NS_PER_S, robot_index
 
 CONTACT_BOUND = 5.0
 """[s]: the longest a gap the object could pass through may stay open while the cage still counts

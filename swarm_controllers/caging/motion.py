@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from swarm_controllers.caging.config import CagingConfig, PidGains
-from swarm_sim.types import Pose2D
+from swarm_msgs_py.types import Pose2D
 
 Point = tuple[float, float]
 

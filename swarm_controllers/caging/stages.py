@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from swarm_controllers.caging.behaviour import Phase
-from swarm_sim.types import BehaviourStatus, RobotId
+from swarm_msgs_py.types import BehaviourStatus, RobotId
 
 RECRUITMENT = frozenset(p.value for p in (Phase.APPROACH, Phase.WAIT_SUMMON, Phase.TO_CAGE, Phase.SUMMONING,
                                           Phase.PLACED))

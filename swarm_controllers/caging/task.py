@@ -40,9 +40,9 @@ import numpy as np
 
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.world_config import TransportConfig
-from swarm_sim.geometry import yaw_to_quaternion
+from swarm_msgs_py.geometry import yaw_to_quaternion
+from swarm_msgs_py.types import Pose2D
 from swarm_sim.scenario import ScenarioError
-from swarm_sim.types import Pose2D
 from swarm_sim.world.bullet import pybullet as p
 
 if TYPE_CHECKING:

@@ -40,7 +40,7 @@ Rules, in the paper's words, and how they are realised here:
   robot that gave up has arrived when it is inside the depot disc.
 * **Docks** (``depot.delivery: docks``, the queue paper's CPFA baseline, sec. III: "robots are
   required to unload resources at designated docks", staying T_unload): a carrier heads for the
-  dock stop nearest to it and, once its centre is within ``depot.dock_radius`` of it, stands
+  dock stop nearest to it and, once its centre is within its zone's radius of it, stands
   still until the world has dropped the resource after T_unload. No queue: carriers contend for
   a dock with their obstacle avoidance. As in the authors' CPFA (Tameem786/Collision_Free_CPFA,
   ``CPFA_controller::IsInTheNest``: the robot's centre within ``NestRadius`` of one of the
@@ -96,10 +96,10 @@ from swarm_controllers.api import new_command, uniform_draws
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.messages import PheromoneMessage
 from swarm_controllers.motion import Avoidance, Drive, drive_for
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.messaging import per_inbox
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, RobotId, slot_constructor
 
 _TWO_PI = 2.0 * math.pi
 _IDLE = (0.0, 0.0)
@@ -202,13 +202,14 @@ class CpfaBehaviour:
 
     def __init__(
         self, scenario: Scenario, robot: RobotId, rng: np.random.Generator,
-        *, keep_out: float | None = None, drive: Drive | None = None,
+        *, keep_out: float | None = None, perimeter: float | None = None, drive: Drive | None = None,
     ) -> None:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
-        give-up return ends at its edge. None: the depot disc (the plain CPFA). drive: the robot's
-        motion layer when another behaviour owns it (the queue strategies'; default: the robot
-        model's, `swarm_controllers.motion.drive_for`)."""
+        give-up return ends at its edge. None: the depot disc (the plain CPFA). perimeter [m]: the
+        queue strategies' perimeter radius, given with keep_out: a give-up return's blind leg ends
+        `RIM_MARGIN` outside it. drive: the robot's motion layer when another behaviour owns it
+        (the queue strategies'; default: the robot model's, `swarm_controllers.motion.drive_for`)."""
         cfg = CpfaConfig.of(scenario)
         dt = scenario.sim.dt
         self.robot = robot
@@ -245,15 +246,15 @@ class CpfaBehaviour:
         self._bound = half - margin if half > margin else half / 2.0
         self._site_clearance2 = (nest_radius + margin) ** 2
         self._keep_out2 = -1.0 if keep_out is None else keep_out**2
-        self._rim = scenario.depot.perimeter_radius + RIM_MARGIN if keep_out is not None and self._drive.blind_legs \
-            else 0.0
+        self._rim = perimeter + RIM_MARGIN if perimeter is not None and self._drive.blind_legs else 0.0
         """[m] where a give-up return's blind leg ends (0: it aims at the centre and arrives at the
         keep-out radius, re-aiming on the way)."""
         docks_mode = keep_out is None and scenario.depot.delivery == "docks"
-        self._docks = [z.center for z in delivery_zones(scenario)] if docks_mode else []
+        zones = delivery_zones(scenario) if docks_mode else ()
+        self._docks = [z.center for z in zones]
         """Dock stops a carrier returns to: the zones the docks delivery implies [m, world frame]
         (empty: the depot centre)."""
-        self._dock_r2 = scenario.depot.dock_radius**2
+        self._dock_r2 = max((z.radius for z in zones), default=0.0) ** 2
 
         self._state = CpfaState.DEPARTING
         self._mode = SearchMode.UNINFORMED

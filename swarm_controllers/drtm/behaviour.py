@@ -48,8 +48,8 @@ from swarm_controllers.drtm.response_threshold import (
     traffic_flow_density,
 )
 from swarm_controllers.motion import drive_for
+from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId
 
 _BLOCK = 256
 """Random numbers are drawn from the robot's generator this many at a time (a scalar draw per

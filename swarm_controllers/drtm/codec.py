@@ -15,7 +15,7 @@ tick: ``nest_food`` F(t) [tokens], ``nest_waiting`` N_W and ``nest_oaes`` the OA
 
 from swarm_controllers.drtm.protocol import NestReport, NestState
 from swarm_msgs_py.records import RecordFamily
-from swarm_msgs_py.server_outputs import Series, ServerOutputs
+from swarm_sim.outputs import Series, ServerOutputs
 
 NEST_REPORTS = "/nest/reports"
 NEST_STATE = "/nest/state"

@@ -25,8 +25,8 @@ from collections.abc import Sequence
 
 from swarm_controllers.drtm.config import NestConfig
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
+from swarm_msgs_py.types import NS_PER_S
 from swarm_sim.inbound import Reason, Rejections
-from swarm_sim.types import NS_PER_S
 
 
 class NestLedger:

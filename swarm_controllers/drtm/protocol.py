@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import ClassVar
 
+from swarm_msgs_py.types import RobotId
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import RobotId
 
 NEST = "nest"
 """The nest server's channel."""

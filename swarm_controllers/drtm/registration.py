@@ -20,7 +20,7 @@ _SERVER = ServerSpec(
     outputs="swarm_controllers.drtm.codec:OUTPUTS",
 )
 _METRICS = tuple(
-    Metric(name, f"swarm_controllers.drtm.metrics:{name}", None)
+    Metric(name, f"swarm_controllers.drtm.metrics:{name}")
     for name in ("food_deviation", "energy_efficiency", "oae_total", "food_collected", "nest_food_final",
                  "nest_food_series", "active_robots_series", "oae_series", "oae_by_state", "oae_returning_total")
 )

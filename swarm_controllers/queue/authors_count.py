@@ -28,8 +28,8 @@ from depot_manager.admission import DepotAdmission
 from depot_manager.config import QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, make_layout
 from swarm_controllers.queue.behaviour import PATH_CONE, Phase
+from swarm_msgs_py.types import BehaviourStatus
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import BehaviourStatus
 
 FOLLOWING = frozenset({Phase.QUEUED.name, Phase.LEAVING.name})
 """The states the authors call FOLLOWING_ENTRY_PATH and EXITING."""

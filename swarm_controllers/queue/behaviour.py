@@ -57,17 +57,17 @@ from functools import lru_cache
 import numpy as np
 
 from depot_manager.admission import DepotAdmission
-from depot_manager.config import QueueConfig
+from depot_manager.config import DockingConfig, QueueConfig
 from depot_manager.geometry import DepotGeometryConfig, QueueLayout, make_layout
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioReply, Refusal, ReportKind, within_range
 from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
 from swarm_controllers.motion import drive_for
+from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.messaging import per_inbox
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 
 _new_status = slot_constructor(BehaviourStatus)
 
@@ -156,7 +156,7 @@ class QueueBehaviour:
         """The robot's motion layer, shared with its CPFA (one ``BaseController`` per robot)."""
         self._to_point = self._drive.to_point
         self._center = (float(depot.center[0]), float(depot.center[1]))
-        self._R = depot.perimeter_radius
+        self._R = DockingConfig.of(scenario).perimeter_radius
         self._lane = queue.lane_spacing
         self._gamma = scenario.robots.radio_range
         self._tail = queue.joining == "tail"
@@ -166,7 +166,8 @@ class QueueBehaviour:
         self._detour_far = self._drive.blind_legs
         """Check a non-carrier's path against the disc from any distance, not only near it: a
         blind leg started far out would cross the perimeter (``_forage``)."""
-        self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, drive=self._drive)
+        self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, perimeter=self._R,
+                                   drive=self._drive)
         self._cpfa_step = self._cpfa.step
         self._avoid = self._drive.avoidance(0.1)
         self._layout, self._cells, self._slots, self._docks = _queues(

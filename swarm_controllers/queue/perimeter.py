@@ -15,10 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from depot_manager.config import DockingConfig
+from swarm_msgs_py.types import NS_PER_S, DropEvent, RobotId
 from swarm_sim.registry import delivery_zones
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import NS_PER_S, DropEvent, RobotId
 
 PROBE = "perimeter"
 """The probe's name: its crossings are ``RunTrace.probes["perimeter"]``."""
@@ -39,7 +40,7 @@ class PerimeterLog:
     def __init__(self, scenario: Scenario, robots: tuple[RobotId, ...]) -> None:
         self.robots = robots
         self._center = np.asarray(scenario.depot.center, dtype=float)
-        self._r2 = scenario.depot.perimeter_radius ** 2
+        self._r2 = DockingConfig.of(scenario).perimeter_radius ** 2
         self._inside = np.zeros(len(robots), dtype=bool)
         self._crossings = Crossings({r: [] for r in robots}, {r: [] for r in robots})
 
@@ -109,7 +110,7 @@ def deliveries_outside_docks(trace: Any) -> int | None:
     if trace.config is None:
         return None
     stops = np.array([z.center for z in delivery_zones(trace.config, "docks")])
-    radius = trace.config.depot.dock_radius + 1e-6
+    radius = DockingConfig.of(trace.config).dock_radius + 1e-6
     return sum(
         1 for d in trace.drops if np.min(np.hypot(stops[:, 0] - d.x, stops[:, 1] - d.y)) > radius
     )

@@ -1,5 +1,6 @@
-"""The queue paper's registry records (queue_depot_traffic.md): the ``docks`` delivery kind (its
-docks in `depot_manager.docks`) and the queue strategies, the robots' side here, the depot
+"""The queue paper's registry records (queue_depot_traffic.md): the perimeter probe, the ``docks``
+delivery kind (its docks in `depot_manager.docks`, its world section ``docking``, its runs
+measured by the perimeter probe) and the queue strategies, the robots' side here, the depot
 manager's server in the top-level `depot_manager` package."""
 
 from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES, STATES
@@ -17,18 +18,19 @@ from swarm_sim.registry import (
     register_probe,
 )
 
+register_probe(Probe(
+    name="perimeter",
+    observer="swarm_controllers.queue.perimeter:PerimeterLog",
+    metrics="swarm_controllers.queue.perimeter:perimeter_metrics",
+    details=(("dropoff_times_s", "dropoff_count"),),
+))
+
 register_delivery(DeliveryKind(
     name="docks",
     zones="depot_manager.docks:dock_zones",
     checks=("depot_manager.docks:check_docks",),
-))
-
-register_probe(Probe(
-    name="perimeter",
-    tasks=("foraging",),
-    observer="swarm_controllers.queue.perimeter:PerimeterLog",
-    metrics="swarm_controllers.queue.perimeter:perimeter_metrics",
-    details=(("dropoff_times_s", "dropoff_count"),),
+    world=(("docking", "depot_manager.config:DockingConfig"),),
+    probes=("perimeter",),  # the queue strategies and the paper's CPFA baseline deliver here
 ))
 
 register(Algorithm(
@@ -45,12 +47,12 @@ register(Algorithm(
     peers=(PHEROMONES, "depot_manager.codec:RADIO"),
     deliveries=("docks",),
     metrics=(
-        Metric("queue_length_mean", "depot_manager.metrics:queue_length_mean", 0.0),
-        Metric("queue_length_max", "depot_manager.metrics:queue_length_max", 0),
+        Metric("queue_length_mean", "depot_manager.metrics:queue_length_mean"),
+        Metric("queue_length_max", "depot_manager.metrics:queue_length_max"),
         Metric("authors_collision_time_per_robot_s",
-               "swarm_controllers.queue.authors_count:authors_collision_time_per_robot_s", None),
+               "swarm_controllers.queue.authors_count:authors_collision_time_per_robot_s"),
         Metric("authors_collision_time_total_min",
-               "swarm_controllers.queue.authors_count:authors_collision_time_total_min", None),
+               "swarm_controllers.queue.authors_count:authors_collision_time_total_min"),
     ),
     collision_rule="swarm_controllers.queue.authors_count:collision_rule",
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",

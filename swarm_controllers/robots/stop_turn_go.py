@@ -55,9 +55,9 @@ from math import atan2, hypot, inf, remainder
 import numpy as np
 
 from swarm_controllers.robots.ring import RingSensor
+from swarm_msgs_py.types import Command
 from swarm_sim.robots.footbot import INTERWHEEL_DISTANCE
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import Command
 
 PLAN_TIME = 2.0 / 32.0
 """[s] a robot stands before each planned move: the STOP tick that pushes it and the tick that

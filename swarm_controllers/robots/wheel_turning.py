@@ -32,9 +32,9 @@ from math import atan2, cos, hypot, inf, remainder, sin
 import numpy as np
 
 from swarm_controllers.robots.ring import RingSensor
+from swarm_msgs_py.types import Command
 from swarm_sim.robots.footbot import INTERWHEEL_DISTANCE
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import Command
 
 NO_TURN, SOFT_TURN, HARD_TURN = 0, 1, 2
 _TWO_PI = 2.0 * math.pi

@@ -70,10 +70,10 @@ from swarm_controllers.spiral.geometry import (
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment
 from swarm_controllers.spiral.regions import RegionConfig, region_order
 from swarm_controllers.spiral.state import RegionView
+from swarm_msgs_py.types import NS_PER_S, RobotId, robot_index
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.protocol import Drawing, Lines
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, RobotId, robot_index
 
 FORWARD = 1
 """Walk from the spiral's start (region center), outward, clockwise."""

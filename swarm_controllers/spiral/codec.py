@@ -19,7 +19,7 @@ from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment, 
 from swarm_controllers.spiral.state import decode_center_state, encode_center_state
 from swarm_msgs_py.diagnostics import TYPE_NAME
 from swarm_msgs_py.records import RecordFamily
-from swarm_msgs_py.server_outputs import ServerMarkers, ServerOutputs, ServerState
+from swarm_sim.outputs import ServerMarkers, ServerOutputs, ServerState
 
 CENTER_REPORTS = "/center/reports"
 CENTER_ASSIGNMENTS = "/center/assignments"

@@ -93,8 +93,7 @@ from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.motion import Drive, drive_for
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.geometry import SpiralPath, ddsa_path
-from swarm_sim.scenario import Scenario
-from swarm_sim.types import (
+from swarm_msgs_py.types import (
     STOP,
     BehaviourStatus,
     Command,
@@ -103,6 +102,7 @@ from swarm_sim.types import (
     RobotId,
     robot_index,
 )
+from swarm_sim.scenario import Scenario
 
 LANE_YIELD_TIMEOUT = 3.0
 """A searcher whose lane stays blocked this long [s, sim time] swerves after all."""

@@ -94,9 +94,9 @@ from swarm_controllers.spiral.ddsa import LaneAvoidance
 from swarm_controllers.spiral.geometry import SpiralPath
 from swarm_controllers.spiral.protocol import ProgressReport, RegionAssignment, WalkProgress
 from swarm_controllers.spiral.regions import RegionConfig
+from swarm_msgs_py.types import STOP, BehaviourStatus, Command, Observation, Pose2D, RobotId
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import STOP, BehaviourStatus, Command, Observation, Pose2D, RobotId
 
 ASK_RETRY = 2.0
 """A report unanswered this long [s, sim time] is sent again (the answer normally takes two ticks)."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from swarm_sim.types import NS_PER_S
+from swarm_msgs_py.types import NS_PER_S
 
 MINUTE_NS = 60 * NS_PER_S
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+from swarm_msgs_py.types import Coordinate, RobotId
 from swarm_sim.protocol import ROBOTS
-from swarm_sim.types import Coordinate, RobotId
 
 CENTER = "center"
 """The center's channel."""

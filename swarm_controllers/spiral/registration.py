@@ -6,7 +6,7 @@ from swarm_sim.registry import Algorithm, DeliveryKind, Measure, Metric, Panel, 
 
 _SECTION = ("spiral", "swarm_controllers.spiral.config:SpiralConfig")
 _CHECKS = ("swarm_controllers.spiral.config:check_spiral",)
-_METRICS = tuple(Metric(name, f"swarm_controllers.spiral.metrics:{name}", None)
+_METRICS = tuple(Metric(name, f"swarm_controllers.spiral.metrics:{name}")
                  for name in ("resources_per_robot_per_min", "resources_per_robot_per_min_mean"))
 _HEADLINE = (Measure("resources_per_robot", "resources", "collected per robot"),
              Measure("resources_per_robot_per_min_mean", "resources/min", "foraging rate per robot"),
@@ -60,7 +60,7 @@ for _name, _delivery in (("mdbsa_c", "depot"), ("mdbsa_d", "region_centers")):
         servers=(_CENTER,),
         peers=("swarm_controllers.spiral.codec:WALKERS",),
         deliveries=(_delivery,),
-        metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count", None), *_METRICS),
+        metrics=(Metric("regions", "swarm_controllers.spiral.center:region_count"), *_METRICS),
         paths="swarm_controllers.spiral.center:planned_paths",
         comparison=_COMPARISON,
         headline=(*_HEADLINE, Measure("regions", symbol="N_regions")),

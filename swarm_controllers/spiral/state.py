@@ -1,7 +1,7 @@
 """`/center/state`: the center's regions as diagnostic_msgs/msg/DiagnosticArray.
 
 Published reliable + transient-local whenever it changes, so a late joiner (RViz, `ros2 topic
-echo`, the recorder) has the current state at once (`swarm_msgs_py.server_outputs.ServerState`:
+echo`, the recorder) has the current state at once (`swarm_sim.outputs.ServerState`:
 the value is a `RegionView` tuple, decoded back exactly). One status per region, name
 ``region_<i>``, values ``length``, ``remaining`` [m of spiral], ``finished``, ``walkers``
 (``robot_3:+1 robot_9:-1``: robot and walking direction), ``covered`` (``0.0-3.25 10.5-12.0``:

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 from swarm_sim import registry
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, NodeDownEvent, PickupEvent, RobotId, RobotStats
 
 
 @dataclass
@@ -35,7 +35,7 @@ class RunTrace:
     status: dict[RobotId, BehaviourStatus] = field(default_factory=dict)
     """Each behaviour's last published status."""
     config: Scenario | None = None
-    """The scenario the run used (world facts the metrics need: docks, perimeter, regions)."""
+    """The scenario the run used (world facts the metrics need: its world sections)."""
     probes: dict[str, Any] = field(default_factory=dict)
     """What each probe of the run's task observed (`swarm_sim.registry.Probe`), by name."""
     server_stale: dict[str, int] = field(default_factory=dict)
@@ -123,7 +123,9 @@ def _mean(values: dict[RobotId, float] | dict[RobotId, int]) -> float:
 
 
 def summarize(trace: RunTrace) -> dict[str, Any]:
-    """The JSON result of one run (schema documented in docs/command_line.md)."""
+    """The JSON result of one run: the core's fields, then its task's, its probes' and its
+    algorithm's (`_registered_metrics`); a field another paper reports is absent, not None
+    (schema: docs/command_line.md)."""
     collision = collision_time_by_robot(trace)
     contact = contact_time_by_robot(trace)
     oae = oae_by_robot(trace)
@@ -175,16 +177,14 @@ def foraging_metrics(trace: RunTrace) -> dict[str, Any]:
 
 
 def _registered_metrics(trace: RunTrace) -> dict[str, Any]:
-    """The world task's metrics and its probes', then every metric an algorithm registers (runs
-    of algorithms that do not declare one report its default, so every run has the same fields)."""
+    """The world task's metrics, those of the probes the run asked for, then its algorithm's own:
+    a row carries the fields of what ran and nothing of the other papers'."""
     ours = registry.of(trace.config) if trace.config is not None else None
     task = registry.task(ours.task if ours is not None else "foraging")
     out = registry.resolve(task.metrics)(trace) if task.metrics else {}
-    for probe in registry.probes(task.name):
+    for probe in registry.probes(trace.config) if trace.config is not None else ():
         out.update(registry.resolve(probe.metrics)(trace))
-    mine = {m.name for m in ours.metrics} if ours is not None else set()
-    for a in registry.algorithms():
-        for m in a.metrics:
-            if m.name not in out:
-                out[m.name] = registry.resolve(m.function)(trace) if m.name in mine else m.default
+    for m in ours.metrics if ours is not None else ():
+        if m.name not in out:
+            out[m.name] = registry.resolve(m.function)(trace)
     return out

@@ -23,15 +23,15 @@ import numpy as np
 
 from swarm_msgs_py import clock as clock_codec
 from swarm_msgs_py import diagnostics, odometry, scan, topics
-from swarm_msgs_py.server_outputs import SeriesLog
+from swarm_msgs_py.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
 from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.inbound import Bounds, Inbound, Rejections
 from swarm_sim.messaging import delivery_order
+from swarm_sim.outputs import SeriesLog
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
-from swarm_sim.types import NS_PER_S, DropEvent, NodeDownEvent, PickupEvent, robot_index
 
 
 class MalformedMessageWarning(UserWarning):
@@ -226,7 +226,7 @@ def _probes(trace: RunTrace, positions: dict[int, np.ndarray]) -> dict[str, Any]
     """Replay the recorded odometry through the probes the batch runner feeds live
     (`swarm_sim.registry.Probe`; a robot missing from a tick keeps its previous position)."""
     observers = {p.name: registry.resolve(p.observer)(trace.config, trace.robots)
-                 for p in registry.probes(registry.of(trace.config).task)}
+                 for p in registry.probes(trace.config)}
     previous = np.full((len(trace.robots), 2), np.inf)
     for stamp in sorted(positions):
         xy = positions[stamp]

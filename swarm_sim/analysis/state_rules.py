@@ -21,7 +21,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from swarm_sim.types import BehaviourStatus, RobotId
+from swarm_msgs_py.types import BehaviourStatus, RobotId
 
 Rule = Callable[[BehaviourStatus], "float | None"]
 """A robot's state -> the half-angle [deg] about its heading within which the ring's reading counts

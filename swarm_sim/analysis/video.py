@@ -31,18 +31,18 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from swarm_msgs_py import diagnostics, topics
+from swarm_msgs_py.types import NS_PER_S, DropEvent, PickupEvent
 from swarm_sim import registry
-from swarm_sim.analysis.video_canvas import SIZE_PX, WIDTH_PX, Canvas
+from swarm_sim.analysis.video_canvas import SIZE_PX, WIDTH_PX, Canvas, FrameState
 from swarm_sim.recording import BagError, bag_info, read_bag
 from swarm_sim.scenario import scenario_from_dict
-from swarm_sim.types import NS_PER_S, BehaviourStatus, DropEvent, PickupEvent
 
 __all__ = ("FORMATS", "SIZE_PX", "WIDTH_PX", "VideoInfo", "frames", "render_video", "resource_points", "save_frame")
 
@@ -63,28 +63,6 @@ class _Watch:
     """The servers' marker topics."""
     bodies: dict[str, object]
     """State topic -> its `StateTopic`, for the task's bodies (`TaskSpec.bodies`)."""
-
-
-@dataclass
-class _State:
-    """What the frame at the current sim time shows."""
-
-    odom: dict[int, bytes] = field(default_factory=dict)
-    """Robot index -> its last odometry message (decoded only when a frame is drawn)."""
-    status: dict[str, BehaviourStatus] = field(default_factory=dict)
-    """Robot -> its last reported status."""
-    carrying: set[str] = field(default_factory=set)
-    resources: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    delivered: int = 0
-    lines: dict[tuple[str, str], list[tuple[np.ndarray, tuple[float, ...], float]]] = field(default_factory=dict)
-    """Servers' line strips by (topic, namespace): (points [m], RGBA, width [m]) each."""
-    points: dict[tuple[str, str], tuple[np.ndarray, tuple[float, ...], float, str]] = field(default_factory=dict)
-    """Servers' point lists by (topic, namespace): (points [m], RGBA, size [m], matplotlib marker)."""
-    placed: dict[str, tuple[np.ndarray, tuple[float, ...]]] = field(default_factory=dict)
-    """What the world task placed besides resources (the caging landmarks), by name: (points
-    [m], RGBA), from ``/world/markers``."""
-    bodies: dict[str, tuple[float, float]] = field(default_factory=dict)
-    """The task's bodies at their last state-topic position [m] (the caging object), by field."""
 
 
 @dataclass(frozen=True)
@@ -121,7 +99,7 @@ def _rgba(marker) -> tuple[float, ...]:
     return tuple(min(max(float(v), 0.0), 1.0) if math.isfinite(v) else 0.5 for v in (c.r, c.g, c.b, c.a))
 
 
-def _apply(state: _State, topic: str, data: bytes, watch: _Watch) -> None:
+def _apply(state: FrameState, topic: str, data: bytes, watch: _Watch) -> None:
     """Fold one recorded message into the state."""
     robots = watch.robots
     if topic.endswith("/" + topics.ODOM):
@@ -195,7 +173,7 @@ def frames(bag: Path | str, times: np.ndarray) -> Iterator[np.ndarray]:
         overlays=frozenset(t for t, i in info.topics.items() if i.type_name == _MARKER_TYPES and t != topics.WORLD_MARKERS),
         bodies={st.topic: st for st in (registry.resolve(task.state) if task.state else ()) if st.field in sizes},
     )
-    state = _State()
+    state = FrameState()
     canvas = Canvas(scenario, len(names), sizes)
     done = 0
     try:

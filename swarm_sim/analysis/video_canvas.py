@@ -7,19 +7,17 @@ progress in the title. One matplotlib figure whose artists are updated per frame
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from swarm_msgs_py import odometry
-from swarm_msgs_py.server_outputs import outputs_of
+from swarm_msgs_py.types import BehaviourStatus
 from swarm_sim import registry
+from swarm_sim.outputs import outputs_of
 from swarm_sim.protocol import Lines
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-
-if TYPE_CHECKING:
-    from swarm_sim.analysis.video import _State as State
 
 SIZE_PX = 720
 """Frame height [px], and the arena's square (a multiple of 16, as H.264 wants)."""
@@ -34,6 +32,28 @@ beyond 16 states they repeat."""
 NO_STATUS = ("#d0d0d0", "no status yet")
 BODY_COLOUR = (0.84, 0.15, 0.16, 0.55)
 
+
+@dataclass
+class FrameState:
+    """What the frame at the current sim time shows (folded from the bag by
+    `swarm_sim.analysis.video`)."""
+
+    odom: dict[int, bytes] = field(default_factory=dict)
+    """Robot index -> its last odometry message (decoded only when a frame is drawn)."""
+    status: dict[str, BehaviourStatus] = field(default_factory=dict)
+    """Robot -> its last reported status."""
+    carrying: set[str] = field(default_factory=set)
+    resources: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    delivered: int = 0
+    lines: dict[tuple[str, str], list[tuple[np.ndarray, tuple[float, ...], float]]] = field(default_factory=dict)
+    """Servers' line strips by (topic, namespace): (points [m], RGBA, width [m]) each."""
+    points: dict[tuple[str, str], tuple[np.ndarray, tuple[float, ...], float, str]] = field(default_factory=dict)
+    """Servers' point lists by (topic, namespace): (points [m], RGBA, size [m], matplotlib marker)."""
+    placed: dict[str, tuple[np.ndarray, tuple[float, ...]]] = field(default_factory=dict)
+    """What the world task placed besides resources (the caging landmarks), by name: (points
+    [m], RGBA), from ``/world/markers``."""
+    bodies: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """The task's bodies at their last state-topic position [m] (the caging object), by field."""
 
 def overlays(scenario: Scenario) -> list[tuple[str, Lines | object]]:
     """(server name, drawing item) of every server of the scenario's algorithm, its core drawn
@@ -168,7 +188,7 @@ class Canvas:
             self.key.legend(handles=world, title="world", loc="lower left", fontsize=8, title_fontsize=9,
                             frameon=False, bbox_to_anchor=(0.0, 0.02))
 
-    def draw(self, state: State, t: float, robot_names: list[str]) -> np.ndarray:
+    def draw(self, state: FrameState, t: float, robot_names: list[str]) -> np.ndarray:
         segments, colours = [], []
         for key in sorted(state.lines):
             for xy, rgba, _ in state.lines[key]:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from swarm_sim.types import Command, RobotId
+from swarm_msgs_py.types import Command, RobotId
 
 
 class CommandWatch:

@@ -40,9 +40,9 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 
 from swarm_msgs_py import auth, diagnostics, topics
-from swarm_msgs_py.qos import EVENTS, STATE_LATCHED, family_qos
 from swarm_sim.inbound import Bounds, Inbound, Rejections, merged, total
 from swarm_sim.messaging import Mailbox
+from swarm_sim.nodes.qos import EVENTS, STATE_LATCHED, family_qos
 from swarm_sim.scenario import Scenario
 
 ACK_WAIT_ENV = "SWARMFORAGE_ACK_WAIT"
@@ -70,7 +70,7 @@ def wait_acked(publishers: Iterable[Any], seconds: float) -> bool:
 
 @dataclass(frozen=True)
 class EndpointConfig:
-    """The parameters of a controller or server node (`swarm_msgs_py.params.declare_config`)."""
+    """The parameters of a controller or server node (`swarm_sim.nodes.params.declare_config`)."""
 
     scenario: str = ""
     """Scenario name or YAML path (the same one the world loads; '': the default scenario)."""

@@ -23,8 +23,8 @@ import sys
 from pathlib import Path
 
 from swarm_msgs_py import topics
-from swarm_msgs_py.server_outputs import LivePlot, outputs_of
 from swarm_sim import registry
+from swarm_sim.outputs import LivePlot, outputs_of
 
 LAYOUT_FILE = Path(__file__).resolve().parents[2] / "launch_py" / "foxglove_layout.json"
 LICHTBLICK_FILE = LAYOUT_FILE.with_name("lichtblick_layout.json")

@@ -16,10 +16,10 @@ from __future__ import annotations
 from rclpy.node import Node
 
 from swarm_msgs_py import auth, topics
-from swarm_msgs_py.qos import EVENTS
 from swarm_sim import registry
 from swarm_sim.inbound import Inbound
 from swarm_sim.nodes.endpoint import ack_wait, wait_acked
+from swarm_sim.nodes.qos import EVENTS
 from swarm_sim.nodes.world_recording import WorldRecording
 
 

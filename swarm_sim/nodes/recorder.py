@@ -21,8 +21,8 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy
 
 from swarm_msgs_py import topics
-from swarm_msgs_py.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_profile
 from swarm_sim.nodes.live_view import LiveView
+from swarm_sim.nodes.qos import EVENTS, RECORD_LATCHED, published_depth, rosbag2_profile
 from swarm_sim.recording import BagWriter
 
 _ROBOT_NAMESPACE = re.compile(r"^/robot_\d+/")

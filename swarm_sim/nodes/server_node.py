@@ -3,7 +3,7 @@
 ``swarm-server --channel depot --scenario queue_qmt ...`` runs the server the scenario's
 algorithm registers on that channel, built from its registry record alone: its core, its message
 family (`swarm_sim.nodes.endpoint.Endpoint`) and its declared outputs
-(`swarm_msgs_py.server_outputs.ServerOutputs`: state topics and markers, reliable +
+(`swarm_sim.outputs.ServerOutputs`: state topics and markers, reliable +
 transient-local). The node is named as the record says (``depot_manager``, ``center``, ...).
 
 On each ``/clock`` tick k the node hands the core the messages stamped before k, publishes the
@@ -35,19 +35,20 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from swarm_msgs_py import ack, auth, diagnostics, markers, topics
+from swarm_msgs_py import ack, auth, diagnostics, topics
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py.executor import make_executor
-from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
-from swarm_msgs_py.server_outputs import MARKER_ARRAY, StateWatch, outputs_of
+from swarm_msgs_py.types import NS_PER_S, NodeDownEvent
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph
 from swarm_sim.inbound import Reason
+from swarm_sim.nodes import markers
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config, wait_acked
+from swarm_sim.nodes.executor import make_executor
+from swarm_sim.nodes.params import declare_config
+from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.outputs import MARKER_ARRAY, StateWatch, outputs_of
 from swarm_sim.protocol import Drawing, Lines, Server
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import NS_PER_S, NodeDownEvent
 
 CLOCK_BYTES = 64
 """Cap on a ``/clock`` message [bytes] (ours are 12)."""

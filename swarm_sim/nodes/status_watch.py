@@ -23,10 +23,10 @@ from rclpy.executors import Executor
 from rclpy.node import Node
 
 from swarm_msgs_py import auth, diagnostics, topics
-from swarm_msgs_py.qos import EVENTS
+from swarm_msgs_py.types import BehaviourStatus, RobotId
 from swarm_sim.inbound import Inbound, Reason
+from swarm_sim.nodes.qos import EVENTS
 from swarm_sim.nodes.world_recording import WorldRecording
-from swarm_sim.types import BehaviourStatus, RobotId
 
 _DECODE_STATUS = auth.verified(diagnostics.decode_status)
 """A status must carry the run's tag: a forged `finished` would end the run early."""

@@ -30,9 +30,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from swarm_msgs_py import auth, topics
-from swarm_msgs_py.server_outputs import MARKER_ARRAY, outputs_of
 from swarm_msgs_py.topics import CLOCK
 from swarm_sim import registry
+from swarm_sim.outputs import MARKER_ARRAY, outputs_of
 from swarm_sim.scenario import Scenario
 
 WORLD = ("/", "world")

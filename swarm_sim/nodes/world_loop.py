@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from rclpy.executors import Executor
 
-from swarm_sim.types import NS_PER_S
+from swarm_msgs_py.types import NS_PER_S
 
 if TYPE_CHECKING:
     from swarm_sim.nodes.world_node import WorldNode

@@ -40,23 +40,23 @@ from rclpy.signals import SignalHandlerOptions
 from swarm_msgs_py import ack as ack_codec
 from swarm_msgs_py import auth, odometry, scan, topics, twist
 from swarm_msgs_py import clock as clock_codec
-from swarm_msgs_py.executor import make_executor
-from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import SENSOR_LOCKSTEP
 from swarm_msgs_py.sensing import Sensing
+from swarm_msgs_py.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim import registry
 from swarm_sim.cli import first_paragraph, number
 from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.command_watch import CommandWatch
+from swarm_sim.nodes.executor import make_executor
 from swarm_sim.nodes.lockstep import LockstepBarrier
+from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.qos import SENSOR_LOCKSTEP
 from swarm_sim.nodes.status_watch import StatusWatch
 from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
 from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
-from swarm_sim.types import FINISHED, NS_PER_S, Command, NodeDownEvent, Observation, RobotId
 from swarm_sim.world import World
 
 COMMAND_BYTES = 512

@@ -17,10 +17,11 @@ from collections.abc import Sequence
 
 from rclpy.node import Node
 
-from swarm_msgs_py import auth, diagnostics, markers, topics
-from swarm_msgs_py.qos import EVENTS, STATE_LATCHED
+from swarm_msgs_py import auth, diagnostics, topics
 from swarm_sim.inbound import Rejections
+from swarm_sim.nodes import markers
 from swarm_sim.nodes.endpoint import RejectionReport
+from swarm_sim.nodes.qos import EVENTS, STATE_LATCHED
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario
 from swarm_sim.world import World

@@ -18,8 +18,8 @@ from pathlib import Path
 from rclpy.node import Node
 
 from swarm_msgs_py import topics
-from swarm_msgs_py.qos import STATE_LATCHED
 from swarm_sim.nodes.live_view import LiveView
+from swarm_sim.nodes.qos import STATE_LATCHED
 from swarm_sim.nodes.recorder import Recorder
 from swarm_sim.scenario import Scenario, scenario_to_dict
 

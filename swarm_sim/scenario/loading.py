@@ -14,6 +14,7 @@ Sections the file leaves out are not filled in: ``TheSection.of(scenario)`` give
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 import re
@@ -223,7 +224,7 @@ def load_scenario(
     given += [(key.replace("__", "."), value) for key, value in fields.items() if value is not None]
     for key, value in given:
         _set_path(data, key, value)
-    return _finish(_build(Scenario, data, ""), given)
+    return _finish(_build(Scenario, _moved(data, carry=False), ""), given)
 
 
 def _leaves(key: str, value: Any) -> Iterable[tuple[str, Any]]:
@@ -337,5 +338,29 @@ def scenario_to_dict(scenario: Scenario) -> dict[str, Any]:
 
 
 def scenario_from_dict(data: dict[str, Any]) -> Scenario:
-    """The scenario `scenario_to_dict` wrote (bag metadata), built and validated again."""
-    return _finish(_build(Scenario, data, ""))
+    """The scenario `scenario_to_dict` wrote (bag metadata), built and validated again; keys a
+    world section has taken over since the bag was recorded (`WorldSection.MOVED`) are carried
+    into it first, so an old recording still reads."""
+    return _finish(_build(Scenario, _moved(data, carry=True), ""))
+
+
+def _moved(data: dict[str, Any], carry: bool) -> dict[str, Any]:
+    """`data` with every key a declared world section lists in its ``MOVED`` put into that
+    section (a copy; the section's own value wins where both are given), or, unless `carry`,
+    a ScenarioError naming the first such key and where it lives now (a scenario file)."""
+    out = copy.deepcopy(data) if carry else data
+    for name in registry.world_sections():
+        for old, field_name in registry.world_section(name).MOVED.items():
+            *parents, leaf = old.split(".")
+            where: Any = out
+            for part in parents:
+                where = where.get(part) if isinstance(where, dict) else None
+            if not (isinstance(where, dict) and leaf in where):
+                continue
+            if not carry:
+                raise ScenarioError(f"{old}: moved to {name}.{field_name}")
+            value = where.pop(leaf)
+            section = out.setdefault(name, {})
+            if isinstance(section, dict):
+                section.setdefault(field_name, value)
+    return out

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -271,14 +272,9 @@ class ResourceConfig:
 
 @dataclass(frozen=True)
 class DepotConfig:
-    """The central depot: its disc, where resources are delivered, and the perimeter and docks
-    around it (queue paper sec. III). World facts only; the drop zones a delivery kind implies
-    are worked out by its registered record (`swarm_sim.sites.drop_zones`).
-
-    The queue paper's fields (`perimeter_radius`, `docks`, `unload_time`, `dock_radius`,
-    `dock_distance`) stay here rather than in a section of that paper: every run's perimeter log
-    and its ``deliveries_outside_docks`` result read them whatever the algorithm, and every
-    recorded bag's scenario carries them under ``depot``."""
+    """The central depot: its disc and where resources are delivered. World facts only; the drop
+    zones a delivery kind implies are worked out by its registered record, from world sections of
+    its own where it needs more (`swarm_sim.sites.drop_zones`)."""
 
     center: tuple[float, float] = (0.0, 0.0)
     """[m, world frame]"""
@@ -287,19 +283,6 @@ class DepotConfig:
     delivery: str = "depot"
     """Where resources are delivered: a registered delivery kind (`swarm_sim.registry.DeliveryKind`):
     `depot` anywhere in the depot disc (the shared core's); the papers register the others."""
-    perimeter_radius: float = 2.0
-    """Radius of the perimeter (red circle) [m] around the depot; the queue paper's drop-off
-    time runs from a carrier's entry into it."""
-    docks: int = 4
-    """Number K of docks on the depot boundary."""
-    unload_time: float = 5.0
-    """T_unload: a robot stays at its dock this long before its resource is dropped [s]. The
-    queue paper gives no value; 5 s is our choice."""
-    dock_radius: float = 0.06
-    """A robot unloads while its centre is within this distance of the dock stop [m]."""
-    dock_distance: float | None = None
-    """Distance of the dock stops from the depot centre [m]; None: one robot radius outside
-    the depot disc (where the queue layouts end)."""
 
 
 @dataclass(frozen=True)
@@ -366,12 +349,15 @@ class Section:
 
 
 class WorldSection:
-    """Base of a world-fact section a task or an algorithm declares (a frozen dataclass, named in
-    the ``world`` of its registry record): `SECTION` is its top-level key in a scenario file,
-    `of` reads it from a scenario (its defaults if the scenario does not give it), `check`
-    refuses impossible values when the scenario is loaded."""
+    """Base of a world-fact section a task, an algorithm or a delivery kind declares (a frozen
+    dataclass, named in the ``world`` of its registry record): `SECTION` is its top-level key in a
+    scenario file, `of` reads it from a scenario (its defaults if the scenario does not give it),
+    `check` refuses impossible values when the scenario is loaded."""
 
     SECTION: ClassVar[str] = ""
+    MOVED: ClassVar[Mapping[str, str]] = {}
+    """Dotted keys where scenarios recorded earlier kept some of its fields -> the field: a
+    recorded scenario still loads (`swarm_sim.scenario.scenario_from_dict` carries them over)."""
 
     @classmethod
     def of(cls, scenario: Scenario) -> Self:

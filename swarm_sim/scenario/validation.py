@@ -175,15 +175,3 @@ def check_world(s: Scenario) -> None:
         _require(_inside(o.center, half, 0.0), f"obstacles[{i}].center: {o.center} is outside the arena")
     _require(s.controller.arrival_tolerance > 0, "controller.arrival_tolerance: must be positive")
     _require(r.radio_range > 0, "robots.radio_range: must be positive")
-    # The queue paper's depot fields (kept in `DepotConfig`, see there): every run reads them.
-    d = s.depot
-    _require(d.unload_time >= 0, "depot.unload_time: must not be negative")
-    _require(d.dock_radius > 0, "depot.dock_radius: must be positive")
-    _require(d.docks >= 1, "depot.docks: need at least one dock")
-    _require(d.dock_distance is None or d.dock_distance > 0, "depot.dock_distance: must be positive")
-    stop = d.radius + r.diameter / 2 if d.dock_distance is None else d.dock_distance
-    _require(
-        d.docks == 1 or 2 * stop * math.sin(math.pi / d.docks) >= r.diameter,
-        f"depot.docks: {d.docks} docks do not fit side by side {stop} m from the depot centre",
-    )
-    _require(d.perimeter_radius > d.radius, "depot.perimeter_radius: must exceed depot.radius")

@@ -43,15 +43,15 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Collection, Mapping
+from collections.abc import Callable, Collection, Mapping
 from itertools import repeat
 from operator import attrgetter
 
 import numpy as np
 
-from swarm_sim.geometry import wrap_angle, yaw_to_quaternion
+from swarm_msgs_py.geometry import wrap_angle, yaw_to_quaternion
+from swarm_msgs_py.types import Command, Observation, Pose2D, RobotId, RobotStats
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import Command, Observation, Pose2D, RobotId, RobotStats
 from swarm_sim.world import bullet
 from swarm_sim.world.bullet import pybullet as p
 from swarm_sim.world.jit import inline, kernel
@@ -60,8 +60,11 @@ from swarm_sim.world.pairs import RobotPairs
 from swarm_sim.world.proximity import ProximityRing
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet
 from swarm_sim.world.start import start_positions
-from swarm_sim.world.tasks import TaskFactory, WorldTask
+from swarm_sim.world.tasks import WorldTask
 
+TaskFactory = Callable[["World", tuple[np.random.SeedSequence, np.random.SeedSequence]], WorldTask]
+"""Builds a task for a world being built: (world, the task's two seed sequences); beside `World`
+so the tasks' protocol (`swarm_sim.world.tasks`) needs nothing of the world."""
 TILT_INERTIA = 1e6
 """Roll and pitch inertia [kg m^2] of a robot that is not planar (``robots.planar``; the generic
 robot): large enough that contacts never tip it, though they leave tilts below 1e-9 (and turning

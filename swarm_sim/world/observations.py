@@ -3,7 +3,7 @@
 `Observation` and `Pose2D` are frozen slotted dataclasses. Their generated ``__init__`` sets
 each field through ``object.__setattr__``, which made constructing them most of the cost of
 `World.observe` (1000 robots: 1.1 ms a tick). Here the slots are filled through their
-descriptors directly (`swarm_sim.types.slot_setters`): field by field for the whole swarm
+descriptors directly (`swarm_msgs_py.types.slot_setters`): field by field for the whole swarm
 (`observations`, 1000 robots: 0.7 ms), or one object at a time (`with_messages`: the batch
 runner's copies carrying a tick's inbox). Both fall back to the ordinary constructor should the
 classes ever gain fields or a ``__post_init__`` (test_world checks both give equal objects).
@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from swarm_sim.types import Observation, Pose2D, RobotId, slot_constructor, slot_setters
+from swarm_msgs_py.types import Observation, Pose2D, RobotId, slot_constructor, slot_setters
 from swarm_sim.world.jit import kernel
 
 _TWO_PI = 2.0 * math.pi
@@ -109,4 +109,4 @@ def with_messages(obs: Observation, messages: tuple[object, ...]) -> Observation
 
 
 _new_observation = slot_constructor(Observation)
-"""``Observation(...)``, positional, for a fraction of its cost (`swarm_sim.types.slot_constructor`)."""
+"""``Observation(...)``, positional, for a fraction of its cost (`swarm_msgs_py.types.slot_constructor`)."""

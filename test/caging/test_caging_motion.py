@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from swarm_controllers.caging.config import CagingConfig, PidGains
 from swarm_controllers.caging.motion import Formation, GoTo, Limits, Motion, Neighbour, Pid, Spin, deadband
-from swarm_sim.types import Pose2D
+from swarm_msgs_py.types import Pose2D
 
 CFG = CagingConfig()
 LIMITS = Limits(linear=0.5, angular=11.3, dt=0.1, sigma=math.radians(3.0))

@@ -17,11 +17,11 @@ from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_controllers.caging.task import CagingSense
 from swarm_controllers.caging.world_config import TransportConfig
+from swarm_msgs_py.types import NS_PER_S, STOP, BehaviourStatus, Observation, Pose2D, robot_index
 from swarm_sim import batch
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NS_PER_S, STOP, BehaviourStatus, Observation, Pose2D, robot_index
 
 SMALL = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=200"]
 """Six robots (the paper's smallest swarm) on a 2 x 2 m grid: the whole protocol in ~3 min of sim."""

@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 from swarm_controllers.caging.stages import progress, stage
+from swarm_msgs_py.types import BehaviourStatus
 from swarm_sim import registry
-from swarm_sim.types import BehaviourStatus
 
 
 def _statuses(*phases: str, leg: str = "0/0", recruiter: str = "") -> dict:

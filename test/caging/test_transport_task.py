@@ -14,12 +14,12 @@ from swarm_controllers.caging.behaviour import Phase
 from swarm_controllers.caging.metrics import inside_polygon, polyline_length
 from swarm_controllers.caging.sensing import SENSING, STATE
 from swarm_controllers.caging.task import OBJECT, WALL
+from swarm_msgs_py.types import Command, Pose2D
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour, task_factory
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import Command, Pose2D
 from swarm_sim.world import World
 from swarm_sim.world.bullet import pybullet as p
 

@@ -15,6 +15,7 @@ from generic_robot import generic_scenario
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from depot_manager.config import DockingConfig
 from swarm_controllers.cpfa.behaviour import (
     CpfaBehaviour,
     CpfaState,
@@ -25,11 +26,11 @@ from swarm_controllers.cpfa.behaviour import (
 )
 from swarm_controllers.cpfa.config import CpfaConfig
 from swarm_controllers.cpfa.messages import PheromoneMessage
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("cpfa")
@@ -646,7 +647,7 @@ def _inner_state(b: CpfaBehaviour) -> tuple:
 QUEUE_QMT = generic_scenario("queue_qmt")
 
 
-@pytest.mark.parametrize(("s", "keep_out"), [(BASE, None), (QUEUE_CPFA, None), (QUEUE_QMT, QUEUE_QMT.depot.perimeter_radius + 0.25)],
+@pytest.mark.parametrize(("s", "keep_out"), [(BASE, None), (QUEUE_CPFA, None), (QUEUE_QMT, DockingConfig.of(QUEUE_QMT).perimeter_radius + 0.25)],
                          ids=["cpfa", "docks", "keep_out"])
 def test_the_motion_skipped_while_the_avoidance_drives_changes_nothing(s, keep_out):
     """Same commands, same states and draws as a CPFA that steers on every tick, along a drive

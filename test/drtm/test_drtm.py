@@ -19,8 +19,8 @@ from swarm_controllers.drtm.response_threshold import (
     traffic_flow_density,
 )
 from swarm_controllers.drtm.task import NestSense
+from swarm_msgs_py.types import Observation, Pose2D
 from swarm_sim.scenario import ScenarioError, load_scenario
-from swarm_sim.types import Observation, Pose2D
 
 # ------------------------------------------------------------------ eqs. (2)-(7) by hand
 

@@ -23,12 +23,12 @@ from swarm_controllers.drtm.metrics import (
 )
 from swarm_controllers.drtm.nest import NestServer
 from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
-from swarm_msgs_py.server_outputs import SeriesLog
+from swarm_msgs_py.types import BehaviourStatus, DropEvent
 from swarm_sim import registry
 from swarm_sim.analysis.metrics import RunTrace
+from swarm_sim.outputs import SeriesLog
 from swarm_sim.registry import task_factory
 from swarm_sim.scenario import ScenarioError
-from swarm_sim.types import BehaviourStatus, DropEvent
 from swarm_sim.world import World
 
 DT_NS = 100_000_000
@@ -142,7 +142,7 @@ def test_food_changes_only_by_deliveries_consumption_and_the_nest_rate(events, p
 def test_the_light_points_at_the_nest_centre_within_its_range():
     s = _scenario("sensors.light_range=1.0")
     with World(s, task_factory(s)) as world:
-        from swarm_sim.types import Pose2D
+        from swarm_msgs_py.types import Pose2D
 
         world.teleport({"robot_0": Pose2D(0.5, 0.0, math.pi), "robot_1": Pose2D(0.0, -0.9, 0.0),
                         "robot_2": Pose2D(1.5, 1.5, 0.0)})
@@ -200,7 +200,7 @@ def test_series_are_sampled_every_five_seconds():
 
 def test_the_recorded_nest_state_replays_as_the_batch_runners_series():
     """The nest's series are read off the states it sends: from the messages in a batch run,
-    from their recorded bytes in a bag replay (`swarm_msgs_py.server_outputs.SeriesLog`)."""
+    from their recorded bytes in a bag replay (`swarm_sim.outputs.SeriesLog`)."""
     nest = NestServer(_scenario())
     (spec,) = registry.algorithm("drtm").servers
     live, replayed = SeriesLog([spec], {}), SeriesLog([spec], {})

@@ -36,7 +36,7 @@ from depot_manager.geometry import (
 from depot_manager.protocol import DepotGrant, DepotReport, Refusal, ReportKind
 from depot_manager.server import DepotServer
 from swarm_controllers.spiral.protocol import ProgressReport
-from swarm_msgs_py.server_outputs import StateWatch
+from swarm_sim.outputs import StateWatch
 from swarm_sim.scenario import ControllerConfig, DepotConfig, Scenario
 
 P_MIN = 0.3

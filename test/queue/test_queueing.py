@@ -13,7 +13,7 @@ from generic_robot import generic_scenario
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from depot_manager.config import QueueConfig
+from depot_manager.config import DockingConfig, QueueConfig
 from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
 from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.queue.behaviour import (
@@ -24,9 +24,9 @@ from swarm_controllers.queue.behaviour import (
     QueueBehaviour,
     _segment_hits_disc,
 )
+from swarm_msgs_py.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.batch import run_batch
-from swarm_sim.types import NS_PER_S, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROBOTS = 16
@@ -64,7 +64,7 @@ def test_only_carriers_enter_the_perimeter(run):
     scenario, result = run
     poses, trace = result.poses, result.trace
     dt = scenario.sim.dt
-    R = scenario.depot.perimeter_radius - scenario.robots.diameter / 2
+    R = DockingConfig.of(scenario).perimeter_radius - scenario.robots.diameter / 2
     r = np.hypot(poses[..., 0], poses[..., 1])
     for i, robot in enumerate(trace.robots):
         picks = sorted(p.stamp_ns / NS_PER_S for p in trace.pickups if p.robot == robot)
@@ -83,7 +83,7 @@ def test_only_carriers_enter_the_perimeter(run):
 
 def test_queue_lengths_are_recorded(run):
     scenario, result = run
-    lines = 1 if QueueConfig.of(scenario).wrapping == "single" else scenario.depot.docks
+    lines = 1 if QueueConfig.of(scenario).wrapping == "single" else DockingConfig.of(scenario).docks
     assert result.trace.series["queue_lengths"], "the depot server recorded no queue lengths"
     assert all(len(q) == lines for _, q in result.trace.series["queue_lengths"])
 
@@ -114,7 +114,7 @@ def test_tail_joining_talks_over_the_radio_and_entry_joining_does_not():
 def test_a_non_carrier_is_steered_out_of_the_perimeter():
     scenario = generic_scenario("queue_qmt", ["robots.count=1"])
     b = QueueBehaviour(scenario, "robot_0", np.random.default_rng(0))
-    from swarm_sim.types import Observation, Pose2D
+    from swarm_msgs_py.types import Observation, Pose2D
 
     ranges = np.full(scenario.sensors.scan.rays, np.inf, dtype=np.float32)
     obs = Observation("robot_0", 0, Pose2D(1.0, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), False))
@@ -168,16 +168,16 @@ def test_the_depot_manager_ignores_reports_from_robots_that_do_not_exist():
 
 def test_dropoff_time_stops_at_the_dock_before_t_unload():
     from swarm_controllers.queue.perimeter import PROBE, Crossings, dock_arrival_s, dropoff_times
+    from swarm_msgs_py.types import DropEvent
     from swarm_sim.analysis.metrics import RunTrace
-    from swarm_sim.types import DropEvent
 
     s = generic_scenario("queue_qmt")
     drop = DropEvent("robot_0", 100 * NS_PER_S, 3, "dock_0", 0.585, 0.0)
     trace = RunTrace("queue_qmt", 0, ("robot_0",), 120.0, 1.0, 320, "batch", drops=[drop], config=s,
                      probes={PROBE: Crossings(entries={"robot_0": [10.0, 40.0]})})
     # the foraging task drops on the first tick the carrier has been inside for T_unload
-    assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - s.depot.unload_time)
-    assert dropoff_times(trace) == [pytest.approx(100.0 - s.depot.unload_time - 40.0)]
+    assert dock_arrival_s(trace, drop) == pytest.approx(100.0 - DockingConfig.of(s).unload_time)
+    assert dropoff_times(trace) == [pytest.approx(100.0 - DockingConfig.of(s).unload_time - 40.0)]
 
 
 class _Everyone:
@@ -318,7 +318,7 @@ def test_a_tail_seeker_falls_back_to_entry_joining_after_seek_timeout(timeout):
     assert QueueConfig.of(s).seek_timeout == timeout
     b = make_behaviour(s, "robot_0", np.random.default_rng(0))
     ranges = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
-    x = s.depot.perimeter_radius - 0.1  # inside the perimeter, carrying: it starts seeking
+    x = DockingConfig.of(s).perimeter_radius - 0.1  # inside the perimeter, carrying: it starts seeking
     phases = []
     for k in range(40):  # 4 s, standing where it is (nobody answers)
         b.step(Observation("robot_0", k * s.dt_ns, Pose2D(x, 0.0, math.pi), 0.0, 0.0, ranges, ForagingSense((), True)))

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 from swarm_controllers.spiral.center import FORWARD, REVERSE, Assignment, RegionAssigner
 from swarm_controllers.spiral.geometry import SpiralPath, mdbsa_path, region_centers, region_side
 from swarm_controllers.spiral.regions import region_order
+from swarm_msgs_py.types import robot_name
 from swarm_sim.scenario import ScenarioError
-from swarm_sim.types import robot_name
 
 ARENA = 8.0
 

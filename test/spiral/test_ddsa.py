@@ -16,12 +16,12 @@ from swarm_controllers.avoidance import ray_angles
 from swarm_controllers.spiral.config import SpiralConfig
 from swarm_controllers.spiral.ddsa import LANE_YIELD_TIMEOUT, DdsaBehaviour, DdsaState, LaneAvoidance
 from swarm_controllers.spiral.geometry import ddsa_path
+from swarm_msgs_py.types import STOP, Command, Observation, Pose2D
 from swarm_sim.analysis.metrics import resources_delivered
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError
-from swarm_sim.types import STOP, Command, Observation, Pose2D
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("ddsa", robots__count=4)

@@ -34,12 +34,12 @@ from swarm_controllers.spiral.geometry import (
 from swarm_controllers.spiral.mdbsa import ASK_MARGIN, ASK_RETRY, DEPOT_POINT_HIT, DEPOT_POINT, MdbsaBehaviour, MdbsaState
 from swarm_controllers.spiral.protocol import CENTER, ProgressReport, RegionAssignment, WalkProgress
 from swarm_controllers.spiral.regions import RegionConfig
+from swarm_msgs_py.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.messaging import Router
 from swarm_sim.protocol import ROBOTS
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import DropEvent, Observation, Pose2D, robot_name
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROW_MAJOR = ["regions.order=row_major"]

@@ -21,12 +21,12 @@ from swarm_controllers.spiral.codec import (
 from swarm_controllers.spiral.geometry import region_centers, region_side
 from swarm_controllers.spiral.protocol import RegionAssignment
 from swarm_msgs_py import topics
+from swarm_msgs_py.types import NS_PER_S
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry, load_run
 from swarm_sim.batch import run_batch
 from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.scenario import load_scenario
-from swarm_sim.types import NS_PER_S
 
 ROBOTS = 8
 DURATION = 120.0

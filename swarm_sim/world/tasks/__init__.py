@@ -27,13 +27,10 @@ The hooks, called by the world in this order:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, Protocol
+from collections.abc import Mapping, Sequence
+from typing import Any, Protocol
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from swarm_sim.world.core import World
 
 
 class WorldTask(Protocol):
@@ -62,7 +59,3 @@ class WorldTask(Protocol):
     def progress(self) -> str:
         """A few words for progress lines (``delivered=12``)."""
         ...
-
-
-TaskFactory = Callable[["World", tuple[np.random.SeedSequence, np.random.SeedSequence]], WorldTask]
-"""Builds a task for a world being built: (world, the task's two seed sequences)."""

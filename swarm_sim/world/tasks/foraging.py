@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from swarm_msgs_py.types import DropEvent, PickupEvent, RobotId
 from swarm_sim.sites import drop_zones, zones_clear_of_resources
-from swarm_sim.types import DropEvent, PickupEvent, RobotId
 from swarm_sim.world.jit import kernel
 from swarm_sim.world.resources import place_one, place_resources
 

@@ -10,7 +10,7 @@ DELIVERIES = Panel("resources delivered", "resources delivered [resources]",
 register_task(TaskSpec(
     name="foraging",
     core="swarm_sim.world.tasks.foraging:ForagingTask",
-    sensing="swarm_msgs_py.foraging:SENSING",
+    sensing="swarm_sim.world.tasks.foraging_sensing:SENSING",
     metrics="swarm_sim.analysis.metrics:foraging_metrics",
     headline=(Measure("resources_delivered", "resources"), Measure("total_resources", "resources")),
     panels=(DELIVERIES,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from dummy_algorithm.messages import Ping
-from swarm_sim.types import NS_PER_S, BehaviourStatus, Command, Observation
+from swarm_msgs_py.types import NS_PER_S, BehaviourStatus, Command, Observation
 
 PING_PERIOD_NS = 2 * NS_PER_S
 ARRIVED = 0.5

@@ -9,7 +9,7 @@ from dummy_algorithm.task import BeaconSense
 from swarm_msgs_py.cdr import ENCAPSULATION, align, codec, frames_fragment, skip_header, split_stamp
 from swarm_msgs_py.records import RecordFamily
 from swarm_msgs_py.sensing import SenseTopic, Sensing
-from swarm_msgs_py.server_outputs import Series, ServerOutputs
+from swarm_sim.outputs import Series, ServerOutputs
 
 TYPE_NAME = "geometry_msgs/msg/PointStamped"
 _FRAME = frames_fragment("base_link", then_align=8)

@@ -13,6 +13,6 @@ register(Algorithm(
     task="beacon",
     servers=(ServerSpec(channel="counter", core="dummy_algorithm.server:CounterServer",
                         family="dummy_algorithm.codec:PINGS", outputs="dummy_algorithm.codec:OUTPUTS"),),
-    metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard", None),),
+    metrics=(Metric("pings_heard", "dummy_algorithm.server:pings_heard"),),
     panels=(Panel("collision time per robot", "collision time [s]", "collision_time_s_by_robot"),),
 ))

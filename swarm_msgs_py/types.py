@@ -1,7 +1,9 @@
-"""Core data types shared by the world, the behaviours, the codecs and the analysis.
+"""The vocabulary every layer speaks: the data types shared by the codecs beside this module,
+the world, the behaviours and the analysis.
 
-ROS-free on purpose: the world core, every behaviour and the batch runner exchange these
-frozen dataclasses; only `swarm_msgs_py` converts them to and from ROS messages.
+ROS-free on purpose, and at the bottom of the house: the world core, every behaviour and the
+batch runner exchange these frozen dataclasses; the codecs of this package convert them to and
+from ROS messages' bytes.
 
 Frames: "world" is the arena frame, origin at the arena centre, x east, y north, z up.
 Times are simulation time. A tick k happens at ``k * dt`` seconds; stamps are integer

@@ -22,10 +22,10 @@ from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from swarm_msgs_py.cdr import split_stamp
-from swarm_sim.geometry import yaw_to_quaternion
+from swarm_msgs_py.geometry import yaw_to_quaternion
+from swarm_msgs_py.types import Pose2D, RobotId, robot_index
 from swarm_sim.scenario import Scenario
 from swarm_sim.sites import drop_zones
-from swarm_sim.types import Pose2D, RobotId, robot_index
 
 WORLD_FRAME = "world"
 RESOURCE_DIAMETER = 0.05

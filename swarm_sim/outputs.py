@@ -24,9 +24,9 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from swarm_msgs_py.types import NS_PER_S
 from swarm_sim import registry
 from swarm_sim.protocol import Drawing
-from swarm_sim.types import NS_PER_S
 
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 

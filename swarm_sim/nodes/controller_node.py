@@ -52,16 +52,16 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from swarm_msgs_py import auth, diagnostics, odometry, scan, topics, twist
-from swarm_msgs_py.executor import make_executor, share_sim_time
-from swarm_msgs_py.params import declare_config
-from swarm_msgs_py.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_msgs_py.types import Observation, robot_index
 from swarm_sim import registry
 from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.cli import first_paragraph
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
+from swarm_sim.nodes.executor import make_executor, share_sim_time
 from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
+from swarm_sim.nodes.params import declare_config
+from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.scenario import Scenario, load_scenario
-from swarm_sim.types import Observation, robot_index
 
 ControllerConfig = EndpointConfig
 """A controller node's parameters: scenario, overrides, seed and how long `connect` waits."""

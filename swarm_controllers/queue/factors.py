@@ -1,0 +1,44 @@
+"""The queue paper's factor groups (`swarm_sim.factor_sweeps`, run by ``scripts/factors``): at 48
+and at 112 robots, the authors' robot against one factor changed at a time."""
+
+from swarm_sim.factor_sweeps import Factor, FactorGroup
+
+# footbot_cpfa and the generic queue robot share body (0.17 m), speed (0.16 m/s) and turn rate
+# (1.143 rad/s): they differ in the motion rule, the ring and planarity only.
+BASELINE = Factor("baseline", "the authors' robot (footbot_cpfa: stop-turn-go, the CPFA lineage's collision turn, "
+                  "the queue authors' path stop)", ("--robot-model", "authors"))
+MOTION_GENERIC = Factor("motion_generic", "motion rule: today's generic robot (continuous steering, our avoidance "
+                        "and brake), same body and speeds", ("--robot-model", "generic"))
+TURN = Factor("turn_2.29", "turn rate: the wheels at RobotForwardSpeed (16 cm/s) when turning, 2.29 rad/s, instead "
+              "of RobotRotationSpeed's 8 cm/s",
+              ("--robot-model", "authors", "--set", "robots.platform.max_angular_speed=2.2857"))
+STEP = Factor("step_0.16", "collision step: SearchStepSize 0.16 m (BaseController's default) instead of the "
+              "experiment files' 0.08 m",
+              ("--robot-model", "authors", "--set", "robots.stop_turn_go.collision_step=0.16"))
+# Dock distance: the CPFA baseline unloads at the queue authors' NestPosition docks, 0.3 m from the
+# centre (queue_cpfa.yaml); our queue layouts need their docks one body outside the 0.5 m depot
+# (0.585 m: four serpentines do not fit round 0.3 m docks with 0.2 m lanes), so the factor moves the
+# CPFA's docks out to the queue strategies' instead.
+CPFA_DOCKS = Factor("cpfa_docks_0.585", "dock distance: the CPFA baseline's docks 0.585 m from the centre (where "
+                    "our queue strategies' are) instead of the authors' NestPosition 0.3 m",
+                    ("--strategies", "queue_cpfa", "--robot-model", "authors", "--set", "docking.dock_distance=0.585"))
+# Q_ST's join rule: the paper's text (join behind the last robot) against the authors' code (their
+# Q_ST, Tameem786/Collision_Free_CPFA branch CPFA-2.0, boards the spiral's inner lanes ahead of
+# whoever is queued there: controller.queue.join_order=anywhere).
+QST_JOIN = Factor("qst_join_anywhere", "Q_ST's join rule: any free cell of the line (the authors' CPFA-2.0 code) "
+                  "instead of only behind the tail (the paper's sec. V-B)",
+                  ("--strategies", "queue_qst", "--robot-model", "authors", "--set",
+                   "controller.queue.join_order=anywhere"))
+QST_NO_GIVE_UP = Factor("qst_no_give_up", "Q_ST's searcher never gives up (controller.queue.seek_timeout beyond "
+                        "the run; the paper and the authors' code have no give-up) instead of falling back to entry "
+                        "joining after our 120 s",
+                        ("--strategies", "queue_qst", "--robot-model", "authors", "--set",
+                         "controller.queue.seek_timeout=100000"))
+
+GROUPS = (
+    FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
+                (BASELINE, MOTION_GENERIC, TURN, STEP, CPFA_DOCKS, QST_JOIN, QST_NO_GIVE_UP)),
+    # At 112 robots, where the strategies' order is the paper's headline.
+    FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
+                (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
+)
