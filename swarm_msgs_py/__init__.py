@@ -1,10 +1,11 @@
-"""swarm_msgs_py: the generic ROS edge, where a core type (`swarm_sim.types`) meets a ROS message
-(each paper's own messages have their codecs in its package).
+"""swarm_msgs_py: the vocabulary at the bottom of the house, where a core type (`types`) meets a
+standard ROS message (each paper's own messages have their codecs in its package). It imports no
+other project package and no ROS package: the rclpy side is `swarm_sim.nodes`.
 
 Only standard common_interfaces types travel, so a stock Jazzy ``ros2 topic echo`` and any
 MCAP viewer read every topic. The hot codecs write and read CDR bytes directly with `struct`
 (rclpy publishes `bytes`; ``raw=True`` subscriptions hand us bytes) and import no ROS package,
-so bag analysis decodes without ROS. Only `executor`, `markers`, `params` and `qos` import rclpy.
+so bag analysis decodes without ROS.
 
 Stamps are integer sim-time nanoseconds (``header.stamp`` = the tick). Every decoder raises
 `CodecError` (a ValueError naming the ROS type) on malformed or truncated bytes. Each codec

@@ -24,7 +24,7 @@ class Rule:
     scenarios: str
     """The shipped scenarios concerned."""
     key: str
-    """The scenario key that switches it (``controller.queue.join_order``)."""
+    """The scenario key that switches it (a dotted key, as `--set` takes it)."""
     text: str
     """What the paper's text says (and the key's value that reads it so, if any)."""
     code: str
