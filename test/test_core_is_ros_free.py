@@ -9,7 +9,8 @@ import textwrap
 ROS_ADAPTERS = ("swarm_msgs_py.markers", "swarm_msgs_py.qos", "swarm_msgs_py.executor", "swarm_msgs_py.params",
                 "swarm_sim.nodes.world_node", "swarm_sim.nodes.server_node", "swarm_sim.nodes.recorder",
                 "swarm_sim.nodes.endpoint", "swarm_sim.nodes.world_loop", "swarm_sim.nodes.world_outputs",
-                "swarm_sim.nodes.world_recording", "swarm_sim.nodes.peer_relay", "swarm_sim.nodes.status_watch")
+                "swarm_sim.nodes.world_recording", "swarm_sim.nodes.peer_relay", "swarm_sim.nodes.status_watch",
+                "swarm_sim.nodes.run_watch")
 """The only modules allowed to import rclpy or message packages: the nodes (also every
 ``*_node`` module) and the codecs that build rclpy message objects."""
 

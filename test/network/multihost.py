@@ -28,6 +28,15 @@ CONTROLLER_HOSTS = ("hosta", "hostb")
 SMALL_ARENA = ["arena.size=5.0", "resources.distribution=uniform", "resources.count=150",
                "resources.min_depot_clearance=0.3"]
 """test_determinism's busy arena (CPFA): a short run delivers resources."""
+PAPERS = {
+    "mdbsa_d": ("mdbsa_d", []),
+    "queue_qmt": ("queue_qmt", ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]),
+    "drtm": ("drtm", []),
+    "caging": ("caging", []),
+}
+"""The papers whose robots talk to a server or each other across the links: MDBSA-D's center,
+Q_MT's depot manager (a small busy arena: deliveries within seconds), DRTM's nest, caging's
+robots (peer messages through the world)."""
 COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
             "trips_by_robot", "clamped_commands", "stale_ticks")
 
@@ -50,6 +59,17 @@ def batch_differences(bag: Path, graph: dict, robots: int, duration: float, seed
         if not np.array_equal(rows[:, 1:], batch.poses[:, i, :]):  # False for other shapes too
             out.append(f"{robot}'s odometry")
     return out + [key for key in COMPARED if graph[key] != expected[key]]
+
+
+def protocol_messages(bag: Path, scenario: str) -> int:
+    """Messages the bag holds on the topics of the scenario's message families (a server's,
+    or the robots' to each other through the world)."""
+    from swarm_sim import registry
+    from swarm_sim.recording import bag_info
+
+    inbound, outbound = registry.robot_topics(registry.of(load_scenario(scenario)))
+    counts = bag_info(bag).message_counts
+    return sum(counts.get(t, 0) for t in (*inbound, *outbound))
 
 
 def robots_of(count: int) -> dict[str, list[str]]:

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 import pytest
-from multihost import MultiHostRun, batch_differences, flags, robots_of
+from multihost import PAPERS, MultiHostRun, batch_differences, flags, protocol_messages, robots_of
 from netns import Testbed, available, leftovers
 
 from swarm_sim.analysis.replay import load_odometry
@@ -79,16 +79,19 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["resources_delivered"] > 0
 
 
+@pytest.mark.parametrize("paper", list(PAPERS))
 @shaped
-def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
+def test_lossy_links_lockstep_equals_batch(testbed, tmp_path, paper):
     """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
-    mid-run, with a server (MDBSA-D's center) and its protocol: the barrier re-sends unanswered
-    ticks and every node waits for its reliable messages to be acknowledged before answering a
-    tick, so the run is the batch run of its seed."""
-    robots, duration, seed = 8, 15.0, 11
+    mid-run, with each paper's server (MDBSA-D's center, the depot manager, DRTM's nest) or peer
+    messages (caging) and its protocol: the barrier re-sends unanswered ticks and every node
+    waits for its reliable messages to be acknowledged before answering a tick, so the run is
+    the batch run of its seed."""
+    robots, duration, seed = 8, 12.0, 11
+    scenario = PAPERS[paper]
     for host in robots_of(robots):
         testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *MDBSA), "--tick-timeout", "20",
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *scenario), "--tick-timeout", "20",
                        "--resend-period", "0.1")
     run.wait_sim(duration / 3, 120)
     cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
@@ -101,7 +104,8 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
-    assert batch_differences(run.bag, graph, robots, duration, seed, *MDBSA) == []  # ... and recovered from
+    assert batch_differences(run.bag, graph, robots, duration, seed, *scenario) == []  # ... and recovered from
+    assert protocol_messages(run.bag, scenario[0]) > 0  # the protocol went across the links
 
 
 @shaped
