@@ -46,3 +46,28 @@ def context():
     rclpy.init(context=ctx)
     yield ctx
     ctx.try_shutdown()
+
+
+_GRAPH_WORDS = ("graph_helpers", "graph_bag", "launch_py.run", "launch_py.hosts", "rclpy")
+"""A test module naming one of these starts DDS participants or the real graph."""
+
+
+def pytest_configure(config) -> None:
+    config.addinivalue_line("markers", "graph: starts DDS participants or the real graph (swarm-run, nodes); "
+                                       "`scripts/test -m 'not graph'` runs the fast core")
+    config.addinivalue_line("markers", "network: the network stage (test/network: hosts as network namespaces, root)")
+    config.addinivalue_line("markers", "slow: a test of more than ~20 s on an idle 2-core machine")
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """`graph` and `network` by module (its text names the graph or it lies in test/network)."""
+    graph: dict[str, bool] = {}
+    for item in items:
+        path = Path(str(item.fspath))
+        if "network" in path.parts:
+            item.add_marker(pytest.mark.network)
+        if str(path) not in graph:
+            text = path.read_text(encoding="utf-8") if path.suffix == ".py" else ""
+            graph[str(path)] = any(word in text for word in _GRAPH_WORDS)
+        if graph[str(path)]:
+            item.add_marker(pytest.mark.graph)
