@@ -263,6 +263,9 @@ def main(argv: list[str] | None = None) -> int:
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
     transport = with_shared_memory if args.shared_memory else (lambda profile: profile)
+    ack_wait_here = bool(os.environ.get(hosts.ACK_WAIT_ENV)) and bind is None  # one host, asked for
+    if ack_wait_here:  # reliable writers heartbeat as across hosts (the ack wait waits for an answer to one)
+        shared, transport = transport, lambda profile: hosts.with_heartbeat(shared(profile))
 
     def profile_env(base: dict[str, str], name: str, profile: str) -> dict[str, str]:
         (profiles / name).write_text(transport(profile), encoding="utf-8")
@@ -271,6 +274,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.shared_memory:
         remove_dead_shm_files()  # what killed runs left
+    if args.shared_memory or ack_wait_here:
         env = profile_env(env, "loopback.xml", PROFILE_PATH.read_text(encoding="utf-8"))
     world_env = env
     if bind is not None:  # across hosts: every process bound to `bind`, the world serves discovery there

@@ -76,10 +76,12 @@ class ControllerNode(Node):
     of the same seed."""
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
-                 parameter_services: bool = True, plain_twist: bool = False, **kwargs) -> None:
+                 parameter_services: bool = True, plain_twist: bool = False, watch: RunWatch | None = None,
+                 **kwargs) -> None:
         """`scenario`: the one `config` names, already loaded (saves each forked process the
         parse); `parameter_services`: serve ``ros2 param``; `plain_twist`: a robot's own computer
-        (see the module docstring)."""
+        (see the module docstring); `watch`: the process's watch of its world, shared by its
+        nodes (None: this node makes one)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, enable_rosout=False, start_parameter_services=parameter_services,
@@ -120,9 +122,9 @@ class ControllerNode(Node):
             guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind, deliver, refused)
             self.create_subscription(topics.import_type(type_name), name, guarded, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
-        self.watch: RunWatch | None = None
-        """The process's watch of its world (`serve` sets it): the node answers only while its
-        world is current (`swarm_sim.nodes.run_watch`)."""
+        self.watch = watch or RunWatch(self, guard, cfg.world_timeout)
+        """The process's watch of its world: the node answers only while its world is current
+        (`swarm_sim.nodes.run_watch`)."""
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
 
@@ -133,7 +135,7 @@ class ControllerNode(Node):
             return True
         # One peer on each: a server, or the world relaying what robots send each other; and the
         # world heard on /world/run (its ticks are answered only then).
-        missing = self.endpoint.unmatched(1) + ([WORLD_RUN] if self.watch is None or self.watch.run is None else [])
+        missing = self.endpoint.unmatched(1) + ([WORLD_RUN] if self.watch.run is None else [])
         if missing and time.monotonic() < self._connect_by:
             return False
         if missing:
@@ -221,14 +223,13 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     verdict = None
     try:
         executor = make_executor()
+        watch = None  # the first node's, shared by the others: one /world/run subscription a process
         for robot in robots:
             nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services,
-                                        plain_twist=plain_twist))
+                                        plain_twist=plain_twist, watch=watch))
+            watch = nodes[-1].watch
             executor.add_node(nodes[-1])
         share_sim_time(nodes)
-        watch = RunWatch(nodes[0], nodes[0].endpoint.inbound, nodes[0].config.world_timeout)
-        for node in nodes:
-            node.watch = watch
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
         # One call dispatches one message, so the loop asks a flag, not rclpy.ok() (4-9 us a call:
         # 5 ms a tick in a process of 112 robots).
