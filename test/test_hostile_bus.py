@@ -145,10 +145,15 @@ def hostile():
         h.close()
 
 
-def test_no_message_kills_or_stalls_a_node(launch, hostile):
+def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
     """4-byte messages on every sense topic of a robot, an odometry at x = 1e308, a 19 MB array of
     grants to robot_999 and a RadioQuery at x = 1e308: refused by reason, and the run is the
-    batch run. The sense topics carry no tag, so a foreign publisher there taints the run."""
+    batch run. The sense topics carry no tag, so a foreign publisher there taints the run.
+    The run waits for its reliable messages of a tick to be acknowledged (``SWARMFORAGE_ACK_WAIT``,
+    off by default on one host): without it, the flood overflowing the robots' socket buffers
+    can delay a real grant past its tick, and the run leaves the batch run's path (the known limit,
+    README; seen in about 1 of 3 runs on a busy machine)."""
+    monkeypatch.setenv("SWARMFORAGE_ACK_WAIT", "10")
     run = launch("--domain-id", str(domain()), *QUEUE)
     h = hostile(run)
     senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
