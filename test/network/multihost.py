@@ -32,11 +32,11 @@ PAPERS = {
     "mdbsa_d": ("mdbsa_d", []),
     "queue_qmt": ("queue_qmt", ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]),
     "drtm": ("drtm", []),
-    "caging": ("caging", []),
+    "caging": ("caging", ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]"]),
 }
 """The papers whose robots talk to a server or each other across the links: MDBSA-D's center,
-Q_MT's depot manager (a small busy arena: deliveries within seconds), DRTM's nest, caging's
-robots (peer messages through the world)."""
+Q_MT's depot manager (a busy arena), DRTM's nest, caging's robots (peer messages through the
+world; a small arena and landmark grid: the object found and the protocol going within seconds)."""
 COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
             "trips_by_robot", "clamped_commands", "stale_ticks")
 
