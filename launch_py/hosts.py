@@ -148,11 +148,17 @@ def host_profile(role: str, bind: str, server_port: int) -> str:
     return with_heartbeat(rebind(profile, bind))
 
 
-def with_heartbeat(profile: str) -> str:
-    """`profile` with its reliable writers heartbeating every `HEARTBEAT_NS` (a node waiting for
-    its messages to be acknowledged, `ACK_WAIT`, waits for the reader's answer to a heartbeat)."""
+LOOPBACK_HEARTBEAT_NS = 10_000_000
+"""On one host with the acknowledgement wait asked for (``SWARMFORAGE_ACK_WAIT``): reliable writers
+heartbeat every 10 ms (loopback's round trip is microseconds; the wait lasts until the reader's
+answer to a heartbeat)."""
+
+
+def with_heartbeat(profile: str, period_ns: int = HEARTBEAT_NS) -> str:
+    """`profile` with its reliable writers heartbeating every `period_ns` (a node waiting for its
+    messages to be acknowledged, `ACK_WAIT`, waits for the reader's answer to a heartbeat)."""
     writer = (f'<data_writer profile_name="swarmforage_hosts_writer" is_default_profile="true"><times>'
-              f"<heartbeatPeriod><sec>0</sec><nanosec>{HEARTBEAT_NS}</nanosec></heartbeatPeriod></times></data_writer>")
+              f"<heartbeatPeriod><sec>0</sec><nanosec>{period_ns}</nanosec></heartbeatPeriod></times></data_writer>")
     return profile.replace("</profiles>", writer + "</profiles>", 1)
 
 

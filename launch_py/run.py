@@ -265,7 +265,7 @@ def main(argv: list[str] | None = None) -> int:
     transport = with_shared_memory if args.shared_memory else (lambda profile: profile)
     ack_wait_here = bool(os.environ.get(hosts.ACK_WAIT_ENV)) and bind is None  # one host, asked for
     if ack_wait_here:  # reliable writers heartbeat as across hosts (the ack wait waits for an answer to one)
-        shared, transport = transport, lambda profile: hosts.with_heartbeat(shared(profile))
+        shared, transport = transport, lambda profile: hosts.with_heartbeat(shared(profile), hosts.LOOPBACK_HEARTBEAT_NS)
 
     def profile_env(base: dict[str, str], name: str, profile: str) -> dict[str, str]:
         (profiles / name).write_text(transport(profile), encoding="utf-8")
