@@ -1,28 +1,31 @@
 """The graph across lossy links: real-time factor, late ticks and whether the run equals batch.
 
-    sudo python benchmarks/bench_network.py [--robots 8] [--duration 12] [--seed 11]
+    sudo python benchmarks/bench_network.py [--robots 8] [--duration 12] [--seed 11] [--scenario NAME ...]
 
 Root only (network namespaces). The testbed of ``test/network`` (`netns.Testbed` with its
 user-space switch `linkemu`): the world on one host, the controllers on two others (even and odd
 robots), both controller links shaped alike, in lockstep and in realtime at 1x (command timeout
 0.5 s); the rows with a partition cut hostb off for 3 s once a third of the run is done. Prints
-the table of benchmarks/README.md (one markdown row per setting) and each run's per-host counts.
+the table of benchmarks/README.md (one markdown row per setting) and each run's per-host counts. With
+several ``--scenario`` names (e.g. ``cpfa mdbsa_d queue_qmt drtm caging``: the papers with a server or
+peer messages, in the network stage's arenas, `multihost.PAPERS`), one table per scenario.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import random
 import sys
 import tempfile
 import threading
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test" / "network"))
+sys.path[:0] = [str(Path(__file__).resolve().parents[1] / "test" / d) for d in ("network", ".")]
 
-from multihost import SMALL_ARENA, MultiHostRun, batch_differences, flags, robots_of  # noqa: E402
+from multihost import PAPERS, SMALL_ARENA, MultiHostRun, batch_differences, flags, robots_of  # noqa: E402
 from netns import Testbed, available  # noqa: E402
+
+from launch_py.dds import reserve_free_domain  # noqa: E402
 
 SETTINGS = [  # (label, loss, delay [s], jitter [s], partition)
     ("none", 0.0, 0.0, 0.0, False),
@@ -69,9 +72,12 @@ def main() -> None:
     parser.add_argument("--robots", type=int, default=8)
     parser.add_argument("--duration", type=float, default=12.0)
     parser.add_argument("--seed", type=int, default=11)
-    parser.add_argument("--scenario", default="cpfa", help="default: cpfa in the small arena")
+    parser.add_argument("--scenario", nargs="+", default=["cpfa"],
+                        help="one table each (default: cpfa in the small arena; the network stage's papers in "
+                             f"its arenas: {', '.join(PAPERS)})")
     parser.add_argument("--set", dest="overrides", action="append", metavar="KEY=VALUE",
-                        help="scenario overrides (default for cpfa: the small arena)")
+                        help="scenario overrides for every scenario (default: cpfa the small arena, the network "
+                             "stage's papers its arenas)")
     parser.add_argument("--modes", nargs="+", default=["lockstep", "realtime"])
     parser.add_argument("--resend-period", type=float, nargs="+", default=[0.25, 0.1],
                         help="lockstep: the world's re-send periods to try [s]")
@@ -80,17 +86,20 @@ def main() -> None:
     args = parser.parse_args()
     if (why := available()) is not None:
         sys.exit(f"bench_network: {why}")
-    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(101, 199)))
-    scenario = [args.scenario, args.overrides if args.overrides is not None else
-                (SMALL_ARENA if args.scenario == "cpfa" else [])]
-    print(f"{args.scenario}: {args.robots} robots, {args.duration:g} s of sim time, seed {args.seed}")
-    print("| mode | links (both controller hosts) | real-time factor | stale ticks | late commands | ticks re-sent "
-          "| ticks without a command | stops by the timeout | equals batch |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for mode in args.modes:
-        for resend in args.resend_period if mode == "lockstep" else [0.25]:
-            for i in args.settings:
-                print(one(mode, SETTINGS[i], args.robots, args.duration, args.seed, resend, scenario), flush=True)
+    if "ROS_DOMAIN_ID" not in os.environ:
+        domain, _ = reserve_free_domain()  # held while this runs
+        os.environ["ROS_DOMAIN_ID"] = str(domain)
+    for name in args.scenario:
+        default = SMALL_ARENA if name == "cpfa" else PAPERS.get(name, (name, []))[1]
+        scenario = [name, args.overrides if args.overrides is not None else default]
+        print(f"{name}: {args.robots} robots, {args.duration:g} s of sim time, seed {args.seed}")
+        print("| mode | links (both controller hosts) | real-time factor | stale ticks | late commands | ticks re-sent "
+              "| ticks without a command | stops by the timeout | equals batch |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        for mode in args.modes:
+            for resend in args.resend_period if mode == "lockstep" else [0.25]:
+                for i in args.settings:
+                    print(one(mode, SETTINGS[i], args.robots, args.duration, args.seed, resend, scenario), flush=True)
 
 
 if __name__ == "__main__":

@@ -303,16 +303,63 @@ def claim_domain(domain_id: int) -> int:
     return fd
 
 
-def claim_free_domain(first: int | None = None) -> tuple[int, int]:
-    """A free domain of `DOMAIN_RANGE`, claimed (`claim_domain`), trying from `first` (default:
-    the one this process's pid gives) upwards; (domain, lock fd). Raises DomainTaken if none is
-    free."""
+def _reservation_path(domain_id: int) -> Path:
+    return Path(tempfile.gettempdir()) / f"swarmforage-domain-{domain_id}.reserved"
+
+
+def _try_lock(path: Path) -> int | None:
+    """An exclusive lock on `path` (its descriptor), or None if another process holds it (or the
+    file is another user's, or a symlink)."""
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
+def reserve_free_domain(first: int | None = None) -> tuple[int, int]:
+    """A domain of `DOMAIN_RANGE` reserved for this process, which then hands it to runs by
+    number (``--domain-id N``, as a test session does): an exclusive lock on the domain's
+    reservation file, taken only where no run holds the domain and nothing uses it. ``auto``
+    (`claim_free_domain`) passes over reserved domains, so concurrent test sessions and
+    runs never pick one twice. Returns (domain, the reservation's fd: keep it open); raises
+    DomainTaken if none is free."""
     lo, hi = DOMAIN_RANGE
     start = lo + os.getpid() % (hi - lo + 1) if first is None else first
     for k in range(hi - lo + 1):
         domain = lo + (start - lo + k) % (hi - lo + 1)
+        reservation = _try_lock(_reservation_path(domain))
+        if reservation is None:
+            continue
+        try:
+            os.close(claim_domain(domain))  # free now: no run on it, nothing bound
+        except DomainTaken:
+            os.close(reservation)
+            continue
+        return domain, reservation
+    raise DomainTaken(f"every domain {lo}-{hi} is reserved or in use")
+
+
+def claim_free_domain(first: int | None = None) -> tuple[int, int]:
+    """A free domain of `DOMAIN_RANGE`, claimed (`claim_domain`), trying from `first` (default:
+    the one this process's pid gives) upwards and passing over domains another process has
+    reserved (`reserve_free_domain`); (domain, lock fd). Raises DomainTaken if none is free."""
+    lo, hi = DOMAIN_RANGE
+    start = lo + os.getpid() % (hi - lo + 1) if first is None else first
+    for k in range(hi - lo + 1):
+        domain = lo + (start - lo + k) % (hi - lo + 1)
+        reservation = _try_lock(_reservation_path(domain))
+        if reservation is None:  # reserved by a test session (or another auto claim this instant)
+            continue
         try:
             return domain, claim_domain(domain)
         except DomainTaken:
             continue
+        finally:
+            os.close(reservation)  # the run's claim holds it from here
     raise DomainTaken(f"every domain {lo}-{hi} is in use")

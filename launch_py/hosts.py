@@ -145,9 +145,21 @@ def host_profile(role: str, bind: str, server_port: int) -> str:
         profile = dds.robot_profile()
     else:
         profile = ET.tostring(dds._loopback_profile(), encoding="unicode")  # as the others: no comments
+    return with_heartbeat(rebind(profile, bind))
+
+
+LOOPBACK_HEARTBEAT_NS = 10_000_000
+"""On one host with the acknowledgement wait asked for (``SWARMFORAGE_ACK_WAIT``): reliable writers
+heartbeat every 10 ms (loopback's round trip is microseconds; the wait lasts until the reader's
+answer to a heartbeat)."""
+
+
+def with_heartbeat(profile: str, period_ns: int = HEARTBEAT_NS) -> str:
+    """`profile` with its reliable writers heartbeating every `period_ns` (a node waiting for its
+    messages to be acknowledged, `ACK_WAIT`, waits for the reader's answer to a heartbeat)."""
     writer = (f'<data_writer profile_name="swarmforage_hosts_writer" is_default_profile="true"><times>'
-              f"<heartbeatPeriod><sec>0</sec><nanosec>{HEARTBEAT_NS}</nanosec></heartbeatPeriod></times></data_writer>")
-    return rebind(profile, bind).replace("</profiles>", writer + "</profiles>", 1)
+              f"<heartbeatPeriod><sec>0</sec><nanosec>{period_ns}</nanosec></heartbeatPeriod></times></data_writer>")
+    return profile.replace("</profiles>", writer + "</profiles>", 1)
 
 
 def host_env(role: str, domain_id: int, bind: str, server: tuple[str, int], profile_path: Path,

@@ -56,6 +56,7 @@ from swarm_sim.analysis.text import summary_lines
 from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
 from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.nodes.run_watch import WORLD_TIMEOUT
 from swarm_sim.nodes.ws_proxy import check_port
 from swarm_sim.recording import repair_bag
 from swarm_sim.recording.metadata import METADATA_FILE
@@ -213,6 +214,10 @@ def main(argv: list[str] | None = None) -> int:
                         help="realtime, with --remote-controllers: the remote robots' computers speak plain "
                              "geometry_msgs/Twist on wall-clock time (swarm-controllers --plain-twist), as "
                              "TurtleBot-class robots do")
+    parser.add_argument("--world-timeout", type=number(float, 0, 86400, open_low=True), default=WORLD_TIMEOUT,
+                        metavar="S", help="every controller and server process, here or on another host, leaves by "
+                        "itself when the run ends, or once the world has been silent S wall seconds (killed, or "
+                        f"unreachable that long; default {WORLD_TIMEOUT:g})")
     parser.add_argument("--key-file", type=Path, metavar="PATH",
                         help="write the run's credential here (mode 0600), for the controllers on other hosts "
                              "(SWARMFORAGE_KEY_FD=3 ... 3<PATH); required with --remote-controllers")
@@ -258,6 +263,9 @@ def main(argv: list[str] | None = None) -> int:
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
     transport = with_shared_memory if args.shared_memory else (lambda profile: profile)
+    ack_wait_here = bool(os.environ.get(hosts.ACK_WAIT_ENV)) and bind is None  # one host, asked for
+    if ack_wait_here:  # reliable writers heartbeat as across hosts (the ack wait waits for an answer to one)
+        shared, transport = transport, lambda profile: hosts.with_heartbeat(shared(profile), hosts.LOOPBACK_HEARTBEAT_NS)
 
     def profile_env(base: dict[str, str], name: str, profile: str) -> dict[str, str]:
         (profiles / name).write_text(transport(profile), encoding="utf-8")
@@ -266,6 +274,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if args.shared_memory:
         remove_dead_shm_files()  # what killed runs left
+    if args.shared_memory or ack_wait_here:
         env = profile_env(env, "loopback.xml", PROFILE_PATH.read_text(encoding="utf-8"))
     world_env = env
     if bind is not None:  # across hosts: every process bound to `bind`, the world serves discovery there
@@ -281,6 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
         robots_env = profile_env(env, "robots.xml", robot_profile())
     common = scenario_args(args, scenario)
+    watching = [*common, "--world-timeout", f"{args.world_timeout:g}"]  # the controllers' and servers'
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
         f"seed {scenario.seed}, {args.mode}, {len(groups)} controller process(es), domain {domain}\n"
@@ -301,7 +311,7 @@ def main(argv: list[str] | None = None) -> int:
         _write_key(args.key_file, run_key)
     if bind is not None:
         _print_remote(domain, (bind, port), remote,
-                      [*common, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
+                      [*watching, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
 
     def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
         key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
@@ -337,10 +347,10 @@ def main(argv: list[str] | None = None) -> int:
     launched = said = time.monotonic()
     try:
         _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
-        children += [start(label, [*cmd, *common], robots_env) for label, cmd in controllers]
+        children += [start(label, [*cmd, *watching], robots_env) for label, cmd in controllers]
         children += [start(f"server {spec.channel} ({spec.node_name})",
                            [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, "--mode", args.mode,
-                            *common])
+                            *watching])
                      for spec in servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)
@@ -352,7 +362,8 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"[swarm-run] {now - launched:5.1f} s: waiting for the world node to come up "
                       f"({running + 1} processes starting: Python, ROS and pybullet imports)", flush=True)
             for label, p in children:
-                if p.poll() is not None and p.pid not in reported:
+                # 0, 3, 130: it left because the world ended the run (it said so itself)
+                if p.poll() is not None and p.pid not in reported and p.returncode not in (0, 3, 130):
                     reported.add(p.pid)
                     print(f"[swarm-run] the {label} (pid {p.pid}) {_how(p.returncode)} while the run went on; "
                           "the world declares what it ran dead", file=sys.stderr, flush=True)

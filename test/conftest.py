@@ -4,7 +4,6 @@ plug-ins of this tree are the ones imported."""
 from __future__ import annotations
 
 import os
-import random
 import sys
 from pathlib import Path
 
@@ -17,9 +16,13 @@ sys.path[:0] = _PLUGINS
 os.environ["PYTHONPATH"] = os.pathsep.join([*_PLUGINS, *filter(None, [os.environ.get("PYTHONPATH")])])
 
 # Before anything imports rclpy: loopback only (sockets bound to 127.0.0.1, launch_py.dds), and
-# a domain no other run on this machine uses.
-os.environ.setdefault("ROS_DOMAIN_ID", str(random.Random(os.getpid()).randint(101, 199)))
-from launch_py.dds import apply_to_current_process, loopback_env  # noqa: E402 - after the domain
+# a domain reserved for this session (`launch_py.dds.reserve_free_domain`: the lock is held while
+# pytest lives), so concurrent suites and `--domain-id auto` runs never pick it too.
+from launch_py.dds import apply_to_current_process, loopback_env, reserve_free_domain  # noqa: E402
+
+if "ROS_DOMAIN_ID" not in os.environ:
+    _DOMAIN, _RESERVATION = reserve_free_domain()
+    os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN)
 
 apply_to_current_process(loopback_env(int(os.environ["ROS_DOMAIN_ID"]), processes=2))
 
@@ -43,3 +46,28 @@ def context():
     rclpy.init(context=ctx)
     yield ctx
     ctx.try_shutdown()
+
+
+_GRAPH_WORDS = ("graph_helpers", "graph_bag", "launch_py.run", "launch_py.hosts", "rclpy")
+"""A test module naming one of these starts DDS participants or the real graph."""
+
+
+def pytest_configure(config) -> None:
+    config.addinivalue_line("markers", "graph: starts DDS participants or the real graph (swarm-run, nodes); "
+                                       "`scripts/test -m 'not graph'` runs the fast core")
+    config.addinivalue_line("markers", "network: the network stage (test/network: hosts as network namespaces, root)")
+    config.addinivalue_line("markers", "slow: a test of more than ~20 s on an idle 2-core machine")
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    """`graph` and `network` by module (its text names the graph or it lies in test/network)."""
+    graph: dict[str, bool] = {}
+    for item in items:
+        path = Path(str(item.fspath))
+        if "network" in path.parts:
+            item.add_marker(pytest.mark.network)
+        if str(path) not in graph:
+            text = path.read_text(encoding="utf-8") if path.suffix == ".py" else ""
+            graph[str(path)] = any(word in text for word in _GRAPH_WORDS)
+        if graph[str(path)]:
+            item.add_marker(pytest.mark.graph)

@@ -12,6 +12,7 @@ import os
 import subprocess
 import sys
 import time
+from collections import Counter
 
 import numpy as np
 import pytest
@@ -24,7 +25,7 @@ from rclpy.node import Node
 from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_REPORTS, RADIO, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKind
 from launch_py.dds import discovery_port
-from swarm_msgs_py import ack, clock, diagnostics, odometry, topics, twist
+from swarm_msgs_py import ack, auth, clock, diagnostics, odometry, topics, twist
 from swarm_msgs_py.types import BehaviourStatus, NodeDownEvent, Pose2D
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
@@ -73,6 +74,34 @@ class Hostile(Node):
             self.create_subscription(topics.type_of(topics.CLOCK), topics.CLOCK,
                                      lambda d: setattr(self, "stamp", clock.decode_clock(d)), SENSOR_LOCKSTEP, raw=True)
         self.pubs = {}
+        self.counted: dict[str, dict[tuple[str, str], int]] = {}
+        """What each node of the run reports it rejected so far (its tagged /diagnostics)."""
+        self.create_subscription(topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS, self._on_counts,
+                                 STATE_LATCHED, raw=True)
+
+    def _on_counts(self, data: bytes) -> None:
+        if auth.strip(data) is not None:  # the run's nodes tag theirs; not what a forger (we) sent
+            self.counted.update(diagnostics.decode_rejections(data)[1])
+
+    def repeat_until_counted(self, run, send, wants: dict[tuple[str, str], int], timeout: float = 90.0) -> None:
+        """`send(missing)` a round of forged messages every 0.3 s until the run's nodes report
+        them rejected: for each (where, reason) of `wants`, at least that many in all; `missing`:
+        the (where, reason) still short. (A receiver that has not matched the forger yet drops
+        what it sends, and some of it is best-effort: a fixed number of rounds was counted short
+        on a busy machine.)"""
+        deadline = time.monotonic() + timeout
+        missing = set(wants)
+        while True:
+            send(missing)
+            self.spin(0.3)
+            totals = Counter()
+            for counts in self.counted.values():
+                totals.update(counts)
+            missing = {k for k, n in wants.items() if totals[k] < n}
+            if not missing:
+                return
+            assert time.monotonic() < deadline and run.proc.poll() is None, (
+                f"not counted: { {k: (totals[k], n) for k, n in wants.items()} }")
 
     def publisher(self, topic: str, qos=EVENTS, msg_type=None):
         base = topic[:-len(topics.HEARD) - 1] if topic.endswith("/" + topics.HEARD) else topic  # a relay's type
@@ -116,26 +145,40 @@ def hostile():
         h.close()
 
 
-def test_no_message_kills_or_stalls_a_node(launch, hostile):
+def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
     """4-byte messages on every sense topic of a robot, an odometry at x = 1e308, a 19 MB array of
     grants to robot_999 and a RadioQuery at x = 1e308: refused by reason, and the run is the
-    batch run. The sense topics carry no tag, so a foreign publisher there taints the run."""
+    batch run. The sense topics carry no tag, so a foreign publisher there taints the run.
+    The run waits for its reliable messages of a tick to be acknowledged (``SWARMFORAGE_ACK_WAIT``,
+    off by default on one host): without it, the flood overflowing the robots' socket buffers
+    can delay a real grant past its tick, and the run leaves the batch run's path (the known limit,
+    README; seen in about 1 of 3 runs on a busy machine)."""
+    monkeypatch.setenv("SWARMFORAGE_ACK_WAIT", "10")
     run = launch("--domain-id", str(domain()), *QUEUE)
     h = hostile(run)
     senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
               for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)]
     grants, radio = h.publisher(DEPOT_GRANTS), h.publisher(topics.heard(RADIO_TOPIC))
     h.wait_matched(run)
+    h.spin(90, until=lambda: grants.get_subscription_count() >= 6)  # every robot: the flood is sent 3 times only
+    assert grants.get_subscription_count() >= 6
     (huge,) = DEPOT.encode(0, [DepotGrant(0, "robot_999", "entry_line_0", k) for k in range(100_000)])
     assert len(huge) > 19e6
-    for _ in range(3):
+    floods = []
+
+    def send(missing) -> None:
         s = h.stamp
         for pub in senses:
             pub.publish(b"\x00\x01\x00\x00")
         senses[0].publish(odometry.encode_odometry("robot_0", s + 10**8, Pose2D(1e308, 0.0, 0.0), 0.0, 0.0))
         radio.publish(RADIO.encode(s, [RadioQuery(s, "robot_1", 1e308, 0.0)])[0])
-        grants.publish(huge)
-        h.spin(0.5)
+        if len(floods) < 3:  # reliable: what is sent to a matched reader arrives (more would stall the robots)
+            floods.append(grants.publish(huge))
+
+    h.repeat_until_counted(run, send, {
+        **{(f"/robot_0/{name}", "malformed"): 3 for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)},
+        ("/robot_0/odom", "out of bounds"): 3, (DEPOT_GRANTS, "too big"): 3 * 6,
+        (topics.heard(RADIO_TOPIC), "unauthenticated"): 3})
     code, summary, err = run.finish()
     assert code == 6, err[-3000:]
     assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0 and summary["run_ended"] == "complete"
@@ -161,7 +204,7 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     h.publisher(topics.DIAGNOSTICS, STATE_LATCHED)  # the recorder hears it transient-local
     h.publisher(topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP)
     h.wait_matched(run)
-    for _ in range(5):
+    def send(_) -> None:
         s = h.stamp
         h.pubs[DEPOT_REPORTS].publish(DEPOT.encode(s, [DepotReport(s, "robot_1", ReportKind.JOIN,
                                                                           "entry_line_0", 0)])[0])
@@ -172,7 +215,11 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
         h.pubs[topics.DIAGNOSTICS].publish(diagnostics.encode_rejections(s, "/robot_0/controller",
                                                                          {("/radio", "malformed"): 999}))
         h.pubs[topics.LOCKSTEP_ACK].publish(ack.encode_ack("depot", s + 10**13))
-        h.spin(0.3)
+
+    h.repeat_until_counted(run, send, {
+        (DEPOT_REPORTS, "unauthenticated"): 5, (DEPOT_GRANTS, "unauthenticated"): 5 * 6,
+        (topics.WORLD_EVENTS, "unauthenticated"): 5, (topics.LOCKSTEP_ACK, "unauthenticated"): 5,
+        ("/robot_0/status", "unauthenticated"): 5})
     code, summary, err = run.finish()
     assert code == 0, err[-3000:]
     rejected = summary["rejected_messages"]
@@ -199,10 +246,12 @@ def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_
     forged = h.publisher(topics.CLOCK, SENSOR_LOCKSTEP)
     strings = other.create_publisher(String, topics.CLOCK, 10)
     h.wait_matched(run)
-    for _ in range(10):  # best effort, and the depot manager may match the forger late: 10 sent, 3 counted
+
+    def send(_) -> None:
         forged.publish(clock.encode_clock(h.stamp + 10**13))
         strings.publish(String(data="tick"))
-        h.spin(0.3)
+
+    h.repeat_until_counted(run, send, {(topics.CLOCK, "wrong tick"): 3})  # by the depot manager
     code, summary, err = run.finish()
     assert code == 6, err[-3000:]
     assert any(f.endswith(f"on {topics.CLOCK}") for f in summary["foreign_publishers"])

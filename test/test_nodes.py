@@ -149,10 +149,22 @@ class _InboxLog:
         return getattr(self._behaviour, name)
 
 
+def _world_running(peer: Node):
+    """`peer` says on /world/run that its run goes on, as the world does (latched)."""
+    from swarm_msgs_py import run_state
+    from swarm_sim.nodes.qos import STATE_LATCHED
+    from swarm_sim.nodes.run_watch import WORLD_RUN
+
+    pub = peer.create_publisher(topics.import_type(run_state.TYPE_NAME), WORLD_RUN, STATE_LATCHED)
+    pub.publish(run_state.encode_run_state("test", run_state.RUNNING, 0))
+    return pub
+
+
 def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(context):
     scenario = load_scenario("cpfa", SMALL)
     node = ControllerNode("robot_0", ControllerConfig(overrides=SMALL), context=context)
     peer = Node("peer", context=context)
+    _world_running(peer)  # a stand-in world: nodes answer its ticks only (`run_watch`)
     received, statuses, inbox = [], [], []
     peer.create_subscription(topics.type_of(topics.CMD_VEL), "/robot_0/cmd_vel",
                              lambda d: received.append(twist.decode_twist(d)), SENSOR_LOCKSTEP, raw=True)
@@ -292,6 +304,7 @@ def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
     scenario = load_scenario("cpfa", SMALL)
     node = ControllerNode("robot_0", ControllerConfig(overrides=SMALL), context=context)
     peer = Node("peer", context=context)
+    _world_running(peer)  # a stand-in world: nodes answer its ticks only (`run_watch`)
     received, reports = [], []
     peer.create_subscription(topics.type_of(topics.CMD_VEL), "/robot_0/cmd_vel",
                              lambda d: received.append(twist.decode_twist(d)), SENSOR_LOCKSTEP, raw=True)
@@ -350,6 +363,7 @@ def test_a_clock_from_the_future_never_moves_a_server_off_the_schedule(context):
     config = ServerNodeConfig(scenario="queue_qmt", overrides=("robots.count=2",), startup_timeout=0.1)
     server = ServerNode("depot", config, context=context)
     peer = Node("peer", context=context)
+    _world_running(peer)  # a stand-in world: nodes answer its ticks only (`run_watch`)
     acks = []
     clock_pub = peer.create_publisher(topics.type_of(topics.CLOCK), topics.CLOCK, SENSOR_LOCKSTEP)
     peer.create_subscription(topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK,

@@ -61,6 +61,7 @@ from swarm_sim.nodes.executor import make_executor, share_sim_time
 from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
+from swarm_sim.nodes.run_watch import EXIT_CODES, WORLD_RUN, RunWatch
 from swarm_sim.scenario import Scenario, load_scenario
 
 ControllerConfig = EndpointConfig
@@ -75,10 +76,12 @@ class ControllerNode(Node):
     of the same seed."""
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
-                 parameter_services: bool = True, plain_twist: bool = False, **kwargs) -> None:
+                 parameter_services: bool = True, plain_twist: bool = False, watch: RunWatch | None = None,
+                 **kwargs) -> None:
         """`scenario`: the one `config` names, already loaded (saves each forked process the
         parse); `parameter_services`: serve ``ros2 param``; `plain_twist`: a robot's own computer
-        (see the module docstring)."""
+        (see the module docstring); `watch`: the process's watch of its world, shared by its
+        nodes (None: this node makes one)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, enable_rosout=False, start_parameter_services=parameter_services,
@@ -119,6 +122,9 @@ class ControllerNode(Node):
             guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind, deliver, refused)
             self.create_subscription(topics.import_type(type_name), name, guarded, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
+        self.watch = watch or RunWatch(self, guard, cfg.world_timeout)
+        """The process's watch of its world: the node answers only while its world is current
+        (`swarm_sim.nodes.run_watch`)."""
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
 
@@ -127,8 +133,9 @@ class ControllerNode(Node):
         timeout passed); True once it exists."""
         if self._cmd_pub is not None:
             return True
-        # One peer on each: a server, or the world relaying what robots send each other.
-        missing = self.endpoint.unmatched(1)
+        # One peer on each: a server, or the world relaying what robots send each other; and the
+        # world heard on /world/run (its ticks are answered only then).
+        missing = self.endpoint.unmatched(1) + ([WORLD_RUN] if self.watch.run is None else [])
         if missing and time.monotonic() < self._connect_by:
             return False
         if missing:
@@ -143,12 +150,12 @@ class ControllerNode(Node):
 
     def _wall_tick(self) -> None:
         """``--plain-twist``: a step on the wall clock with the newest observation of each topic."""
-        if len(self._latest) == self._expected:
+        if len(self._latest) == self._expected and self.watch.current():
             self._wall_ticks += 1
             self._tick(self._wall_ticks * self.scenario.dt_ns)
 
     def _on_observation(self, name: str, decoded: tuple) -> None:
-        if self._cmd_pub is None:  # not connected yet: the world cannot have started
+        if self._cmd_pub is None or not self.watch.current():  # not connected, or not our world's tick
             return
         if self.plain_twist:  # its own clock steps it (`_wall_tick`)
             self._latest[name] = decoded
@@ -206,16 +213,21 @@ def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str],
 
 
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
-          scenario: Scenario | None = None, parameter_services: bool = True, plain_twist: bool = False) -> int:
-    """The robots' controller nodes in this process, spun until shut down; `teardown=False`
-    leaves without destroying the DDS participant (see `serve_forked`)."""
+          scenario: Scenario | None = None, parameter_services: bool = True, plain_twist: bool = False,
+          say: bool = True) -> int:
+    """The robots' controller nodes in this process, spun until the run ends (`RunWatch`: the
+    exit code, with one line saying why unless `say` is False) or the process is stopped (0);
+    `teardown=False` leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
     nodes: list[ControllerNode] = []
+    verdict = None
     try:
         executor = make_executor()
+        watch = None  # the first node's, shared by the others: one /world/run subscription a process
         for robot in robots:
             nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services,
-                                        plain_twist=plain_twist))
+                                        plain_twist=plain_twist, watch=watch))
+            watch = nodes[-1].watch
             executor.add_node(nodes[-1])
         share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
@@ -224,11 +236,13 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
         stopped = []
         rclpy.get_default_context().on_shutdown(lambda: stopped.append(True))
         connecting = list(nodes)
-        while connecting and not stopped:
+        while connecting and not stopped and verdict is None:
             executor.spin_once(timeout_sec=0.1)
             connecting = [n for n in connecting if not n.connect()]
-        while not stopped:
+            verdict = watch.verdict()
+        while not stopped and verdict is None:
             executor.spin_once(timeout_sec=0.5)
+            verdict = watch.verdict()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -236,7 +250,16 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
             for node in nodes:
                 node.destroy_node()
             rclpy.try_shutdown()
-    return 0
+    if verdict is None:
+        return 0
+    code, why = verdict
+    if say:
+        print(f"[controllers] {_robots_text(robots)}: {why}: leaving (exit {code})", file=sys.stderr, flush=True)
+    return code
+
+
+def _robots_text(robots: list[str]) -> str:
+    return ", ".join(robots) if len(robots) <= 4 else f"{len(robots)} robots ({robots[0]} ...)"
 
 
 def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
@@ -289,7 +312,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
             code = 1
             try:
                 code = serve([robot], config, ros_args, teardown=False, scenario=scenario,
-                             parameter_services=parameter_services, plain_twist=plain_twist)
+                             parameter_services=parameter_services, plain_twist=plain_twist, say=False)
             finally:
                 sys.stdout.flush()
                 sys.stderr.flush()
@@ -309,6 +332,7 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
 
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, stop)
+    ended: dict[int, list[str]] = {}  # exit code -> robots whose process left because the run ended
     while children:
         try:
             pid, status = os.waitpid(-1, os.WNOHANG)
@@ -321,10 +345,17 @@ def serve_forked(robots: list[str], config: ControllerConfig, ros_args: list[str
             continue
         robot = children.pop(pid, "?")
         code = os.waitstatus_to_exitcode(status)
-        if not stopping or code not in (0, -signal.SIGINT, -signal.SIGKILL):
+        if not stopping and code in EXIT_CODES:  # its run ended (`RunWatch`): said once for all below
+            ended.setdefault(code, []).append(robot)
+        elif not stopping or code not in (0, -signal.SIGINT, -signal.SIGKILL):
             how = f"was killed by signal {-code}" if code < 0 else f"exited with code {code}"
             print(f"[controllers] the process of {robot} (pid {pid}) {how}", file=sys.stderr, flush=True)
-    return 0
+    if stopping or not ended:
+        return 0
+    code = max(ended, key=lambda c: len(ended[c]))  # what most robots heard
+    for c, robots in sorted(ended.items()):
+        print(f"[controllers] {_robots_text(robots)}: {EXIT_CODES[c]}: left (exit {c})", file=sys.stderr, flush=True)
+    return code
 
 
 def main(argv: list[str] | None = None) -> int:

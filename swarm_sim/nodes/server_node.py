@@ -46,6 +46,7 @@ from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_argu
 from swarm_sim.nodes.executor import make_executor
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.nodes.run_watch import RunWatch
 from swarm_sim.outputs import MARKER_ARRAY, StateWatch, outputs_of
 from swarm_sim.protocol import Drawing, Lines, Server
 from swarm_sim.scenario import Scenario, load_scenario
@@ -89,6 +90,9 @@ class ServerNode(Node):
         self.create_subscription(topics.type_of(topics.WORLD_EVENTS), topics.WORLD_EVENTS, self._on_world_events,
                                  EVENTS, raw=True)
         self._ack_pub = None
+        self.watch = RunWatch(self, self.endpoint.inbound, cfg.world_timeout)
+        """The world's ``/world/run``: ticks are acknowledged only while it is current; the
+        process leaves when it ends (`swarm_sim.nodes.run_watch`)."""
         outputs = outputs_of(spec)
         self._state = StateWatch(outputs.state)
         self._state_pubs = {st.topic: self.create_publisher(topics.import_type(st.type_name), st.topic, STATE_LATCHED)
@@ -108,7 +112,7 @@ class ServerNode(Node):
         readiness by creating the ack publisher."""
         robots = self.scenario.robots.count
         deadline = time.monotonic() + self.config.startup_timeout
-        while time.monotonic() < deadline and self.endpoint.unmatched(robots):
+        while time.monotonic() < deadline and self.endpoint.unmatched(robots) and self.watch.verdict() is None:
             executor.spin_once(timeout_sec=0.1)
         self._ack_pub = self.create_publisher(
             topics.type_of(topics.LOCKSTEP_ACK), topics.LOCKSTEP_ACK, SENSOR_LOCKSTEP
@@ -127,7 +131,7 @@ class ServerNode(Node):
                     inbound.reject(topics.WORLD_EVENTS, Reason.UNKNOWN_ROBOT, f"node_down for {e.node[:40]!r}")
 
     def _on_clock(self, data: bytes) -> None:
-        if self._ack_pub is None:
+        if self._ack_pub is None or not self.watch.current():  # not ready, or not our world's tick
             return
         inbound = self.endpoint.inbound
         stamp = inbound.decode(topics.CLOCK, clock_codec.decode_clock, data, CLOCK_BYTES)
@@ -187,17 +191,19 @@ def parse_args(argv: list[str]) -> tuple[str, ServerNodeConfig, list[str]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """One server node in its own process, spun until shut down."""
+    """One server node in its own process, spun until its run ends (the exit code and one line
+    saying why, `swarm_sim.nodes.run_watch`) or it is stopped (0)."""
     channel, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-server", *ros_args])
     node = None
+    verdict = None
     try:
         node = ServerNode(channel, config)
         executor = make_executor()
         executor.add_node(node)
         node.wait_for_robots(executor)
-        while rclpy.ok():
+        while rclpy.ok() and (verdict := node.watch.verdict()) is None:
             executor.spin_once(timeout_sec=0.5)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
@@ -205,7 +211,10 @@ def main(argv: list[str] | None = None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    if verdict is None:
+        return 0
+    print(f"[server {channel}] {verdict[1]}: leaving (exit {verdict[0]})", file=sys.stderr, flush=True)
+    return verdict[0]
 
 
 if __name__ == "__main__":

@@ -48,9 +48,11 @@ from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.command_watch import CommandWatch
 from swarm_sim.nodes.executor import make_executor
 from swarm_sim.nodes.lockstep import LockstepBarrier
+from swarm_sim.nodes.endpoint import ack_wait
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.qos import SENSOR_LOCKSTEP
+from swarm_sim.nodes.run_watch import RunBeacon
 from swarm_sim.nodes.status_watch import StatusWatch
 from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
@@ -210,6 +212,8 @@ class WorldNode(Node):
             self.watch.hear(topic, sub.get_publisher_count)
         self._progress = registry.resolve(algorithm.progress) if algorithm.progress else None
         self.loop = WorldLoop(self)
+        self.beacon = RunBeacon(self, lambda: self.world.t_ns)
+        """``/world/run``: the run goes on, then how it ended (`swarm_sim.nodes.run_watch`)."""
 
     stop_requested = False
     """Set by `main`'s SIGINT/SIGTERM handler; the run stops at its next spin."""
@@ -510,6 +514,7 @@ def main(argv: list[str] | None = None) -> int:
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
+    failed = True  # until the run ends as it should (a crash: the others hear "world failed")
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
         try:
@@ -526,15 +531,20 @@ def main(argv: list[str] | None = None) -> int:
         executor = make_executor()
         executor.add_node(node)
         node.run(executor)
+        failed = False
         if node.stop_requested:
             raise Interrupted
     except (KeyboardInterrupt, ExternalShutdownException, Interrupted):
+        failed = False
         print("[world] interrupted: closing the bag", flush=True)
         if node is not None:
             node.ended = "interrupted"
     finally:
         if node is not None:
+            node.beacon.end("world failed" if failed else node.ended)  # every other process of the run leaves on it
             node.close()
+            if ack_wait() > 0:  # across hosts: until the end reached every reader (lossy links)
+                node.beacon.wait_acknowledged()
             node.destroy_node()
         rclpy.try_shutdown()
     return 0

@@ -28,6 +28,15 @@ CONTROLLER_HOSTS = ("hosta", "hostb")
 SMALL_ARENA = ["arena.size=5.0", "resources.distribution=uniform", "resources.count=150",
                "resources.min_depot_clearance=0.3"]
 """test_determinism's busy arena (CPFA): a short run delivers resources."""
+PAPERS = {
+    "mdbsa_d": ("mdbsa_d", []),
+    "queue_qmt": ("queue_qmt", ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]),
+    "drtm": ("drtm", []),
+    "caging": ("caging", ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]"]),
+}
+"""The papers whose robots talk to a server or each other across the links: MDBSA-D's center,
+Q_MT's depot manager (a busy arena), DRTM's nest, caging's robots (peer messages through the
+world; a small arena and landmark grid: the object found and the protocol going within seconds)."""
 COMPARED = ("resources_delivered", "collision_time_s_by_robot", "contact_time_s_by_robot", "oae_by_robot",
             "trips_by_robot", "clamped_commands", "stale_ticks")
 
@@ -50,6 +59,17 @@ def batch_differences(bag: Path, graph: dict, robots: int, duration: float, seed
         if not np.array_equal(rows[:, 1:], batch.poses[:, i, :]):  # False for other shapes too
             out.append(f"{robot}'s odometry")
     return out + [key for key in COMPARED if graph[key] != expected[key]]
+
+
+def protocol_messages(bag: Path, scenario: str) -> int:
+    """Messages the bag holds on the topics of the scenario's message families (a server's,
+    or the robots' to each other through the world)."""
+    from swarm_sim import registry
+    from swarm_sim.recording import bag_info
+
+    inbound, outbound = registry.robot_topics(registry.of(load_scenario(scenario)))
+    counts = bag_info(bag).message_counts
+    return sum(counts.get(t, 0) for t in (*inbound, *outbound))
 
 
 def robots_of(count: int) -> dict[str, list[str]]:
@@ -130,6 +150,9 @@ class MultiHostRun:
                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             finally:
                 os.close(fd)
+        self.left: dict[str, tuple[int, float]] = {}
+        """Controller host -> (exit code, when it exited [monotonic]), noted as they leave."""
+        threading.Thread(target=self._watch_controllers, daemon=True).start()
         self.server = f"{world}:{7000 + int(os.environ['ROS_DOMAIN_ID'])}"
         self.sockets: dict[str, set[tuple[str, str, str]]] = {h: set() for h in HOSTS}
 
@@ -159,6 +182,41 @@ class MultiHostRun:
         out, err = self.out.join(5), self.err.join(5)
         assert code == 0, f"swarm-run exited {code}:\n{out[-3000:]}\n{err[-3000:]}"
         return json.loads(out.strip().splitlines()[-1])
+
+    def _watch_controllers(self) -> None:
+        while len(self.left) < len(self.controllers):
+            for host, proc in self.controllers.items():
+                if host not in self.left and proc.poll() is not None:
+                    self.left[host] = (proc.returncode, time.monotonic())
+            time.sleep(0.05)
+
+    def wait_controllers(self, since: float, within: float) -> dict[str, tuple[int, float, str]]:
+        """Each controller host's process once it has left by itself: host -> (exit code, wall
+        seconds from `since` (monotonic) to its exit, the line it said last); fails if one is
+        still there `within` seconds after `since`."""
+        while len(self.left) < len(self.controllers):
+            left = [h for h in self.controllers if h not in self.left]
+            assert time.monotonic() - since < within, f"still running {within} s after the end: {left}"
+            time.sleep(0.05)
+        out = {}
+        for host, (code, at) in self.left.items():
+            err = self.controllers[host].stderr.read().strip().splitlines()
+            out[host] = (code, at - since, err[-1] if err else "")
+        return out
+
+    def world_pid(self) -> int:
+        """The world node's process (the launcher's child running swarm_sim.nodes.world_node)."""
+        for entry in Path("/proc").iterdir():
+            if not entry.name.isdigit():
+                continue
+            try:
+                stat = (entry / "stat").read_text()
+                cmdline = (entry / "cmdline").read_bytes()
+            except (OSError, ValueError):
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == self.launcher.pid and b"swarm_sim.nodes.world_node" in cmdline:
+                return int(entry.name)
+        raise AssertionError("no world node process")
 
     def foreign_sockets(self) -> list[str]:
         """Sockets noted on a host bound to anything but that host's own address (0.0.0.0, *,

@@ -9,11 +9,14 @@ that each host's sockets are bound to that host's address only. Skipped without 
 from __future__ import annotations
 
 import json
+import os
+import signal
 import threading
+import time
 
 import numpy as np
 import pytest
-from multihost import MultiHostRun, batch_differences, flags, robots_of
+from multihost import PAPERS, MultiHostRun, batch_differences, flags, protocol_messages, robots_of
 from netns import Testbed, available, leftovers
 
 from swarm_sim.analysis.replay import load_odometry
@@ -39,6 +42,15 @@ def testbed(request):
 
 
 shaped = pytest.mark.parametrize("testbed", [True], indirect=True, ids=["shaped"])
+LEAVE_WITHIN = 5.0
+"""Wall seconds within which every remote process has left after its run's end."""
+
+
+def assert_left_with_the_run(run: MultiHostRun, ended: float) -> None:
+    """Every controller host's process left by itself, exit 0, by the time swarm-run ended
+    (`ended`, monotonic) or `LEAVE_WITHIN` seconds after, saying that the run completed."""
+    for host, (code, after, line) in run.wait_controllers(ended, LEAVE_WITHIN).items():
+        assert code == 0 and after < LEAVE_WITHIN and "the world ended the run (complete)" in line, (host, code, after, line)
 
 
 def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_path):
@@ -50,6 +62,7 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     run.wait_sim(duration / 2, 90)
     run.note_sockets()
     graph = run.finish(120)
+    assert_left_with_the_run(run, time.monotonic())
     out, _ = echo.communicate(timeout=30)
     heard = json.loads(out.strip().splitlines()[-1])
     assert heard["type"] == "geometry_msgs/msg/TwistStamped", heard
@@ -66,16 +79,19 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["resources_delivered"] > 0
 
 
+@pytest.mark.parametrize("paper", list(PAPERS))
 @shaped
-def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
+def test_lossy_links_lockstep_equals_batch(testbed, tmp_path, paper):
     """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
-    mid-run, with a server (MDBSA-D's center) and its protocol: the barrier re-sends unanswered
-    ticks and every node waits for its reliable messages to be acknowledged before answering a
-    tick, so the run is the batch run of its seed."""
-    robots, duration, seed = 8, 15.0, 11
+    mid-run, with each paper's server (MDBSA-D's center, the depot manager, DRTM's nest) or peer
+    messages (caging) and its protocol: the barrier re-sends unanswered ticks and every node
+    waits for its reliable messages to be acknowledged before answering a tick, so the run is
+    the batch run of its seed."""
+    robots, duration, seed = 8, 12.0, 11
+    scenario = PAPERS[paper]
     for host in robots_of(robots):
         testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *MDBSA), "--tick-timeout", "20",
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *scenario), "--tick-timeout", "20",
                        "--resend-period", "0.1")
     run.wait_sim(duration / 3, 120)
     cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
@@ -84,10 +100,12 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path):
         run.note_sockets()
         cut.join(0.5)
     graph = run.finish(240)
+    assert_left_with_the_run(run, time.monotonic())
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
-    assert batch_differences(run.bag, graph, robots, duration, seed, *MDBSA) == []  # ... and recovered from
+    assert batch_differences(run.bag, graph, robots, duration, seed, *scenario) == []  # ... and recovered from
+    assert protocol_messages(run.bag, scenario[0]) > 0  # the protocol went across the links
 
 
 @shaped
@@ -103,6 +121,7 @@ def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
     run.wait_sim(5.0, 120)
     testbed.partition("hostb", 3.0)
     graph = run.finish(120)
+    assert_left_with_the_run(run, time.monotonic())
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["mode"] == "realtime"
     cut, kept = robots_of(robots)["hostb"], robots_of(robots)["hosta"]
@@ -122,3 +141,53 @@ def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
         assert len(still) >= 10 and np.allclose(np.diff(still[:, 1:], axis=0), 0.0, atol=1e-6), (robot, still)
     assert graph["by_host"]["hostb"]["stopped"] >= len(cut)
     assert sum(commands[r]["stopped_ticks"] for r in kept) < sum(commands[r]["stopped_ticks"] for r in cut)
+
+
+WORLD_TIMEOUT = 4.0
+"""The end tests' ``--world-timeout``: a remote process leaves once the world was silent this long."""
+
+
+@shaped
+def test_cut_off_longer_than_the_timeout_then_ctrl_c_every_remote_process_leaves(testbed, tmp_path):
+    """hostb cut off longer than ``--world-timeout``: its controllers leave (world vanished, 5)
+    within the timeout and a beat; then Ctrl-C on the world's host: hosta's leave (interrupted,
+    130) within a few seconds."""
+    robots = 4
+    run = MultiHostRun(testbed, tmp_path, robots, *flags(600.0, 2), "--tick-timeout", "1", "--real-time-factor",
+                       "4", "--world-timeout", f"{WORLD_TIMEOUT:g}")
+    run.wait_sim(2.0, 90)
+    cut = time.monotonic()
+    testbed.netem("hostb", loss=1.0)
+    try:
+        while "hostb" not in run.left:
+            assert time.monotonic() - cut < WORLD_TIMEOUT + LEAVE_WITHIN, "hostb's controllers outlived their world"
+            time.sleep(0.1)
+    finally:
+        testbed.netem("hostb")
+    assert run.launcher.poll() is None and "hosta" not in run.left  # the run goes on without hostb's robots
+    stop = time.monotonic()
+    os.kill(run.launcher.pid, signal.SIGINT)  # Ctrl-C in the world host's terminal
+    left = run.wait_controllers(stop, LEAVE_WITHIN)
+    code, vanished, line = left["hostb"]
+    assert code == 5 and "the world vanished" in line, left
+    assert WORLD_TIMEOUT - 1.0 < vanished + (stop - cut) < WORLD_TIMEOUT + LEAVE_WITHIN, left  # from the cut
+    code, after, line = left["hosta"]
+    assert code == 130 and after < LEAVE_WITHIN and "interrupted" in line, left
+    assert run.launcher.wait(60) == 130
+    print(f"\n[end times] cut off {WORLD_TIMEOUT:g} s timeout: hostb left {vanished + stop - cut:.1f} s after the cut; "
+          f"Ctrl-C: hosta left {after:.1f} s after it")
+
+
+def test_a_killed_world_its_remote_processes_leave_within_the_timeout(testbed, tmp_path):
+    run = MultiHostRun(testbed, tmp_path, 4, *flags(600.0, 2), "--real-time-factor", "4",
+                       "--world-timeout", f"{WORLD_TIMEOUT:g}")
+    run.wait_sim(2.0, 90)
+    killed = time.monotonic()
+    os.kill(run.world_pid(), signal.SIGKILL)
+    left = run.wait_controllers(killed, WORLD_TIMEOUT + LEAVE_WITHIN)
+    for host, (code, after, line) in left.items():
+        assert code == 5 and WORLD_TIMEOUT - 1.0 < after < WORLD_TIMEOUT + LEAVE_WITHIN, (host, left)
+        assert "the world vanished: not heard for" in line, (host, line)
+    assert run.launcher.wait(60) == 5
+    print(f"\n[end times] world SIGKILL, {WORLD_TIMEOUT:g} s timeout: "
+          + ", ".join(f"{h} left {a:.1f} s after" for h, (_, a, _) in left.items()))

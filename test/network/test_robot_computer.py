@@ -52,16 +52,24 @@ def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
         deadline = time.monotonic() + 120
         while world.poll() is None:
             assert time.monotonic() < deadline, "the realtime run did not end in 120 s"
-            assert robot.poll() is None, robot.stderr.read()[-2000:]
+            assert robot.poll() in (None, 0), robot.stderr.read()[-2000:]  # 0: it heard the run's end
             for host in bed.address:
                 sockets |= {(host, local) for _, local, _ in bed.sockets(host)}
             time.sleep(0.3)
         out = world.stdout.read()
         assert world.returncode == 0, out[-3000:]
+        ended = time.monotonic()
+        try:  # the robot's computer leaves by itself when its world ends the run
+            left = robot.wait(5.0)
+        except subprocess.TimeoutExpired:
+            raise AssertionError("the robot's controller outlived its world by 5 s") from None
+        robot_said = robot.stderr.read().strip().splitlines()[-1:]
+        robot_after = time.monotonic() - ended
         heard = json.loads(echo.communicate(timeout=30)[0].strip().splitlines()[-1])
     finally:
         bed.close()
         assert leftovers() == []
+    assert left == 0 and "the world ended the run (complete)" in robot_said[0], (left, robot_said, robot_after)
     assert heard["type"] == "geometry_msgs/msg/Twist" and heard["publishers"] == ["/robot_0/controller"], heard
     assert {h for h, _ in sockets} == {"world", "hosta", "cli"}
     assert [s for s in sockets if s[1].rpartition(":")[0] != bed.address[s[0]]] == []
