@@ -26,6 +26,7 @@ import argparse
 import json
 import os
 import re
+import resource
 import subprocess
 import sys
 import time
@@ -121,7 +122,7 @@ def parse_output(output: str) -> dict:
 
 
 def row(strategy: str, experiment: int, cell: int | None, seed: int, facts: dict, printed: dict,
-        wall_s: float, provenance: dict) -> dict:
+        wall_s: float, cpu_s: float | None, provenance: dict) -> dict:
     """One reference run in our spiral results schema (the fields our rows share) plus provenance."""
     if printed["seed"] != seed:
         raise ReferenceError(f"the run printed seed {printed['seed']}, it was given {seed}")
@@ -137,6 +138,7 @@ def row(strategy: str, experiment: int, cell: int | None, seed: int, facts: dict
         "robots": robots, "regions": None if strategy == "ddsa" else facts["regions"], "layout": "tiers",
         "mode": "reference", "reference": True,
         "sim_seconds": sim_s, "wall_seconds": round(wall_s, 3),
+        "cpu_seconds": None if cpu_s is None else round(cpu_s, 3),
         "real_time_factor": round(sim_s / wall_s, 2) if wall_s > 0 else None,
         "total_resources": total, "resources_delivered": delivered,
         "resources_collected_pct": round(100.0 * delivered / total, 6),
@@ -155,16 +157,18 @@ def row(strategy: str, experiment: int, cell: int | None, seed: int, facts: dict
     }
 
 
-def run_one(argos: str, env: dict, tree: Path, xml: str, seed: int, timeout_s: float) -> tuple[dict, dict, float]:
+def run_one(argos: str, env: dict, tree: Path, xml: str, seed: int, timeout_s: float) -> tuple[dict, dict, float, float]:
+    """(the file's facts, what the run printed, its wall seconds, its CPU seconds (user + system):
+    the machine is shared, so the wall time alone is no speed measure)."""
     text = (tree / xml).read_text()
     facts = xml_facts(text)
     temp = tree / f".swarmforage_{Path(xml).stem}_s{seed}.xml"
     temp.write_text(experiment_xml(text, seed))
     try:
-        start = time.perf_counter()
+        start, used = time.perf_counter(), _children_cpu()
         done = subprocess.run([argos, "-n", "-z", "-c", temp.name], cwd=tree, capture_output=True, text=True,
                               timeout=timeout_s, stdin=subprocess.DEVNULL, env=env)
-        wall = time.perf_counter() - start
+        wall, cpu = time.perf_counter() - start, _children_cpu() - used
     except subprocess.TimeoutExpired:
         raise ReferenceError(f"{xml} seed {seed}: argos3 ran past {timeout_s:.0f} s") from None
     finally:
@@ -173,9 +177,14 @@ def run_one(argos: str, env: dict, tree: Path, xml: str, seed: int, timeout_s: f
         tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
         raise ReferenceError(f"{xml} seed {seed}: argos3 exited {done.returncode}: {ANSI.sub('', tail[0])}")
     try:
-        return facts, parse_output(done.stdout + "\n" + done.stderr), wall
+        return facts, parse_output(done.stdout + "\n" + done.stderr), wall, cpu
     except ReferenceError as e:
         raise ReferenceError(f"{xml} seed {seed}: {e}") from None
+
+
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _done(out: Path) -> set[tuple]:
@@ -245,12 +254,12 @@ def main(argv: list[str] | None = None) -> int:
             for seed in range(1, a.seeds + 1):
                 if (a.strategy, a.experiment, cell, seed, a.commit) in done:
                     continue
-                facts, printed, wall = run_one(a.argos, env, a.tree, xml, seed, a.timeout)
-                r = row(a.strategy, a.experiment, cell, seed, facts, printed, wall, provenance)
+                facts, printed, wall, cpu = run_one(a.argos, env, a.tree, xml, seed, a.timeout)
+                r = row(a.strategy, a.experiment, cell, seed, facts, printed, wall, cpu, provenance)
                 with out.open("a") as f:
                     f.write(json.dumps(r) + "\n")
                 print(f"[reference] {a.strategy} exp {a.experiment} cell {cell} seed {seed}: "
-                      f"{r['resources_delivered']} resources in {wall:.1f} s wall", flush=True)
+                      f"{r['resources_delivered']} resources in {wall:.1f} s wall, {cpu:.1f} s CPU", flush=True)
     except (ReferenceError, OSError) as e:
         print(f"reference: {e}", file=sys.stderr)
         return 2

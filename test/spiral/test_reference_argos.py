@@ -76,7 +76,7 @@ def test_a_run_becomes_one_row_in_our_schema():
     printed = ref.parse_output(output(color=True))
     assert printed["minutes"] == [3, 0, 4] and printed["seed"] == 7
     facts = {"length_s": 180, "robots": 5, "resources": 40, "regions": 16}
-    r = ref.row("mdbsa_c", 1, 16, 7, facts, printed, 2.0, {"commit": COMMIT})
+    r = ref.row("mdbsa_c", 1, 16, 7, facts, printed, 2.0, 1.5, {"commit": COMMIT})
     assert (r["robots"], r["regions"], r["resources_delivered"], r["total_resources"]) == (5, 16, 9, 40)
     assert r["resources_per_robot"] == pytest.approx(1.8)
     assert r["resources_collected_pct"] == pytest.approx(22.5)
@@ -87,8 +87,9 @@ def test_a_run_becomes_one_row_in_our_schema():
     assert r["authors_collision_time_per_robot_s"] == pytest.approx(2.5)
     assert r["collision_time_per_robot_s"] == pytest.approx(5.0)
     assert r["collision_time_total_min"] == pytest.approx(25.0 / 60, abs=1e-6)
+    assert (r["wall_seconds"], r["cpu_seconds"], r["real_time_factor"]) == (2.0, 1.5, 90.0)
     assert r["reference"] is True and r["mode"] == "reference" and r["commit"] == COMMIT
-    assert ref.row("ddsa", 1, None, 7, facts, printed, 2.0, {})["regions"] is None
+    assert ref.row("ddsa", 1, None, 7, facts, printed, 2.0, None, {})["regions"] is None
 
 
 @pytest.mark.parametrize("text, message", [
@@ -112,7 +113,7 @@ def test_output_that_is_not_one_run_is_refused(text, message):
 def test_a_run_that_is_not_the_file_it_was_given_is_refused(kwargs, message):
     facts = {"length_s": 180, "robots": 5, "resources": 40, "regions": 16}
     with pytest.raises(ref.ReferenceError, match=message):
-        ref.row("mdbsa_d", 1, 16, 7, facts, ref.parse_output(output(**kwargs)), 1.0, {})
+        ref.row("mdbsa_d", 1, 16, 7, facts, ref.parse_output(output(**kwargs)), 1.0, 1.0, {})
 
 
 def test_cells_name_their_files():
@@ -149,6 +150,7 @@ def test_main_appends_rows_skips_done_runs_and_cleans_up(tmp_path):
     out = tmp_path / "results.jsonl"
     assert _main(tree, argos, out, "--seeds", "2") == 0
     rows = [json.loads(line) for line in out.read_text().splitlines()]
+    assert all(r["cpu_seconds"] >= 0 for r in rows)
     assert [(r["seed"], r["cell"], r["xml"]) for r in rows] == [
         (1, 16, "Distributed/experiments/Experiment1_rg16.xml"), (2, 16, "Distributed/experiments/Experiment1_rg16.xml")]
     assert _main(tree, argos, out, "--seeds", "3") == 0
