@@ -27,6 +27,7 @@ import json
 import os
 import re
 import resource
+import signal
 import subprocess
 import sys
 import time
@@ -227,6 +228,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--timeout", type=float, default=1800.0, help="wall seconds one run may take")
     p.add_argument("--out", type=Path, help="default results/reference/spiral/exp<E>/results.jsonl")
     a = p.parse_args(argv)
+    # a stopped sweep (SIGTERM) unwinds like ^C: the running argos3 is killed, its temporary file removed
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         if not re.fullmatch(r"[0-9a-f]{40}", a.commit) or not re.fullmatch(r"[0-9a-f]{40}", a.argos_commit):
             raise ReferenceError("--commit and --argos-commit take 40 hex digits")
