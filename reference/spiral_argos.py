@@ -229,7 +229,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", type=Path, help="default results/reference/spiral/exp<E>/results.jsonl")
     a = p.parse_args(argv)
     # a stopped sweep (SIGTERM) unwinds like ^C: the running argos3 is killed, its temporary file removed
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    previous = signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
     try:
         if not re.fullmatch(r"[0-9a-f]{40}", a.commit) or not re.fullmatch(r"[0-9a-f]{40}", a.argos_commit):
             raise ReferenceError("--commit and --argos-commit take 40 hex digits")
@@ -266,6 +266,8 @@ def main(argv: list[str] | None = None) -> int:
     except (ReferenceError, OSError) as e:
         print(f"reference: {e}", file=sys.stderr)
         return 2
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     return 0
 
 
