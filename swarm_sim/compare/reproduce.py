@@ -14,7 +14,7 @@ Without ``--robot-model``, every sweep runs twice: on each algorithm's authors' 
 (``--robot-model authors``, into ``OUT/authors/``) and on today's generic robot (``OUT/generic/``),
 and REPORT.md puts each claim's result on both side by side, with the count of claims holding for
 each, then includes ``OUT/CAUSES.md`` (the evidence behind the causes, written from the
-one-factor-at-a-time sweeps) when there is one. Where ``OUT/reference/<comparison>/results.jsonl``
+one-factor-at-a-time sweeps) when there is one. Where ``OUT/reference/<comparison>/**/results.jsonl``
 holds runs of the authors' own code (same fields as ours, plus ``reference: true``), every level cell
 also shows them and our runs judged against them.
 """

@@ -4,7 +4,7 @@ It leads with the truth: per paper and robot model the count of claims in each v
 every level cell (the paper's number, ours ± 95 % interval, n, the ratio), then the relations and
 trends, then each claim that does not hold with its cause and the cause's grade, then where a
 paper's text and its authors' code disagree, which rule each scenario follows. Where
-``OUT/reference/<comparison>/results.jsonl`` holds runs of the authors' code, each level cell also
+``OUT/reference/<comparison>/**/results.jsonl`` holds runs of the authors' code, each level cell also
 shows them and a verdict of ours against them. Nothing here knows a paper: the claims, rows and
 rules come from each comparison's sweeps.
 """
@@ -37,7 +37,7 @@ from swarm_sim.compare.verdicts import (
 )
 
 REFERENCE = "reference"
-"""``OUT/reference/<comparison>/results.jsonl``: the authors' code's runs (issue 37), if any."""
+"""``OUT/reference/<comparison>/**/results.jsonl``: the authors' code's runs, if any (one file, or one per experiment)."""
 
 
 def _num(x: float, digits: int = 3) -> str:
@@ -84,14 +84,19 @@ def common_fields(pairs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
 
 
 def _reference(out: Path, name: str) -> list[dict] | None:
-    path = out / REFERENCE / name / RESULTS
-    if not path.is_file():
+    """The authors' code's runs of a comparison: every results file under ``reference/<name>/``
+    (one, or one per experiment as ``exp1/``, ``exp2/``); a file that cannot be read is left out,
+    saying so."""
+    paths = sorted((out / REFERENCE / name).rglob(RESULTS))
+    if not paths:
         return None
-    try:
-        return [r for r in read_results(path) if r.get(REFERENCE) is True]
-    except ResultsFileError as exc:
-        print(f"swarm-compare all: {exc}: the authors' code's runs left out")
-        return None
+    rows = []
+    for path in paths:
+        try:
+            rows += [r for r in read_results(path) if r.get(REFERENCE) is True]
+        except ResultsFileError as exc:
+            print(f"swarm-compare all: {exc}: the authors' code's runs in it left out")
+    return rows
 
 
 def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[str, tuple[list[Verdict], dict]]]:
