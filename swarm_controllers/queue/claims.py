@@ -46,7 +46,7 @@ _CPFA_LATE = Cause(OPEN, "our CPFA jams later than the paper's (37 % at 48 robot
 _JOIN = Cause(PARTIAL, "Q_ST's join rule: the generic robot's committed Q_ST runs predate the shipped scenario's "
                        "switch to the authors' code's join anywhere (`controller.queue.join_order`) and use the "
                        "text's behind-the-tail; on the foot-bot the code's rule lifts Q_ST from 12.9 to 18.4 % at "
-                       "48 robots and from 11.4 to 19.3 % at 112 (the authors'-robot sweep, 10-20 seeds; "
+                       "48 robots and from 11.4 to 17.2 % at 112 (the authors'-robot sweep, 20 seeds; "
                        "`qst_join_anywhere`, 4 seeds, before it)", "qst_join_anywhere", 4)
 _COLL_RULE = Cause(OPEN, "collision time counted by the world's proximity ring for every strategy; counted "
                          "as the queue authors count it (within ±30 deg on the queue path) Q_SE's grows "
