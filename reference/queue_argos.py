@@ -17,11 +17,11 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import resource
-import subprocess
 import sys
-import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
+from argos_run import ReferenceError, run_argos  # noqa: E402
 
 AUTHORS_SEEDS = (123456, 789012, 345678, 901234, 567890, 135791, 246802, 864209, 751936, 428573,
                  613579, 982034, 704321, 319864, 580246, 162738, 947120, 830591, 204869, 678345)
@@ -37,10 +37,6 @@ LINE = re.compile(
     r"Random Seed: (?P<seed>\d+)")
 """The line ``PostExperiment`` prints (collision in minutes, all robots; circle in minutes per
 delivery: their ``(TimeInsideRedCircle / 60) / score``)."""
-
-
-class ReferenceError(Exception):
-    """A run or an input that cannot be used; the message names it."""
 
 
 def experiment_xml(text: str, robots: int, seed: int) -> str:
@@ -90,29 +86,12 @@ def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, pro
     }
 
 
-def _children_cpu_s() -> float:
-    used = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return used.ru_utime + used.ru_stime
-
-
 def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) -> tuple[dict, float, float]:
     """The printed numbers, the wall seconds and the CPU seconds (user + system) of one run."""
     xml = experiment_xml((tree / EXPERIMENT).read_text(), robots, seed)
-    temp = tree / f".swarmforage_r{robots}_s{seed}.xml"
-    temp.write_text(xml)
-    try:
-        start, cpu = time.perf_counter(), _children_cpu_s()
-        done = subprocess.run([argos, "-c", str(temp.name)], cwd=tree, capture_output=True, text=True,
-                              timeout=timeout_s, stdin=subprocess.DEVNULL)
-        wall, cpu = time.perf_counter() - start, _children_cpu_s() - cpu
-    except subprocess.TimeoutExpired:
-        raise ReferenceError(f"robots {robots} seed {seed}: argos3 ran past {timeout_s:.0f} s") from None
-    finally:
-        temp.unlink(missing_ok=True)
-    if done.returncode != 0:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
-        raise ReferenceError(f"robots {robots} seed {seed}: argos3 exited {done.returncode}: {tail[0]}")
-    return parse_line(done.stdout + done.stderr), wall, cpu
+    output, wall, cpu = run_argos([argos], tree, xml, f".swarmforage_r{robots}_s{seed}.xml",
+                                  f"robots {robots} seed {seed}", timeout_s)
+    return parse_line(output), wall, cpu
 
 
 def _done(out: Path) -> set[tuple[str, int, int, str]]:

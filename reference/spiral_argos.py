@@ -26,12 +26,12 @@ import argparse
 import json
 import os
 import re
-import resource
 import signal
-import subprocess
 import sys
-import time
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
+from argos_run import ANSI, ReferenceError, run_argos  # noqa: E402
 
 STRATEGIES = {
     "ddsa": ("MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-Search-Algorithm", ""),
@@ -48,12 +48,6 @@ SUMMARY = re.compile(r"^\s*(?P<sim>\d+(?:\.\d*)?),\s+(?P<bots>\d+),\s+(?P<collec
                      r"\s+(?P<collision>[-+\d.eE]+),\s+(?P<pct>[-+\d.eE]+)%\s*$")
 MINUTE = re.compile(r"Minute Passed\.\.\. getSimTimeInSeconds: (?P<s>\d+), Food Collected: (?P<n>\d+)")
 SEED = re.compile(r"Using random seed = (\d+)")
-ANSI = re.compile(r"\x1b\[[0-9;]*m")
-
-
-class ReferenceError(Exception):
-    """A run or an input that cannot be used; the message names it."""
-
 
 def xml_name(strategy: str, experiment: int, cell: int | None) -> str:
     """Their experiment file for a cell, relative to the tree. DDSA reads no ``NumOfRegions``:
@@ -159,33 +153,15 @@ def row(strategy: str, experiment: int, cell: int | None, seed: int, facts: dict
 
 
 def run_one(argos: str, env: dict, tree: Path, xml: str, seed: int, timeout_s: float) -> tuple[dict, dict, float, float]:
-    """(the file's facts, what the run printed, its wall seconds, its CPU seconds (user + system):
-    the machine is shared, so the wall time alone is no speed measure)."""
+    """(the file's facts, what the run printed, its wall seconds, its CPU seconds)."""
     text = (tree / xml).read_text()
     facts = xml_facts(text)
-    temp = tree / f".swarmforage_{Path(xml).stem}_s{seed}.xml"
-    temp.write_text(experiment_xml(text, seed))
+    output, wall, cpu = run_argos([argos, "-n", "-z"], tree, experiment_xml(text, seed),
+                                  f".swarmforage_{Path(xml).stem}_s{seed}.xml", f"{xml} seed {seed}", timeout_s, env)
     try:
-        start, used = time.perf_counter(), _children_cpu()
-        done = subprocess.run([argos, "-n", "-z", "-c", temp.name], cwd=tree, capture_output=True, text=True,
-                              timeout=timeout_s, stdin=subprocess.DEVNULL, env=env)
-        wall, cpu = time.perf_counter() - start, _children_cpu() - used
-    except subprocess.TimeoutExpired:
-        raise ReferenceError(f"{xml} seed {seed}: argos3 ran past {timeout_s:.0f} s") from None
-    finally:
-        temp.unlink(missing_ok=True)
-    if done.returncode != 0:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
-        raise ReferenceError(f"{xml} seed {seed}: argos3 exited {done.returncode}: {ANSI.sub('', tail[0])}")
-    try:
-        return facts, parse_output(done.stdout + "\n" + done.stderr), wall, cpu
+        return facts, parse_output(output), wall, cpu
     except ReferenceError as e:
         raise ReferenceError(f"{xml} seed {seed}: {e}") from None
-
-
-def _children_cpu() -> float:
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
 
 
 def _done(out: Path) -> set[tuple]:
