@@ -43,24 +43,14 @@ _MOTION = Cause(PARTIAL, "the foot-bot's stop-turn-go motion rule: with the gene
 _CPFA_LATE = Cause(OPEN, "our CPFA jams later than the paper's (37 % at 48 robots against 15 %; at 112 robots "
                          "both motion rules give the paper's ~15 %); what delays the jam is not measured (the "
                          "dock distance is not it: `cpfa_docks_0.585`, 2 seeds, raises it)")
-_JOIN = Cause(PARTIAL, "Q_ST's join rule: the generic robot's committed Q_ST runs predate the shipped scenario's "
-                       "switch to the authors' code's join anywhere (`controller.queue.join_order`) and use the "
-                       "text's behind-the-tail; on the foot-bot the code's rule lifts Q_ST from 12.9 to 18.4 % at "
-                       "48 robots and from 11.4 to 17.2 % at 112 (the authors'-robot sweep, 20 seeds; "
-                       "`qst_join_anywhere`, 4 seeds, before it)", "qst_join_anywhere", 4)
 _COLL_RULE = Cause(OPEN, "collision time counted by the world's proximity ring for every strategy; counted "
                          "as the queue authors count it (within ±30 deg on the queue path) Q_SE's grows "
                          "fastest of the queue strategies (CAUSES.md); not a one-factor sweep")
 
 
 def _on(cause: Cause) -> tuple[tuple[str, Cause], ...]:
-    """The models a cause applies to: the motion rule is the foot-bot's only; the join rule the
-    generic robot's only (its Q_ST runs predate the switch), where the foot-bot has its motion."""
-    if cause is _MOTION:
-        return (("authors", cause),)
-    if cause is _JOIN:
-        return (("generic", cause), ("authors", _MOTION))
-    return (("*", cause),)
+    """The models a cause applies to: the motion rule is the foot-bot's only."""
+    return (("authors", cause),) if cause is _MOTION else (("*", cause),)
 
 
 def _pair_sizes(a: str, b: str) -> tuple[tuple[int, float], ...]:
@@ -72,7 +62,7 @@ def _levels() -> list[Claim]:
     out = []
     for s in QUEUE_STRATEGIES:
         for n in QUEUE_SIZES:
-            cause = _CPFA_LATE if s == "queue_cpfa" else _JOIN if s == "queue_qst" else _MOTION
+            cause = _CPFA_LATE if s == "queue_cpfa" else _MOTION
             out.append(Claim(f"T2.{QUEUE_LABELS[s]}.{n}", LEVEL, f"{QUEUE_LABELS[s]} collects {PAPER_TABLE_II[s][n]} % "
                              f"with {n} robots", "Table II", PCT, s, (n,), value=PAPER_TABLE_II[s][n], unit="%",
                              note=TEXT_COUNTS.get((s, n), ""), causes=_on(cause)))
@@ -84,9 +74,7 @@ def _order() -> list[Claim]:
     order = list(QUEUE_STRATEGIES)  # Table II: least to most at every size
     for i, a in enumerate(order):
         for b in order[i + 1:]:
-            if (a, b) == ("queue_qse", "queue_qst"):
-                cause = _JOIN
-            elif a == "queue_cpfa":
+            if a == "queue_cpfa":
                 cause = _CPFA_LATE
             else:
                 cause = _MOTION

@@ -257,9 +257,8 @@ QUEUE_RULES: tuple[Rule, ...] = (
          "Sec. V-B: a seeker that finds the tail \"will simply join the queue behind it\" (`behind_tail`)",
          "Tameem786/Collision_Free_CPFA branch CPFA-2.0, `CPFA_controller::Returning`: a carrier boards the spiral "
          "at the innermost lane it crossed once blocked (`anywhere`); its logged runs match Table II's Q_ST",
-         "code", "the text's reading: `--set controller.queue.join_order=behind_tail`; the committed runs on the "
-                 "authors' robots use the code's rule, the generic robot's Q_ST runs still the text's (they "
-                 "predate the switch)"),
+         "code", "the text's reading: `--set controller.queue.join_order=behind_tail`; the committed Q_ST runs "
+                 "on both robot models use the code's rule"),
     Rule("queue_qst", "controller.queue.seek_timeout",
          "no give-up", "no give-up", "neither",
          "ours: a seeker falls back to the entry point after 120 s (factor `qst_no_give_up`)"),
