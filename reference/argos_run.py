@@ -3,10 +3,12 @@ built checkout (its library paths are relative to it) and time it by wall and CP
 machine is shared, so the wall time alone is no speed measure)."""
 from __future__ import annotations
 
+import json
 import re
 import resource
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 ANSI = re.compile(r"\x1b\[[0-9;]*m")
@@ -41,3 +43,17 @@ def run_argos(command: list[str], tree: Path, xml: str, name: str, label: str, t
         tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["(no output)"]
         raise ReferenceError(f"{label}: argos3 exited {done.returncode}: {ANSI.sub('', tail[0])}")
     return done.stdout + "\n" + done.stderr, wall, cpu
+
+
+def done_keys(out: Path, key: Callable[[dict], tuple]) -> set[tuple]:
+    """The runs already in an output file, by ``key`` (so a sweep resumes); a line that is no
+    reference row is refused by its line number, and nothing is written."""
+    if not out.exists():
+        return set()
+    keys = set()
+    for n, text in enumerate(out.read_text().splitlines(), 1):
+        try:
+            keys.add(key(json.loads(text)))
+        except (ValueError, KeyError, TypeError):
+            raise ReferenceError(f"{out}:{n}: not a reference row") from None
+    return keys

@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
-from argos_run import ReferenceError, run_argos  # noqa: E402
+from argos_run import done_keys, ReferenceError, run_argos  # noqa: E402
 
 AUTHORS_SEEDS = (123456, 789012, 345678, 901234, 567890, 135791, 246802, 864209, 751936, 428573,
                  613579, 982034, 704321, 319864, 580246, 162738, 947120, 830591, 204869, 678345)
@@ -95,16 +95,7 @@ def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) ->
 
 
 def _done(out: Path) -> set[tuple[str, int, int, str]]:
-    if not out.exists():
-        return set()
-    keys = set()
-    for n, text in enumerate(out.read_text().splitlines(), 1):
-        try:
-            r = json.loads(text)
-            keys.add((r["strategy"], int(r["robots"]), int(r["seed"]), r["commit"]))
-        except (ValueError, KeyError, TypeError):
-            raise ReferenceError(f"{out}:{n}: not a reference row") from None
-    return keys
+    return done_keys(out, lambda r: (r["strategy"], int(r["robots"]), int(r["seed"]), r["commit"]))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -31,7 +31,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
-from argos_run import ANSI, ReferenceError, run_argos  # noqa: E402
+from argos_run import done_keys, ANSI, ReferenceError, run_argos  # noqa: E402
 
 STRATEGIES = {
     "ddsa": ("MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-Search-Algorithm", ""),
@@ -165,16 +165,7 @@ def run_one(argos: str, env: dict, tree: Path, xml: str, seed: int, timeout_s: f
 
 
 def _done(out: Path) -> set[tuple]:
-    if not out.exists():
-        return set()
-    keys = set()
-    for n, text in enumerate(out.read_text().splitlines(), 1):
-        try:
-            r = json.loads(text)
-            keys.add((r["strategy"], r["experiment"], r["cell"], int(r["seed"]), r["commit"]))
-        except (ValueError, KeyError, TypeError):
-            raise ReferenceError(f"{out}:{n}: not a reference row") from None
-    return keys
+    return done_keys(out, lambda r: (r["strategy"], r["experiment"], r["cell"], int(r["seed"]), r["commit"]))
 
 
 def _env(argos: str) -> dict:
