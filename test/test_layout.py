@@ -152,12 +152,35 @@ def test_no_import_circles():
     round)."""
     graph = _graph()
     assert _cycles(graph) == []
-    # The world loop still annotates with the whole world node: issue 38's seams item (the loop
-    # talks to a narrow interface) removes this circle, and this allowance with it.
-    assert [c for c in _cycles(_graph(type_checking=True))
-            if c != ["swarm_sim.nodes.world_loop", "swarm_sim.nodes.world_node"]] == []
+    assert _cycles(_graph(type_checking=True)) == []
     assert graph["swarm_sim.scenario.schema"] <= {"swarm_sim"}
     assert "swarm_sim.scenario" not in graph["swarm_sim.registry"]
+
+
+def _members(tree: ast.Module, cls: str) -> set[str]:
+    """The names a class of `tree` defines (its methods and properties)."""
+    [node] = [n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == cls]
+    return {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+
+
+def test_world_loop_uses_only_its_host_interface():
+    """The world loop reaches the world node only through `LoopHost` (and its settings through
+    `LoopSettings`): every ``host.X`` it reads is declared there, and it assigns none."""
+    tree = ast.parse(MODULES["swarm_sim.nodes.world_loop"].read_text())
+    host, settings = _members(tree, "LoopHost"), _members(tree, "LoopSettings")
+    used, config, assigned = set(), set(), []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, (ast.Name, ast.Attribute)):
+            owner = ast.unparse(node.value)
+            if owner in ("host", "self.host"):
+                used.add(node.attr)
+                if isinstance(node.ctx, ast.Store):
+                    assigned.append(node.attr)
+            elif owner in ("host.config", "self.host.config", "cfg"):
+                config.add(node.attr)
+    assert used and used <= host, sorted(used - host)
+    assert config and config <= settings, sorted(config - settings)
+    assert assigned == []
 
 
 def test_function_local_imports_of_project_modules_say_why():

@@ -222,6 +222,14 @@ class WorldNode(Node):
         """The whole run (`swarm_sim.nodes.world_loop`)."""
         self.loop.run(executor)
 
+    def poll_recording(self) -> float:
+        """Let the bag flush or split (`WorldRecording.poll`); the wall seconds that took."""
+        return self.recording.poll()
+
+    def start_live_view(self) -> None:
+        """Serve the live view, if the run has one, once the run's topics exist."""
+        self.outputs.start_live_view(self.discover)
+
     # ------------------------------------------------------------------ intake
 
     @property
@@ -457,7 +465,7 @@ class WorldNode(Node):
     def close(self) -> None:
         self.recording.close(
             {f.topic for f in self.watch.found},
-            wall_seconds=f"{time.monotonic() - getattr(self, 'wall_start', time.monotonic()):.3f}",
+            wall_seconds=f"{time.monotonic() - (self.loop.wall_start or time.monotonic()):.3f}",
             sim_seconds=f"{self.world.t_ns / NS_PER_S:.6f}",
             server_stale_ticks=json.dumps(self.server_stale_ticks),
             ended=self.ended,
