@@ -29,6 +29,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
@@ -164,7 +165,8 @@ def output_directory(args: argparse.Namespace, scenario: Scenario) -> Path:
     return bag
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """swarm-run's options (``--help`` lists them with the exit codes)."""
     parser = argparse.ArgumentParser(
         prog="swarm-run", description=first_paragraph(__doc__), formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="exit codes:\n" + "\n".join(f"  {code:3d}  {what}" for code, what in EXIT_CODES.items()))
@@ -221,44 +223,87 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--key-file", type=Path, metavar="PATH",
                         help="write the run's credential here (mode 0600), for the controllers on other hosts "
                              "(SWARMFORAGE_KEY_FD=3 ... 3<PATH); required with --remote-controllers")
-    args = parser.parse_args(argv)
-    # Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
-    # (nohup, some CI shells and test runners), so install the handlers explicitly.
+    return parser
+
+
+class Refused(Exception):
+    """What makes swarm-run refuse a run before starting anything (exit 2), as the line to print."""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the options and the scenario make of a run, checked before anything starts."""
+
+    scenario: Scenario
+    pace: float | None
+    """Lockstep's cap on sim seconds per wall second (`_pace`)."""
+    bind: str | None
+    """The address the run binds across hosts; None: loopback."""
+    remote: dict[str, list[str]]
+    """Host -> the robots whose controllers run there (started by hand)."""
+    local: list[str]
+    """The robots whose controllers this launcher starts."""
+    groups: list[list[str]]
+    """`local` dealt over the controller processes."""
+    servers: tuple[registry.ServerSpec, ...]
+    processes: int
+    """DDS processes of the run here: controllers, servers, the world."""
+
+
+@dataclass(frozen=True)
+class Environments:
+    """The children's environments (DDS domain, discovery, transport profiles)."""
+
+    world: dict[str, str]
+    robots: dict[str, str]
+    """The controller processes'."""
+    others: dict[str, str]
+    """The servers'."""
+    profiles: Path
+    """This run's Fast DDS profile files (removed at the end)."""
+    port: int | None
+    """The world's discovery server port; None with ``--discovery simple``."""
+
+
+def install_signal_handlers() -> None:
+    """Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
+    (nohup, some CI shells and test runners), so install the handlers explicitly."""
     signal.signal(signal.SIGINT, signal.default_int_handler)
     signal.signal(signal.SIGTERM, _raise_interrupt)
     signal.signal(signal.SIGHUP, _raise_interrupt)  # terminal closed: stop the children too
+
+
+def plan_run(args: argparse.Namespace) -> Plan:
+    """The scenario, the live view's port, the hosts and the process count, checked in that
+    order; raises Refused with the line to print."""
     try:
         scenario = load_scenario(args.scenario, args.overrides, **scenario_fields(args), seed=args.seed)
     except ScenarioError as exc:
-        print(f"swarm-run: {exc}", file=sys.stderr)
-        return 2
-
+        raise Refused(exc) from None
     if (problem := _foxglove_problem(args)) is not None:
-        print(f"swarm-run: {problem}", file=sys.stderr)
-        return 2
+        raise Refused(problem)
     pace = _pace(args)
     try:
         bind, remote = _hosts(args, scenario)
     except hosts.HostError as exc:
-        print(f"swarm-run: {exc}", file=sys.stderr)
-        return 2
+        raise Refused(exc) from None
     local = [r for r in scenario.robot_names if r not in {r for robots in remote.values() for r in robots}]
     groups = split_robots(local, args.controller_processes) if local else []
     servers = registry.of(scenario).servers
     processes = len(groups) + len(servers) + 1
     if processes > PROFILE_MAX_PROCESSES:
-        print(f"swarm-run: {scenario.robots.count} robots in {len(groups)} controller processes make {processes} DDS "
-              f"processes; the loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use --controller-processes "
-              "K with fewer processes)", file=sys.stderr)
-        return 2
-    try:
-        domain, domain_lock = claim_run_domain(args.domain_id)  # held (open) until this process ends
-        bag = output_directory(args, scenario)
-    except (ValueError, DomainTaken) as exc:
-        print(f"swarm-run: {exc}", file=sys.stderr)
-        return 2
+        raise Refused(f"{scenario.robots.count} robots in {len(groups)} controller processes make {processes} DDS "
+                      f"processes; the loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use "
+                      "--controller-processes K with fewer processes)")
+    return Plan(scenario, pace, bind, remote, local, groups, servers, processes)
+
+
+def dds_environments(args: argparse.Namespace, plan: Plan, domain: int) -> Environments:
+    """Every child's DDS environment on `domain`: loopback (or `plan.bind` across hosts), the
+    world as discovery server, the profiles written to a temporary directory."""
+    bind = plan.bind
     port = discovery_port(domain) if args.discovery == "server" else None
-    env = loopback_env(domain, processes=processes, base=os.environ, server_port=port)
+    env = loopback_env(domain, processes=plan.processes, base=os.environ, server_port=port)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):  # many small processes: no BLAS thread pools,
         env.setdefault(var, "1")  # which would also not survive the controllers' fork
     profiles = Path(tempfile.mkdtemp(prefix="swarmforage-"))  # this run's Fast DDS profiles
@@ -289,32 +334,87 @@ def main(argv: list[str] | None = None) -> int:
                                              profiles / "discovery_server.xml")
         # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
         robots_env = profile_env(env, "robots.xml", robot_profile())
-    common = scenario_args(args, scenario)
-    watching = [*common, "--world-timeout", f"{args.world_timeout:g}"]  # the controllers' and servers'
+    return Environments(world_env, robots_env, env, profiles, port)
+
+
+def announce(args: argparse.Namespace, plan: Plan, domain: int, port: int | None, bag: Path) -> None:
+    """The run's first lines: what runs where, and how to look at it with ros2."""
+    scenario = plan.scenario
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
-        f"seed {scenario.seed}, {args.mode}, {len(groups)} controller process(es), domain {domain}\n"
+        f"seed {scenario.seed}, {args.mode}, {len(plan.groups)} controller process(es), domain {domain}\n"
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
-    if port is not None and bind is None:
+    if port is not None and plan.bind is None:
         print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
               f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
               f"FASTRTPS_DEFAULT_PROFILES_FILE={PROFILE_PATH} ros2 topic list --spin-time 2  (discovery takes "
               "~1.5 s: --spin-time 2 without a daemon, or `ros2 daemon start` once with the same variables)",
               flush=True)
+
+
+def run_key(args: argparse.Namespace, plan: Plan, domain: int, port: int | None, watching: list[str]) -> bytes:
+    """This run's credential (`swarm_msgs_py.auth`), written to ``--key-file`` if asked; across
+    hosts, how the other hosts join."""
+    key = secrets.token_bytes(auth.KEY_BYTES)
+    if args.key_file is not None:
+        _write_key(args.key_file, key)
+    if plan.bind is not None:
+        _print_remote(domain, (plan.bind, port), plan.remote,
+                      [*watching, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
+    return key
+
+
+@dataclass(frozen=True)
+class Commands:
+    """The run's command lines: the world node's, and the controller processes' and servers',
+    each with the label the launcher names it by."""
+
+    world: list[str]
+    controllers: list[tuple[str, list[str]]]
+    servers: list[tuple[str, list[str]]]
+
+
+def commands(args: argparse.Namespace, plan: Plan, bag: Path, common: list[str], watching: list[str]) -> Commands:
+    """The command lines of the world node, the controller processes and the servers."""
     python = [sys.executable, "-m"]
+    world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
+                 "--tick-timeout", str(args.tick_timeout), "--resend-period", str(args.resend_period),
+                 "--real-time-factor", str(args.real_time_factor or 1.0)]
+    if plan.pace:
+        world_cmd += ["--pace", str(plan.pace)]
+    if args.foxglove is not None:
+        world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
+    options = [] if args.parameter_services else ["--no-parameter-services"]
+    if args.plain_twist:
+        world_cmd += ["--plain-twist", *(r for robots in plan.remote.values() for r in robots)]
+    if args.controller_processes == 0:  # one process per robot, forked after the imports
+        controllers = [("controller processes (one per robot)",
+                        [*python, "swarm_sim.nodes.controller_node", "--fork", *options, "--robots",
+                         *plan.scenario.robot_names])]
+    else:
+        controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
+                        [*python, "swarm_sim.nodes.controller_node", *options, "--robots", *g]) for g in plan.groups]
+    return Commands(
+        world_cmd,
+        [(label, [*cmd, "--mode", args.mode, *watching]) for label, cmd in controllers],
+        [(f"server {spec.channel} ({spec.node_name})",
+          [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, "--mode", args.mode, *watching])
+         for spec in plan.servers],
+    )
+
+
+def run_processes(args: argparse.Namespace, cmds: Commands, envs: Environments, key: bytes, bag: Path,
+                  domain_lock: int) -> tuple[subprocess.Popen | None, bool]:
+    """Start the world (the discovery server, first), the controllers and the servers; wait for
+    the world to end, reporting the start-up and any child that dies; stop every child, remove
+    the profiles, free the domain. Returns the world's process (None if interrupted before it
+    started) and whether the run was interrupted."""
     me = os.getpid()
 
-    run_key = secrets.token_bytes(auth.KEY_BYTES)  # this run's credential (`swarm_msgs_py.auth`)
-    if args.key_file is not None:
-        _write_key(args.key_file, run_key)
-    if bind is not None:
-        _print_remote(domain, (bind, port), remote,
-                      [*watching, "--mode", args.mode, *(["--plain-twist"] if args.plain_twist else [])], args.key_file)
-
-    def start(label: str, cmd: list[str], env: dict[str, str] = env) -> tuple[str, subprocess.Popen]:
-        key_fd = auth.inheritable_key_pipe(run_key)  # the key reaches the child by a pipe, never argv
+    def start(label: str, cmd: list[str], env: dict[str, str]) -> tuple[str, subprocess.Popen]:
+        key_fd = auth.inheritable_key_pipe(key)  # the key reaches the child by a pipe, never argv
         try:
             proc = subprocess.Popen(cmd, env={**env, auth.ENV: str(key_fd)}, pass_fds=(key_fd,),
                                     start_new_session=True, preexec_fn=lambda: die_with_parent(me))
@@ -322,36 +422,15 @@ def main(argv: list[str] | None = None) -> int:
             os.close(key_fd)
         return label, proc
 
-    world_cmd = [*python, "swarm_sim.nodes.world_node", *common, "--mode", args.mode, "--bag", str(bag),
-                 "--tick-timeout", str(args.tick_timeout), "--resend-period", str(args.resend_period),
-                 "--real-time-factor", str(args.real_time_factor or 1.0)]
-    if pace:
-        world_cmd += ["--pace", str(pace)]
-    if args.foxglove is not None:
-        world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
-    options = [] if args.parameter_services else ["--no-parameter-services"]
-    if args.plain_twist:
-        world_cmd += ["--plain-twist", *(r for robots in remote.values() for r in robots)]
-    if args.controller_processes == 0:  # one process per robot, forked after the imports
-        controllers = [("controller processes (one per robot)",
-                        [*python, "swarm_sim.nodes.controller_node", "--fork", *options, "--robots",
-                         *scenario.robot_names])]
-    else:
-        controllers = [(f"controller process of {', '.join(g) if len(g) <= 4 else f'{len(g)} robots'}",
-                        [*python, "swarm_sim.nodes.controller_node", *options, "--robots", *g]) for g in groups]
-    controllers = [(label, [*cmd, "--mode", args.mode]) for label, cmd in controllers]
     children: list[tuple[str, subprocess.Popen]] = []
     world: subprocess.Popen | None = None
     interrupted = False
     reported: set[int] = set()
     launched = said = time.monotonic()
     try:
-        _, world = start("world", world_cmd, world_env)  # first: it is the discovery server
-        children += [start(label, [*cmd, *watching], robots_env) for label, cmd in controllers]
-        children += [start(f"server {spec.channel} ({spec.node_name})",
-                           [*python, "swarm_sim.nodes.server_node", "--channel", spec.channel, "--mode", args.mode,
-                            *watching])
-                     for spec in servers]
+        _, world = start("world", cmds.world, envs.world)  # first: it is the discovery server
+        children += [start(label, cmd, envs.robots) for label, cmd in cmds.controllers]
+        children += [start(label, cmd, envs.others) for label, cmd in cmds.servers]
         print(f"[swarm-run] started the world and {len(children)} controller/server process(es); the world node "
               "reports while they start and discover each other", flush=True)
         while world.poll() is None:
@@ -375,11 +454,17 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
-        shutil.rmtree(profiles, ignore_errors=True)
+        shutil.rmtree(envs.profiles, ignore_errors=True)
         if args.shared_memory:
             remove_dead_shm_files()  # robot processes leave without tearing their segments down
         os.close(domain_lock)  # every node is stopped: the domain is free again
+    return world, interrupted
 
+
+def report(args: argparse.Namespace, plan: Plan, bag: Path, world: subprocess.Popen | None,
+           interrupted: bool) -> int:
+    """Read the bag (repaired first if the world died), print the run's summary and say what
+    went wrong; the exit code (`EXIT_CODES`)."""
     if world is None:  # interrupted before anything ran
         return 130
     world_died = world.returncode != 0 and not interrupted
@@ -398,13 +483,37 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         print(f"[swarm-run] could not read the bag {bag}: {exc}", file=sys.stderr)
         return 1
-    if remote:
-        summary["by_host"] = by_host(summary, {"local": local, **remote})
+    if plan.remote:
+        summary["by_host"] = by_host(summary, {"local": plan.local, **plan.remote})
     if args.json:
         print(json.dumps(summary))
     else:
         print("\n".join(_done_lines(summary, trace.config, bag)), flush=True)
     return _verdict(summary, world_died=world_died, interrupted=interrupted)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Parse, check the run, claim its DDS domain, start its processes, wait, report."""
+    args = build_parser().parse_args(argv)
+    install_signal_handlers()
+    try:
+        plan = plan_run(args)
+    except Refused as exc:
+        print(f"swarm-run: {exc}", file=sys.stderr)
+        return 2
+    try:
+        domain, domain_lock = claim_run_domain(args.domain_id)  # held (open) until the processes end
+        bag = output_directory(args, plan.scenario)
+    except (ValueError, DomainTaken) as exc:
+        print(f"swarm-run: {exc}", file=sys.stderr)
+        return 2
+    envs = dds_environments(args, plan, domain)
+    common = scenario_args(args, plan.scenario)
+    watching = [*common, "--world-timeout", f"{args.world_timeout:g}"]  # the controllers' and servers'
+    announce(args, plan, domain, envs.port, bag)
+    key = run_key(args, plan, domain, envs.port, watching)
+    world, interrupted = run_processes(args, commands(args, plan, bag, common, watching), envs, key, bag, domain_lock)
+    return report(args, plan, bag, world, interrupted)
 
 
 def _done_lines(summary: dict, scenario: Scenario | None, bag: Path) -> list[str]:
