@@ -36,6 +36,8 @@ _BATCH_CHILD = r"""
 import json, sys, time
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.core import tune_malloc
+tune_malloc()  # as swarm-batch's runs do (idempotent: a tree whose World tunes itself does it once)
 name, robots, duration, arena = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
 fields = {"robots__count": robots, "sim__duration": duration}
 if arena:

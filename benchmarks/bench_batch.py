@@ -13,9 +13,11 @@ import time
 
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.world.core import tune_malloc
 
 
 def main() -> None:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, nargs="+", default=[16, 64, 112])
     parser.add_argument("--duration", type=float, default=120.0)

@@ -30,6 +30,7 @@ from swarm_msgs_py.types import Observation, Pose2D
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario, load_scenario
+from swarm_sim.world.core import tune_malloc
 
 
 def _scenario(name: str, robots: int, duration: float, seed: int) -> Scenario:
@@ -101,6 +102,7 @@ def replay(scenario: Scenario, ticks: list[dict], skip: int) -> tuple[float, int
 
 
 def main(argv: list[str] | None = None) -> int:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     rec = sub.add_parser("record", help="run a batch and keep every behaviour's inputs and answers")

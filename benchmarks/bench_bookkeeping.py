@@ -20,6 +20,7 @@ import time
 import swarm_sim.batch as batch
 from swarm_sim import registry
 from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.world.core import tune_malloc
 
 
 def _without_rule(of):
@@ -38,6 +39,7 @@ def _held_state(servers):
 
 
 def main() -> None:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", default="queue_qmt")
     parser.add_argument("--robots", type=int, default=112)

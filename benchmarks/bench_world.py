@@ -34,6 +34,7 @@ from swarm_sim.registry import task_factory  # noqa: E402
 from swarm_sim.scenario import load_scenario  # noqa: E402
 from swarm_sim.world import World  # noqa: E402
 from swarm_sim.world.raycast import StaticScene, cast_scan, cast_scan_pybullet  # noqa: E402
+from swarm_sim.world.core import tune_malloc  # noqa: E402
 
 BLOCK = 20
 """Ticks per timing block."""
@@ -201,6 +202,7 @@ def _pose(xy, yaw):
 
 
 def main() -> None:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )

@@ -51,6 +51,7 @@ from swarm_controllers.robots.stop_turn_go import StopTurnGo
 from swarm_controllers.robots.wheel_turning import WheelTurning
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
+from swarm_sim.world.core import tune_malloc
 
 GROUPS = ("world", "behaviours", "routing", "servers", "bookkeeping", "gc")
 """Phase names start with one of these (then ':'); the table prints a subtotal per group."""
@@ -390,6 +391,7 @@ def _group_rank(name: str) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, nargs="+", default=[112, 1000])
     parser.add_argument("--scenario", nargs="+", default=["cpfa", "queue_qmt"])

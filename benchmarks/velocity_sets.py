@@ -20,6 +20,7 @@ from profile_batch import scaled_fields
 import swarm_sim.world.core as core
 from swarm_sim.batch import run_batch
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.core import tune_malloc
 
 
 def count(scenario_name: str, robots: int, warmup: float, duration: float, overrides: list[str],
@@ -53,6 +54,7 @@ def count(scenario_name: str, robots: int, warmup: float, duration: float, overr
 
 
 def main(argv: list[str] | None = None) -> int:
+    tune_malloc()  # as the commands that run a world do (`tune_malloc`): time it as they run it
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", default="queue_qmt")
     parser.add_argument("--robots", type=int, nargs="+", default=[112, 1000])

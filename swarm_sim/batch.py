@@ -41,6 +41,7 @@ from swarm_sim.registry import make_behaviour, make_servers, of, resolve, task, 
 from swarm_sim.registry import probes as registered_probes
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.world import World
+from swarm_sim.world.core import tune_malloc
 from swarm_sim.world.observations import with_messages
 
 
@@ -190,7 +191,10 @@ def _collect_events(world: World, trace: RunTrace) -> None:
 
 
 def run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
-    """One sweep run, (scenario, overrides, fields, seed) -> its summary (what executors call)."""
+    """One sweep run, (scenario, overrides, fields, seed) -> its summary (what executors call,
+    each in the process of a ``swarm-batch``/``swarm-compare`` run or of a worker: so it tunes
+    that process's heap for the world, `tune_malloc`)."""
+    tune_malloc()
     name, overrides, fields, seed = job
     scenario = load_scenario(name, overrides, **fields, seed=seed)
     return summarize(run_batch(scenario).trace)

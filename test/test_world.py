@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -708,3 +710,24 @@ def test_no_pybullet_banner_in_our_output():
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "pybullet build time" not in out.stdout + out.stderr and "delivered" in out.stdout
+
+
+def test_a_world_leaves_the_process_alone_and_the_batch_job_tunes_it():
+    """`tune_malloc` changes glibc for the whole process, so building a World must not call it (a
+    library, a test); the batch job (`swarm_sim.batch.run_one`: what swarm-batch and the sweeps'
+    workers run) does. In a fresh process: this one may have been tuned by another test."""
+    code = """
+from swarm_sim.batch import run_one
+from swarm_sim.registry import task_factory
+from swarm_sim.scenario import load_scenario
+from swarm_sim.world import core
+s = load_scenario("cpfa", ["robots.count=2", "sim.duration=1"])
+with core.World(s, task_factory(s)) as world:
+    world.step({})
+print(core._malloc_tuned)
+run_one(("cpfa", ("robots.count=2", "sim.duration=1"), {}, 0))
+print(core._malloc_tuned)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["False", "True"]

@@ -34,6 +34,7 @@ from swarm_controllers.caging.metrics import caging_report, series_of, transport
 from swarm_sim.batch import run_batch
 from swarm_sim.compare.report import md_table
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.core import tune_malloc
 
 DEFLECTION_BINS: tuple[tuple[str, float, float], ...] = (
     ("45", 22.5, 67.5), ("90", 67.5, 112.5), ("135", 112.5, 157.5), ("180", 157.5, 180.01))
@@ -135,7 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     done = {(r["cell"], r["seed"], r["model"]) for r in rows}
     todo = [(cell, seed, args.robot_model) for cell in args.cells for seed in range(args.seeds)
             if (cell, seed, args.robot_model) not in done]
-    with store.open("a") as sink, ProcessPoolExecutor(args.jobs) as pool:
+    with store.open("a") as sink, ProcessPoolExecutor(args.jobs, initializer=tune_malloc) as pool:
         for row in pool.map(run_row, *zip(*todo)) if todo else ():
             sink.write(json.dumps(row) + "\n")
             sink.flush()

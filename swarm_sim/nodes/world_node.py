@@ -60,6 +60,7 @@ from swarm_sim.nodes.world_outputs import WorldOutputs
 from swarm_sim.nodes.world_recording import WorldRecording
 from swarm_sim.scenario import Scenario, ScenarioError, load_scenario
 from swarm_sim.world import World
+from swarm_sim.world.core import tune_malloc
 
 COMMAND_BYTES = 512
 """Cap on a ``cmd_vel`` message [bytes] (ours are under 100)."""
@@ -516,6 +517,7 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
 
 def main(argv: list[str] | None = None) -> int:
     config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
+    tune_malloc()  # this process runs the world (`tune_malloc`: process-wide, so not the World's to do)
     # Our own signal handling: rclpy's handler shuts the context down under the running loop,
     # which then waited out tick timeouts instead of stopping. A flag checked at every spin
     # stops the run promptly wherever it is.

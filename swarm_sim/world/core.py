@@ -111,6 +111,11 @@ def tune_malloc() -> None:
     tick; that doubled the scan's cost for a crowded swarm (measured 1.48 -> 0.75 ms for 112
     robots). Keeping up to 64 MiB (and mmap only above 16 MiB) costs at most that much resident
     memory. Process-wide, idempotent; a no-op where glibc is absent.
+
+    So it is called by what owns a simulation process, never by a constructor (a library or a
+    test that builds a `World` changes nothing process-wide): the world node's `main`, the batch
+    and sweep runs' job (`swarm_sim.batch.run_one`, in the worker process that runs it), the
+    caging corners' workers, and the benchmarks that time a world.
     """
     global _malloc_tuned
     if _malloc_tuned:
@@ -170,7 +175,6 @@ class World:
     def __init__(
         self, scenario: Scenario, task: TaskFactory, seed: int | None = None, *, scan_threads: int = 1,
     ) -> None:
-        tune_malloc()
         self.scenario = scenario
         self.seed = scenario.seed if seed is None else seed
         self.robots: tuple[RobotId, ...] = tuple(scenario.robot_names)
