@@ -191,9 +191,9 @@ def _collect_events(world: World, trace: RunTrace) -> None:
 
 
 def run_one(job: tuple[str, tuple[str, ...], dict, int]) -> dict:
-    """One sweep run, (scenario, overrides, fields, seed) -> its summary (what executors call,
-    each in the process of a ``swarm-batch``/``swarm-compare`` run or of a worker: so it tunes
-    that process's heap for the world, `tune_malloc`)."""
+    """One sweep run, (scenario, overrides, fields, seed) -> its summary. What executors call, in
+    the ``swarm-batch`` or ``swarm-compare`` process or in a worker's: so it is where that process
+    gets `tune_malloc`."""
     tune_malloc()
     name, overrides, fields, seed = job
     scenario = load_scenario(name, overrides, **fields, seed=seed)

@@ -703,9 +703,6 @@ def test_a_robot_whose_pose_was_reset_gets_its_velocity_set_again(make_world, ho
 
 
 def test_no_pybullet_banner_in_our_output():
-    import subprocess
-    import sys
-
     out = subprocess.run([sys.executable, "-m", "swarm_sim.batch", "--robots", "2", "--duration", "1"],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
