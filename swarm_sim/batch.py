@@ -32,7 +32,7 @@ from swarm_sim.analysis.metrics import RunTrace, summarize
 from swarm_sim.analysis.state_rules import RuleLog, StatusLog
 from swarm_sim.analysis.text import summary_line
 from swarm_sim.behaviour import behaviour_rng
-from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields, stop_on_signals
 from swarm_sim.executors import Progress, add_executor_arguments, executor_from_args
 from swarm_sim.messaging import Router, delivery_order
 from swarm_sim.outputs import SeriesLog, StateWatch, outputs_of
@@ -207,6 +207,8 @@ def main(argv: list[str] | None = None) -> int:
     add_executor_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per run")
     args = parser.parse_args(argv)
+    if argv is None:  # the command itself, not a caller's function call
+        stop_on_signals()
     try:
         base = load_scenario(args.scenario, args.overrides, **scenario_fields(args), seed=args.seed)
     except ScenarioError as exc:

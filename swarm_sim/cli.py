@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
+import signal
 import sys
 from collections.abc import Callable
 
@@ -28,6 +29,19 @@ def number(kind: type, low: float, high: float = math.inf, *, open_low: bool = F
         return value
 
     return parse
+
+
+def _interrupt(*_: object) -> None:
+    raise KeyboardInterrupt
+
+
+def stop_on_signals() -> None:
+    """Ctrl-C, SIGTERM and SIGHUP (a closed terminal) all raise KeyboardInterrupt in the main
+    thread, so a command ends through its one "interrupted" line and exit code 130 whatever stops it,
+    even when its parent started it with SIGINT ignored (nohup, some CI shells)."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGHUP, _interrupt)
 
 
 def first_paragraph(doc: str | None) -> str:

@@ -12,8 +12,10 @@ does the bookkeeping (results file, resume, progress), so it is the same whateve
 from __future__ import annotations
 
 import argparse
+import ctypes
 import multiprocessing
 import re
+import signal
 import traceback
 import uuid
 from collections.abc import Callable, Iterator, Sequence
@@ -82,6 +84,20 @@ class Executor:
         self.close()
 
 
+def _pool_worker() -> None:
+    """A pool worker leaves stopping to its parent: it ignores Ctrl-C (the terminal sends it to the
+    whole group; the parent then ends the pool), dies quietly of the parent's SIGTERM
+    (`stop_on_signals`' handler, inherited through fork, would print a traceback per worker) and
+    of the parent's death (Linux's PR_SET_PDEATHSIG), so a stopped sweep leaves no worker behind."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the parent's pool still terminates its workers
+        pass
+
+
 class LocalExecutor(Executor):
     """`jobs` == 1: in this process, in order; more: a fork process pool of `jobs` workers."""
 
@@ -97,7 +113,7 @@ class LocalExecutor(Executor):
             for i, arg in enumerate(args):
                 yield _outcome(i, guarded(fn, arg))
             return
-        with multiprocessing.get_context("fork").Pool(min(self.workers, len(args))) as pool:
+        with multiprocessing.get_context("fork").Pool(min(self.workers, len(args)), initializer=_pool_worker) as pool:
             for i, result in pool.imap_unordered(partial(_indexed, fn), enumerate(args)):
                 yield _outcome(i, result)
 

@@ -80,3 +80,67 @@ def test_dask_local_cluster_matches_the_local_pool_and_resumes_its_sweep(tmp_pat
     assert [r["strategy"] for r in bad.rows] == ["ddsa"]
     (failure,) = read_results(tmp_path / "bad" / "failed.jsonl")
     assert failure["strategy"] == "no_such_scenario" and "ScenarioError" in failure["error"]
+
+
+def _children(pid: int) -> set[int]:
+    """The live child processes of `pid` (Linux /proc)."""
+    from pathlib import Path
+
+    out = set()
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            out |= {int(c) for c in (task / "children").read_text().split()}
+        except OSError:
+            pass
+    return out
+
+
+def _alive(pid: int) -> bool:
+    from pathlib import Path
+
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split(") ", 1)[1][0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGKILL"])
+def test_a_stopped_parallel_sweep_ends_in_one_line_and_leaves_no_worker(tmp_path, how):
+    """``swarm-compare --jobs 2`` stopped mid-sweep: SIGTERM ends it with its one "interrupted"
+    line, exit code 130 and no worker's traceback; SIGKILL of the parent alone still takes its
+    workers with it (PR_SET_PDEATHSIG). Waits for the workers to exist, never for a time."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cmd = [sys.executable, "-m", "swarm_sim.compare.cli", "queue", "--strategies", "queue_qse", "--robots", "48",
+           "--seeds", "4", "--jobs", "2", "--duration", "1800", "--out", str(tmp_path)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    workers: set[int] = set()
+    try:
+        deadline = time.monotonic() + 120  # a bound on a broken start-up, not a timing assumption
+        while len(workers) < 2 and proc.poll() is None and time.monotonic() < deadline:
+            workers = _children(proc.pid)
+            time.sleep(0.05)
+        assert len(workers) >= 2, "the pool's workers never started"
+        os.kill(proc.pid, getattr(signal, how))
+        out, err = proc.communicate(timeout=120)
+        deadline = time.monotonic() + 15  # a run of 1800 s of sim takes longer: a worker left alone outlives it
+        while any(_alive(w) for w in workers) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(_alive(w) for w in workers), "a worker outlived the sweep"
+        if how == "SIGTERM":
+            assert proc.returncode == 130, err
+            assert "Traceback" not in err and "Traceback" not in out, err
+            assert "interrupted" in err and "--resume" in err
+        else:
+            assert proc.returncode == -signal.SIGKILL
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)  # the group this test made, by its id
+        except ProcessLookupError:
+            pass
+        proc.wait()

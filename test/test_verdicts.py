@@ -10,6 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from swarm_sim.compare.reference import evaluate_reference, evaluate_reference_relations
+from swarm_sim.compare.report import reference_marks
 from swarm_sim.compare.verdicts import (
     CONTRADICTS,
     DIRECTION,
@@ -23,7 +25,6 @@ from swarm_sim.compare.verdicts import (
     Cause,
     Claim,
     evaluate,
-    evaluate_reference,
     holm,
     worst,
 )
@@ -153,6 +154,36 @@ def test_the_authors_code_runs_are_judged_as_a_level_against_ours():
     assert evaluate_reference([LEVEL_100], rows("A", 1, around(140.0)), []) == {}
 
 
+def test_a_relation_is_judged_against_the_size_the_authors_code_shows():
+    """The authors' code's runs take the paper's place: their size and direction (ours +50 % holds
+    against their +60 %, not against their +120 %), and where their difference is not significant,
+    "no difference" (ours +50 % then contradicts); their runs are also judged against the paper."""
+    ours = rows("A", 1, around(100.0, 2.0)) + rows("B", 1, around(150.0, 2.0, seed=1))
+
+    def against(b_mean):
+        ref = rows("A", 1, around(100.0, 2.0, seed=2)) + rows("B", 1, around(b_mean, 2.0, seed=3))
+        return evaluate_reference_relations([LEVEL_100, UP_50], ours, ref)
+
+    theirs, mine = against(160.0)["rel"]
+    assert (theirs.verdict, mine.verdict) == (HOLDS, HOLDS)
+    assert theirs.cells[0].effect == pytest.approx(60.0)
+    theirs, mine = against(220.0)["rel"]
+    assert (theirs.verdict, mine.verdict) == (DIRECTION, DIRECTION)
+    theirs, mine = against(100.0)["rel"]
+    assert (theirs.verdict, mine.verdict) == (NOT_SHOWN, CONTRADICTS)
+    assert evaluate_reference_relations([UP_50], ours, rows("C", 1, around(1.0))) == {}
+
+
+def test_the_authors_code_runs_are_drawn_with_their_interval():
+    ref = rows("A", 1, around(100.0, 2.0)) + rows("A", 2, [7.0]) + rows("B", None, [3.0, 5.0])
+    marks = reference_marks(ref, "m", ["A", "B"], [1, 2, 3])
+    lo, mean, hi, n = marks[("A", 1)]
+    assert (mean, n) == (pytest.approx(100.0), 20) and lo < 99.5 and hi > 100.5
+    assert marks[("A", 2)] == (7.0, 7.0, 7.0, 1) and ("A", 3) not in marks
+    assert marks[("B", 1)] == marks[("B", 2)] == marks[("B", 3)]  # a run of cell None serves every cell
+    assert marks[("B", 1)][1::2] == (4.0, 2)
+
+
 def test_the_bootstrap_interval_is_seeded():
     data = rows("A", 1, around(100.0, 9.0)) + rows("B", 1, around(150.0, 9.0, seed=1))
     assert one(UP_50, data).cells[0].ci == one(UP_50, data).cells[0].ci
@@ -217,9 +248,12 @@ def test_the_report_counts_every_claim_once_and_renders_the_reference_column(tmp
     ref.mkdir(parents=True)
     (ref / "results.jsonl").write_text("".join(json.dumps({**r, "reference": True, "repository": "x/y",
                                                            "commit": "0" * 40, "xml": "a.xml"}) + "\n"
-                                               for r in rows("A", 1, around(108.0, seed=5))))
+                                               for r in rows("A", 1, around(108.0, seed=5))
+                                               + rows("B", 1, around(160.0, seed=6))))
     text = "\n".join(report_verdicts({"authors": sweeps}, tmp_path, {"authors": "authors' robots"}))
     assert "authors' code here (authors' robots)" in text and "108 (n=20)" in text
+    assert "| toy | authors' robots | 1 holds of 1 | 1 holds of 1 | 1 holds of 1 |" in text  # the second judgement
+    assert "1: holds → holds" in text  # the relation's column: ours against their +48 %
     dup = [*sweeps, SimpleNamespace(comparison=comparison, claims=(LEVEL_100,), rows=data, extra={})]
     with pytest.raises(ValueError, match="repeat"):
         report_verdicts({"authors": dup}, tmp_path, {"authors": "authors' robots"})

@@ -1,5 +1,6 @@
 """Report building blocks shared by the paper comparisons: number formatting, markdown tables,
-grouped box plots, and the line under every figure that says which robots ran (`caption`)."""
+grouped box plots, the line under every figure that says which robots ran (`caption`), and the
+authors' code's runs drawn beside our boxes (`reference_runs`)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,10 @@ from contextvars import ContextVar
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from swarm_sim.compare.stats import Stats, values_of
+from swarm_sim.compare.verdicts import ALPHA, t_ppf
 
 
 def fmt(x: Any, digits: int = 2) -> str:
@@ -104,6 +108,8 @@ def grouped_boxplot(
 PaperMarks = dict[tuple[str, Any], tuple[float, float, float]]
 """(strategy, cell) -> (low, value, high) of a paper's number: its band, drawn at that box."""
 PAPER_LABEL = "paper"
+REFERENCE_LABEL = "authors' code here"
+"""The authors' own code run on this machine (`swarm_sim.compare.reference`)."""
 
 
 def paper_marks(ax: Any, marks: PaperMarks, cells: Sequence[Any], strategies: Sequence[str],
@@ -122,6 +128,51 @@ def paper_marks(ax: Any, marks: PaperMarks, cells: Sequence[Any], strategies: Se
     return handle
 
 
+def reference_marks(reference: Sequence[dict], metric: str, strategies: Sequence[str], cells: Sequence[object]
+                    ) -> dict[tuple[str, object], tuple[float, float, float, int]]:
+    """(strategy, cell) -> (low, mean, high, n) of the authors' code's runs of `metric`: the mean with
+    its 95 % t interval (low = high = mean for a single run), for a figure beside our box; a run of
+    cell None serves every cell (a strategy without the cells' factor, as in `values_of`)."""
+    out = {}
+    for s in strategies:
+        for cell in cells:
+            v = [float(r[metric]) for r in reference if r.get("strategy") == s and r.get("cell") in (cell, None)
+                 and isinstance(r.get(metric), (int, float)) and math.isfinite(float(r[metric]))]
+            if not v:
+                continue
+            mean = float(np.mean(v))
+            half = 0.0 if len(v) < 2 else t_ppf(1 - ALPHA / 2, len(v) - 1) * float(np.std(v, ddof=1)) / math.sqrt(len(v))
+            out[(s, cell)] = (mean - half, mean, mean + half, len(v))
+    return out
+
+
+def code_marks(ax: Any, reference: Sequence[dict], metric: str, cells: Sequence[Any],
+               strategies: Sequence[str]) -> Any:
+    """The authors' code's runs on a `grouped_boxplot`: a hollow square at their mean with its 95 %
+    interval, on the other side of each box from the paper's diamond; returns the legend handle."""
+    width = 0.8 / max(len(strategies), 1)
+    handle = None
+    for (s, cell), (lo, mid, hi, n) in reference_marks(reference, metric, strategies, cells).items():
+        x = cells.index(cell) - 0.4 + width * (strategies.index(s) + 0.15)
+        handle = ax.errorbar([x], [mid], yerr=[[mid - lo], [hi - mid]], fmt="s", color="0.25", mfc="white",
+                             markersize=4.5, capsize=3, elinewidth=1.0, zorder=6, label=REFERENCE_LABEL)
+    return handle
+
+
+_REFERENCE: ContextVar[Sequence[dict]] = ContextVar("reference", default=())
+
+
+@contextmanager
+def reference_runs(rows: Sequence[dict]) -> Iterator[None]:
+    """Every `boxplot_figure` drawn inside this block shows `rows`, the authors' code's runs of the
+    same strategies and cells (`code_marks`), beside ours and the paper's."""
+    token = _REFERENCE.set(rows)
+    try:
+        yield
+    finally:
+        _REFERENCE.reset(token)
+
+
 def boxplot_figure(
     panels: Sequence[tuple[str, str]],
     rows: Sequence[dict],
@@ -138,7 +189,8 @@ def boxplot_figure(
 ) -> Path:
     """A PNG at `path` with one `grouped_boxplot` per (metric, y label) panel, side by side;
     `references`: metric -> (value, label) of a paper's single number, drawn across its panel;
-    `paper`: metric -> the paper's numbers per box (`paper_marks`, labelled `paper_text`)."""
+    `paper`: metric -> the paper's numbers per box (`paper_marks`, labelled `paper_text`); the
+    authors' code's runs of `reference_runs`, if any, beside each box (`code_marks`)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -157,6 +209,8 @@ def boxplot_figure(
         if paper and metric in paper:
             handle = paper_marks(ax, paper[metric], list(cells), list(strategies), paper_text)
             extra += [handle] if handle else []
+        handle = code_marks(ax, _REFERENCE.get(), metric, list(cells), list(strategies))
+        extra += [handle] if handle else []
         if extra:
             boxes = ax.get_legend()  # grouped_boxplot's strategies, kept beside the paper's
             ax.legend(handles=[*(boxes.legend_handles if boxes else []), *extra], fontsize="small")

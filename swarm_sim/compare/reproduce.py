@@ -15,8 +15,9 @@ Without ``--robot-model``, every sweep runs twice: on each algorithm's authors' 
 and REPORT.md puts each claim's result on both side by side, with the count of claims holding for
 each, then includes ``OUT/CAUSES.md`` (the evidence behind the causes, written from the
 one-factor-at-a-time sweeps) when there is one. Where ``OUT/reference/<comparison>/**/results.jsonl``
-holds runs of the authors' own code (same fields as ours, plus ``reference: true``), every level cell
-also shows them and our runs judged against them.
+holds runs of the authors' own code (same fields as ours, plus ``reference: true``), every level cell,
+relation and trend also shows them and our runs judged against them (`swarm_sim.compare.reference`),
+and every comparison figure draws them beside our boxes and the paper's numbers.
 """
 
 from __future__ import annotations
@@ -31,6 +32,8 @@ from pathlib import Path
 
 from swarm_sim.compare.commands import AUTHORS, build_parser, plans_of, run_comparison
 from swarm_sim.compare.comparison import Comparison
+from swarm_sim.compare.reference import load_reference, matching
+from swarm_sim.compare.report import reference_runs
 from swarm_sim.compare.sweep import RESULTS, RunFunction, read_results
 from swarm_sim.compare.verdict_report import common_fields, report_verdicts
 from swarm_sim.compare.verdicts import Claim
@@ -106,6 +109,7 @@ def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], 
     """Every comparison's sweeps on robot `model`, into OUT/<model>/ when `own_dir`, else OUT."""
     reports: list[SweepReport] = []
     base = args.out / model if own_dir else args.out
+    reference = {name: load_reference(args.out, name) for name in comparisons}
     for name, comparison in comparisons.items():
         out = base / Path(comparison.default_out).name
         for options in comparison.reproduce:
@@ -116,8 +120,10 @@ def _reproduce(args: argparse.Namespace, comparisons: Mapping[str, Comparison], 
             report = SweepReport(comparison, tuple(options), comparison.out_dir(sub), 0)
             try:
                 report.claims = tuple(comparison.claims(sub))  # first: a failed sweep's claims read n/a
-                report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
-                                                               executor=ex)
+                extra = common_fields([dict(p.extra) for p in plans_of(comparison, sub, strategies)])
+                with reference_runs(matching(reference.get(name) or (), extra)):
+                    report.status, report.written = run_comparison(comparison, sub, strategies, run=run,
+                                                                   executor=ex)
                 report.rows, report.extra = _rows(report.out, comparison, sub, strategies)
                 report.runs = len(report.rows)
             except KeyboardInterrupt:

@@ -12,12 +12,18 @@ rules come from each comparison's sweeps.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from swarm_sim.compare.report import fmt_p, md_table
-from swarm_sim.compare.sweep import RESULTS, ResultsFileError, read_results
+from swarm_sim.compare.reference import (
+    evaluate_reference,
+    evaluate_reference_relations,
+    load_reference,
+    matching,
+)
+from swarm_sim.compare.report import REFERENCE_LABEL, fmt_p, md_table
 from swarm_sim.compare.verdicts import (
     ALPHA,
     BOOTSTRAP,
@@ -33,11 +39,7 @@ from swarm_sim.compare.verdicts import (
     Verdict,
     counts,
     evaluate,
-    evaluate_reference,
 )
-
-REFERENCE = "reference"
-"""``OUT/reference/<comparison>/**/results.jsonl``: the authors' code's runs, if any (one file, or one per experiment)."""
 
 
 def _num(x: float, digits: int = 3) -> str:
@@ -83,27 +85,25 @@ def common_fields(pairs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def _reference(out: Path, name: str) -> list[dict] | None:
-    """The authors' code's runs of a comparison: every results file under ``reference/<name>/``
-    (one, or one per experiment as ``exp1/``, ``exp2/``); a file that cannot be read is left out,
-    saying so."""
-    paths = sorted((out / REFERENCE / name).rglob(RESULTS))
-    if not paths:
-        return None
-    rows = []
-    for path in paths:
-        try:
-            rows += [r for r in read_results(path) if r.get(REFERENCE) is True]
-        except ResultsFileError as exc:
-            print(f"swarm-compare all: {exc}: the authors' code's runs in it left out")
-    return rows
+@dataclass(frozen=True)
+class Judged:
+    """One paper's claims on one robot model."""
+
+    verdicts: list[Verdict]
+    """Against the paper (one Holm family)."""
+    levels: dict = field(default_factory=dict)
+    """(claim id, cell) -> our level cell against the authors' code's runs (`evaluate_reference`)."""
+    relations: dict = field(default_factory=dict)
+    """claim id -> (the authors' code against the paper, ours against the authors' code)
+    (`evaluate_reference_relations`)."""
 
 
-def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[str, tuple[list[Verdict], dict]]]:
-    """comparison -> model -> (its verdicts, (claim id, cell) -> ours against the authors' code).
-    `by_model`: model -> the sweeps of ``all`` (each with ``comparison``, ``claims``, ``rows``,
-    ``extra``); one paper's claims on one model are judged together (one Holm family)."""
-    result: dict[str, dict[str, tuple[list[Verdict], dict]]] = {}
+def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[str, Judged]]:
+    """comparison -> model -> its claims judged (`Judged`). `by_model`: model -> the sweeps of
+    ``all`` (each with ``comparison``, ``claims``, ``rows``, ``extra``); one paper's claims on one
+    model are judged together (one Holm family), and again against the authors' code's runs
+    (``OUT/reference/<comparison>/``) where there are any."""
+    result: dict[str, dict[str, Judged]] = {}
     for model, sweeps in by_model.items():
         names = list(dict.fromkeys(r.comparison.name for r in sweeps))
         for name in names:
@@ -115,17 +115,17 @@ def judged(by_model: Mapping[str, Sequence[Any]], out: Path) -> dict[str, dict[s
             rows = {c.id: r.rows for r in mine for c in r.claims}
             if not claims:  # a comparison that declares none has nothing to judge
                 continue
-            verdicts = evaluate(claims, rows)
-            reference = _reference(out, name)
-            against = {}
-            if reference is not None:
-                ref_rows = {c.id: [x for x in reference if all(x.get(k) == v for k, v in r.extra.items())]
-                            for r in mine for c in r.claims}
-                against = {}
-                for r in mine:
-                    found = evaluate_reference(r.claims, rows, ref_rows[r.claims[0].id]) if r.claims else {}
-                    against.update(found)
-            result.setdefault(name, {})[model] = (verdicts, against)
+            reference = load_reference(out, name)
+            if reference is None:
+                result.setdefault(name, {})[model] = Judged(evaluate(claims, rows))
+                continue
+            theirs = {c.id: matching(reference, r.extra) for r in mine for c in r.claims}
+            result.setdefault(name, {})[model] = Judged(
+                evaluate(claims, rows),
+                {k: v for r in mine if r.claims for k, v in
+                 evaluate_reference(r.claims, rows, theirs[r.claims[0].id]).items()},
+                {k: v for r in mine if r.claims for k, v in
+                 evaluate_reference_relations(r.claims, rows, theirs[r.claims[0].id]).items()})
     return result
 
 
@@ -159,7 +159,7 @@ def report_verdicts(by_model: Mapping[str, Sequence[Any]], out: Path, titles: Ma
         for m in models:
             if m not in per:
                 continue
-            c = counts(per[m][0])
+            c = counts(per[m].verdicts)
             for k, v in c.items():
                 totals[m][k] += v
             body.append([name, title[m], *(str(c[v]) for v in VERDICTS), str(sum(c.values()))])
@@ -167,18 +167,56 @@ def report_verdicts(by_model: Mapping[str, Sequence[Any]], out: Path, titles: Ma
         body.append(["**all**", title[m], *(f"**{totals[m][v]}**" for v in VERDICTS), f"**{sum(totals[m].values())}**"])
     lines += md_table(header, body) + [""]
     for m in models:
-        levels = [cv for per in papers.values() if m in per for v in per[m][0] if v.claim.kind == LEVEL
+        levels = [cv for per in papers.values() if m in per for v in per[m].verdicts if v.claim.kind == LEVEL
                   for cv in v.cells]
         within = sum(1 for cv in levels if math.isfinite(cv.effect) and cv.reason == "inside")
         lines.append(f"{title[m]}: {totals[m][HOLDS]} of {sum(totals[m].values())} claims hold; level cells whose "
                      f"mean lies within the band: {within} of {len(levels)} (holding: "
                      f"{sum(1 for cv in levels if cv.verdict == HOLDS)}).")
         lines.append("")
+    lines += _against_code(papers, models, title)
     lines += _levels(papers, models, title, helps)
     lines += _relations(papers, models, title)
     lines += _causes(papers, models, title)
     lines += _rules(rules)
     return lines
+
+
+def _against_code(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
+    """The counts of the second judgement, for the papers whose authors' code was run here
+    (`swarm_sim.compare.reference`): ours against those runs, level cells and relations, and the
+    authors' code against its own paper's relations."""
+    body = []
+    for name, per in papers.items():
+        for m in models:
+            if m not in per or not (per[m].levels or per[m].relations):
+                continue
+            levels = counts_of(cv.verdict for cv in per[m].levels.values())
+            ours = counts_of(v.verdict for _, v in per[m].relations.values())
+            theirs = counts_of(v.verdict for v, _ in per[m].relations.values())
+            body.append([name, title[m], _tally(levels), _tally(ours), _tally(theirs)])
+    if not body:
+        return []
+    return ["### Against the authors' code run here", "",
+            "Where a paper's published code was built and run on this machine (`reference/`, "
+            "`results/reference/`), ours is judged against its runs as well as against the paper, on the same "
+            "scale: a level cell holds when our mean is within ±25 % of theirs (the interval within); a relation "
+            "when ours shows the size and direction theirs shows. The last column judges the authors' code's "
+            "runs against their own paper's relations.", "",
+            *md_table(["paper", "robot model", "level cells: ours vs authors' code",
+                       "relations: ours vs authors' code", f"relations: {REFERENCE_LABEL} vs the paper"], body), ""]
+
+
+def counts_of(verdicts: Iterable[str]) -> dict[str, int]:
+    out = dict.fromkeys(VERDICTS, 0)
+    for v in verdicts:
+        out[v] += 1
+    return out
+
+
+def _tally(c: Mapping[str, int]) -> str:
+    """``3 holds, 1 not shown of 4`` (the classes present)."""
+    return ", ".join(f"{n} {v}" for v, n in c.items() if n) + f" of {sum(c.values())}" if sum(c.values()) else "—"
 
 
 def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps: Mapping[str, str]) -> list[str]:
@@ -188,18 +226,18 @@ def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps:
     for name, per in papers.items():
         lines += [f"### {name}: {helps.get(name, '')}", ""]
         for m in models:
-            cells = [cv for v in per.get(m, ([], {}))[0] if v.claim.kind == LEVEL for cv in v.cells]
+            cells = [cv for v in (per[m].verdicts if m in per else []) if v.claim.kind == LEVEL for cv in v.cells]
             lines.append(f"- {title[m]}: mean within the band in {sum(cv.reason == 'inside' for cv in cells)} of "
                          f"{len(cells)} cells, holding (the interval within) in "
                          f"{sum(cv.verdict == HOLDS for cv in cells)}.")
         lines.append("")
-        ref = any(per[m][1] for m in models if m in per)
+        ref = any(per[m].levels for m in models if m in per)
         header = ["claim", "where", "paper"]
         for m in models:
             header += [f"ours ({title[m]})", "n", "ratio", f"verdict ({title[m]})"]
             if ref:
-                header += [f"authors' code here ({title[m]})", "ours vs authors' code"]
-        first = per[models[0]][0] if models[0] in per else []
+                header += [f"{REFERENCE_LABEL} ({title[m]})", "ours vs authors' code"]
+        first = per[models[0]].verdicts if models[0] in per else []
         body = []
         for i, v in enumerate(first):
             if v.claim.kind != LEVEL:
@@ -212,11 +250,11 @@ def _levels(papers: Mapping, models: list[str], title: Mapping[str, str], helps:
                     if m not in per:
                         row += ["—"] * (6 if ref else 4)
                         continue
-                    mine = per[m][0][i].cells[j]
+                    mine = per[m].verdicts[i].cells[j]
                     ratio = mine.effect / mine.means[1] if mine.means[1] and math.isfinite(mine.effect) else math.nan
                     row += [_ci(mine), str(mine.n[0]), _num(ratio, 2), _bold(_verdict(mine))]
                     if ref:
-                        against = per[m][1].get((v.claim.id, cv.cell))
+                        against = per[m].levels.get((v.claim.id, cv.cell))
                         row += _against(against)
                 body.append(row)
         lines += md_table(header, body) + [""]
@@ -235,15 +273,22 @@ def _against(cv: CellVerdict | None) -> list[str]:
 
 
 def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
-    lines = ["## Relations and trends", "",
-             "Each cell: B against A in % of A [95 % bootstrap interval], the Holm-corrected p, the cell's verdict; "
-             "a trend's cell is its first → last.", ""]
+    intro = ("Each cell: B against A in % of A [95 % bootstrap interval], the Holm-corrected p, the cell's verdict; "
+             "a trend's cell is its first → last.")
+    if any(per[m].relations for per in papers.values() for m in per):
+        intro += (" Where the authors' code was run here, its runs are judged against the paper "
+                  f"(*{REFERENCE_LABEL}*) and ours against its runs (*ours vs authors' code*: the size and direction "
+                  "their runs show take the paper's place; where their difference is not significant, \"no "
+                  "difference\"), in the cells their runs cover.")
+    lines = ["## Relations and trends", "", intro, ""]
     for name, per in papers.items():
         lines += [f"### {name}", ""]
-        header = ["claim", "where", "kind", "paper"]
+        ref = any(per[m].relations for m in models if m in per)
+        header = ["claim", "where", "kind", "paper"] + ([REFERENCE_LABEL] if ref else [])
         for m in models:
             header += [f"ours ({title[m]})", f"verdict ({title[m]})"]
-        first = per[models[0]][0] if models[0] in per else []
+            header += [f"ours vs authors' code ({title[m]})"] if ref else []
+        first = per[models[0]].verdicts if models[0] in per else []
         body = []
         for i, v in enumerate(first):
             if v.claim.kind == LEVEL:
@@ -251,15 +296,29 @@ def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> 
             c = v.claim
             who = f"{c.b} vs {c.a}" if c.b else c.a
             row = [f"`{c.id}`: {c.text} ({who})", c.where, c.kind, c.paper_text()]
+            if ref:
+                theirs = next((per[m].relations[c.id][0] for m in models if m in per and c.id in per[m].relations),
+                              None)
+                row.append(_cells(theirs) if theirs else "—")
             for m in models:
                 if m not in per:
-                    row += ["—", "—"]
+                    row += ["—"] * (3 if ref else 2)
                     continue
-                mine = per[m][0][i]
+                mine = per[m].verdicts[i]
                 row += ["; ".join(_effect(cv) for cv in mine.cells), _bold(mine.verdict)]
+                if ref:
+                    against = per[m].relations.get(c.id)
+                    row.append(_cells(against[1], brief=True) if against else "—")
             body.append(row)
         lines += md_table(header, body) + [""]
     return lines
+
+
+def _cells(v: Verdict, brief: bool = False) -> str:
+    """A verdict's cells and then the claim's verdict, in one table cell; `brief`: each cell's
+    verdict only (its effect stands in another column)."""
+    return "; ".join(f"{cv.cell}: {_verdict(cv)}" if brief else _effect(cv) for cv in v.cells) + \
+        f" → {_bold(v.verdict)}"
 
 
 def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
@@ -271,9 +330,9 @@ def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> lis
              "not a cause). The evidence is in CAUSES.md below.", ""]
     for name, per in papers.items():
         body, grades = [], {}
-        first = per[models[0]][0] if models[0] in per else []
+        first = per[models[0]].verdicts if models[0] in per else []
         for i, v in enumerate(first):
-            mine = {m: per[m][0][i] for m in models if m in per}
+            mine = {m: per[m].verdicts[i] for m in models if m in per}
             failing = [m for m, x in mine.items() if x.verdict != HOLDS]
             if not failing:
                 continue

@@ -220,7 +220,7 @@ def _mean_se_df(x: Sequence[float]) -> tuple[float, float, float]:
     return float(a.mean()), float(a.std(ddof=1) / math.sqrt(a.size)), float(a.size - 1)
 
 
-def _welch(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
+def welch(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float]:
     """(B - A, its standard error, Welch's degrees of freedom)."""
     xa, xb = np.asarray(a, float), np.asarray(b, float)
     va, vb = xa.var(ddof=1) / xa.size, xb.var(ddof=1) / xb.size
@@ -235,7 +235,7 @@ def _t_sf(t: float, df: float) -> float:
     return float(stats.t.sf(t, df)) if math.isfinite(df) else float(stats.norm.sf(t))
 
 
-def _t_ppf(q: float, df: float) -> float:
+def t_ppf(q: float, df: float) -> float:
     from scipy import stats
 
     return float(stats.t.ppf(q, df)) if math.isfinite(df) else float(stats.norm.ppf(q))
@@ -267,7 +267,7 @@ def runs_needed(sigma: float, delta: float, groups: int = 2) -> int | None:
     `sigma` (normal approximation; `groups` 1: a one-sample test)."""
     if not (math.isfinite(sigma) and math.isfinite(delta)) or delta == 0:
         return None
-    z = _t_ppf(1 - ALPHA / 2, math.inf) + _t_ppf(POWER, math.inf)
+    z = t_ppf(1 - ALPHA / 2, math.inf) + t_ppf(POWER, math.inf)
     return max(2, math.ceil(groups * (z * sigma / abs(delta)) ** 2))
 
 
@@ -299,11 +299,11 @@ def holm(ps: Sequence[float]) -> list[float]:
 # ------------------------------------------------------------------ one cell
 
 
-def _seed(claim: Claim, cell: object) -> int:
+def claim_seed(claim: Claim, cell: object) -> int:
     return zlib.crc32(f"{claim.id}|{cell}".encode())
 
 
-def _na(cell: object, n: tuple[int, int], reason: str) -> CellVerdict:
+def na_cell(cell: object, n: tuple[int, int], reason: str) -> CellVerdict:
     return CellVerdict(cell, n, (math.nan, math.nan), math.nan, (math.nan, math.nan), math.nan, reason=reason)
 
 
@@ -311,9 +311,9 @@ def level_cell(claim: Claim, ours: Sequence[float], cell: object, lo: float, hi:
     """Our runs' mean against the band [lo, hi] (one-sample t)."""
     centre = claim.value if claim.value is not None else (lo + hi) / 2
     if len(ours) < 2:
-        return _na(cell, (len(ours), 0), f"{len(ours)} run(s): no interval")
+        return na_cell(cell, (len(ours), 0), f"{len(ours)} run(s): no interval")
     mean, se, df = _mean_se_df(ours)
-    half = _t_ppf(1 - ALPHA / 2, df) * se
+    half = t_ppf(1 - ALPHA / 2, df) * se
     inside, p = band_p(mean, se, df, lo, hi)
     return CellVerdict(cell, (len(ours), 0), (mean, centre), mean, (mean - half, mean + half), p,
                        reason="inside" if inside else "outside")
@@ -322,13 +322,13 @@ def level_cell(claim: Claim, ours: Sequence[float], cell: object, lo: float, hi:
 def relation_cell(claim: Claim, a: Sequence[float], b: Sequence[float], cell: object) -> CellVerdict:
     """B against A (Welch), the effect in % of A with its bootstrap interval."""
     if min(len(a), len(b)) < 2:
-        return _na(cell, (len(a), len(b)), f"{len(a)} / {len(b)} runs: no test")
-    d, se, df = _welch(a, b)
+        return na_cell(cell, (len(a), len(b)), f"{len(a)} / {len(b)} runs: no test")
+    d, se, df = welch(a, b)
     ma, mb = float(np.mean(a)), float(np.mean(b))
     if ma == 0:
-        return _na(cell, (len(a), len(b)), "A's mean is 0: no per-cent size")
+        return na_cell(cell, (len(a), len(b)), "A's mean is 0: no per-cent size")
     effect = 100.0 * (mb - ma) / ma
-    return CellVerdict(cell, (len(a), len(b)), (ma, mb), effect, bootstrap_pct(a, b, _seed(claim, cell)),
+    return CellVerdict(cell, (len(a), len(b)), (ma, mb), effect, bootstrap_pct(a, b, claim_seed(claim, cell)),
                        two_sided_p(d, se, df))
 
 
@@ -417,50 +417,6 @@ def evaluate(claims: Sequence[Claim], rows_of: Mapping[str, Sequence[dict]] | Se
         for cv, (a, b) in zip(p.cells, p.samples):
             cells.append(judge(p.claim, replace(cv, p_adj=next(adjusted)), a, b))
         out.append(Verdict(p.claim, worst(c.verdict for c in cells), tuple(cells)))
-    return out
-
-
-def against_reference(claim: Claim, ours: Sequence[float], reference: Sequence[float], cell: object) -> CellVerdict:
-    """Our runs against the authors' code's runs of the same cell, with a level's rule: the
-    difference in % of the reference within ±`LEVEL_BAND` (Welch's two one-sided tests)."""
-    if min(len(ours), len(reference)) < 2:
-        means = tuple(float(np.mean(x)) if len(x) else math.nan for x in (ours, reference))
-        return replace(_na(cell, (len(ours), len(reference)), f"{len(ours)} / {len(reference)} runs: no test"),
-                       means=means)
-    d, se, df = _welch(reference, ours)
-    ref = float(np.mean(reference))
-    if ref == 0:
-        return _na(cell, (len(ours), len(reference)), "reference mean is 0")
-    half = abs(ref) * LEVEL_BAND
-    inside, p = band_p(d, se, df, -half, half)
-    return CellVerdict(cell, (len(ours), len(reference)), (float(np.mean(ours)), ref), 100.0 * d / ref,
-                       bootstrap_pct(reference, ours, _seed(claim, f"ref|{cell}")), p,
-                       reason="inside" if inside else "outside")
-
-
-def evaluate_reference(claims: Sequence[Claim], rows: Mapping[str, Sequence[dict]] | Sequence[dict],
-                       reference: Sequence[dict]) -> dict[tuple[str, object], CellVerdict]:
-    """(claim id, cell) -> our level cell judged against the authors' code's runs, Holm-corrected
-    over the paper's level cells that have reference runs."""
-    found = []
-    for c in claims:
-        if c.kind != LEVEL:
-            continue
-        mine = rows[c.id] if isinstance(rows, Mapping) else rows
-        for cell in c.cells:
-            ref = values(reference, c.a, cell, c.measure, c.scale)
-            if ref:
-                ours = values(mine, c.a, cell, c.measure, c.scale)
-                found.append(((c.id, cell), against_reference(c, ours, ref, cell)))
-    adjusted = holm([cv.p for _, cv in found])
-    out = {}
-    for (key, cv), p in zip(found, adjusted):
-        cv = replace(cv, p_adj=p)
-        if not math.isfinite(p):
-            out[key] = replace(cv, verdict=NA)
-        else:
-            out[key] = replace(cv, verdict=(HOLDS if cv.reason == "inside" else CONTRADICTS) if p < ALPHA
-                               else NOT_SHOWN)
     return out
 
 
