@@ -54,7 +54,7 @@ from swarm_sim import registry
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.analysis.text import summary_lines
-from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields
+from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields, stop_on_signals
 from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
 from swarm_sim.nodes.run_watch import WORLD_TIMEOUT
@@ -116,10 +116,6 @@ def _stop(procs: list[subprocess.Popen], grace: float) -> None:
         except subprocess.TimeoutExpired:
             p.kill()
             p.wait()
-
-
-def _raise_interrupt(*_: object) -> None:
-    raise KeyboardInterrupt
 
 
 def domain_option(text: str) -> int | str:
@@ -263,14 +259,6 @@ class Environments:
     """This run's Fast DDS profile files (removed at the end)."""
     port: int | None
     """The world's discovery server port; None with ``--discovery simple``."""
-
-
-def install_signal_handlers() -> None:
-    """Ctrl-C (and SIGTERM) must stop the run even if our parent started us with SIGINT ignored
-    (nohup, some CI shells and test runners), so install the handlers explicitly."""
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.signal(signal.SIGTERM, _raise_interrupt)
-    signal.signal(signal.SIGHUP, _raise_interrupt)  # terminal closed: stop the children too
 
 
 def plan_run(args: argparse.Namespace) -> Plan:
@@ -495,7 +483,7 @@ def report(args: argparse.Namespace, plan: Plan, bag: Path, world: subprocess.Po
 def main(argv: list[str] | None = None) -> int:
     """Parse, check the run, claim its DDS domain, start its processes, wait, report."""
     args = build_parser().parse_args(argv)
-    install_signal_handlers()
+    stop_on_signals()  # Ctrl-C, SIGTERM, SIGHUP: stop the children too, even if started with SIGINT ignored
     try:
         plan = plan_run(args)
     except Refused as exc:
