@@ -32,7 +32,7 @@ import rclpy  # noqa: E402
 
 from swarm_msgs_py import topics  # noqa: E402
 from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode  # noqa: E402
-from swarm_sim.nodes.executor import share_sim_time  # noqa: E402
+from swarm_sim.nodes.executor import StampTime  # noqa: E402
 from swarm_sim.recording import bag_info, read_bag  # noqa: E402
 from swarm_sim.scenario import scenario_from_dict  # noqa: E402
 
@@ -74,8 +74,9 @@ def main() -> None:
         context = rclpy.Context()
         rclpy.init(context=context)
         config = ControllerConfig(scenario=scenario.name, seed=seed, startup_timeout=0.0)
-        nodes = {r: ControllerNode(r, config, scenario=scenario, context=context) for r in scenario.robot_names}
-        share_sim_time(list(nodes.values()))
+        stamp_time = StampTime()  # one a process, as swarm-controllers shares it
+        nodes = {r: ControllerNode(r, config, scenario=scenario, context=context, stamp_time=stamp_time)
+                 for r in scenario.robot_names}
         callbacks = {}
         sent: dict[str, bytes] = {}
         for r, node in nodes.items():
