@@ -39,8 +39,8 @@ class StampTime:
 
     A controller steps on one tick's complete set of observations, all stamped with that tick, so
     it needs no other time. rclpy gives every node with ``use_sim_time`` a ``/clock``
-    subscription: one message and a Python callback per tick and process, and the tick's most
-    frequent wake-up of a process per robot (issue 40). An attached node keeps ``use_sim_time``,
+    subscription: one message and a Python callback per tick and process, one of the five
+    messages a tick that wake a process per robot (issue 40: a quarter of those processes' CPU). An attached node keeps ``use_sim_time``,
     declared true and read-only (`STAMP_TIME` says why), and its clock reads the newest tick any
     node of the process stepped on (`set`), as it read the newest ``/clock`` before.
     """

@@ -163,7 +163,8 @@ class WorldNode(Node):
         # rclpy's `Publisher.publish` around the raw publish (a handle context, two type checks) was
         # half of a raw publish's Python, 560 times a tick with 112 robots: the tick calls the
         # publisher's own `publish_raw`.
-        self._obs_targets = {r: {name: (pub.handle.publish_raw, topics.robot_topic(r, name)) for name, pub in pubs.items()}
+        self._obs_targets = {r: {name: (pub.handle.publish_raw, topics.robot_topic(r, name))
+                                 for name, pub in pubs.items()}
                              for r, pubs in self._obs_pubs.items()}
         """Robot -> observation name -> (raw publish, topic)."""
         self._commands: dict[RobotId, Command] = {}

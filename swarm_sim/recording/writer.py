@@ -89,7 +89,8 @@ class _Writer(Writer):
 
     def _own(self) -> bool:
         """Whether the fast path applies (mcap's private members found, a chunked file)."""
-        return self._OWN and getattr(self, "_Writer__chunk_builder", None) is not None
+        return (self._OWN and getattr(self, "_Writer__chunk_builder", None) is not None
+                and isinstance(getattr(self, "_Writer__chunk_size", None), int))
 
     def _add(self, messages: Iterable[tuple[int, bytes]], log_time: int, publish_time: int, sequence: int) -> None:
         stats = self._Writer__statistics
