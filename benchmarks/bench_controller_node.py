@@ -30,9 +30,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import rclpy  # noqa: E402
 
-from swarm_msgs_py import topics  # noqa: E402
+from swarm_msgs_py import auth, topics  # noqa: E402
 from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode  # noqa: E402
-from swarm_sim.nodes.executor import share_sim_time  # noqa: E402
+from swarm_sim.nodes.executor import StampTime  # noqa: E402
+from swarm_sim.nodes.run_watch import WORLD_RUN  # noqa: E402
 from swarm_sim.recording import bag_info, read_bag  # noqa: E402
 from swarm_sim.scenario import scenario_from_dict  # noqa: E402
 
@@ -66,6 +67,11 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
     ticks, recorded = load_ticks(args.bag, args.ticks)
+    # The recorded world's word that its run goes on, without the run's tag (this process has no key):
+    # the nodes answer only the ticks of a world they heard (`swarm_sim.nodes.run_watch`).
+    running = next((auth.strip(m.data) or m.data for m in read_bag(args.bag) if m.topic == WORLD_RUN), None)
+    if running is None:
+        sys.exit(f"{args.bag}: no {WORLD_RUN} message (not a bag of swarm-run)")
     custom = bag_info(args.bag).metadata
     scenario = scenario_from_dict(json.loads(custom["scenario"]))
     seed = int(custom["seed"])
@@ -74,8 +80,11 @@ def main() -> None:
         context = rclpy.Context()
         rclpy.init(context=context)
         config = ControllerConfig(scenario=scenario.name, seed=seed, startup_timeout=0.0)
-        nodes = {r: ControllerNode(r, config, scenario=scenario, context=context) for r in scenario.robot_names}
-        share_sim_time(list(nodes.values()))
+        stamp_time, watch, nodes = StampTime(), None, {}  # one of each a process, as swarm-controllers shares them
+        for r in scenario.robot_names:
+            nodes[r] = ControllerNode(r, config, scenario=scenario, context=context, stamp_time=stamp_time, watch=watch)
+            watch = nodes[r].watch
+        watch.on_message(running)
         callbacks = {}
         sent: dict[str, bytes] = {}
         for r, node in nodes.items():

@@ -622,8 +622,9 @@ def test_analysis_takes_no_more_than_the_live_graph(tmp_path: Path) -> None:
 
 
 def test_the_fast_message_path_writes_the_bytes_mcap_writes() -> None:
-    """`_Writer.add_message` (the world's recording path) against mcap's own, byte for byte:
-    several channels, out-of-order and equal stamps, chunks finished on size."""
+    """`_Writer.add_message` and `add_batch` (the world's recording path) against mcap's own
+    `add_message`, byte for byte: several channels, out-of-order and equal stamps, batches of
+    one stamp across chunks finished on size, an empty batch."""
     import io
     import random
 
@@ -633,16 +634,21 @@ def test_the_fast_message_path_writes_the_bytes_mcap_writes() -> None:
 
     assert _Writer._OWN  # the fast path is taken with the mcap we ship
     outputs = []
-    for cls in (Writer, _Writer):
+    for how in ("mcap", "one by one", "batches"):
         stream = io.BytesIO()
-        writer = cls(stream, chunk_size=4096)
+        writer = (Writer if how == "mcap" else _Writer)(stream, chunk_size=4096)
         writer.start(profile="ros2", library="test")
         schema = writer.register_schema("std_msgs/msg/String", "ros2msg", b"string data")
         channels = [writer.register_channel(f"/t{i}", "cdr", schema) for i in range(3)]
         gen = random.Random(3)
-        for k in range(500):
+        for k in range(100):
             stamp = gen.randrange(10**12) if k % 7 == 0 else 10**9 * (k // 5)
-            writer.add_message(channels[k % 3], stamp, gen.randbytes(gen.randrange(300)), stamp)
+            batch = [(channels[(k + j) % 3], gen.randbytes(gen.randrange(300))) for j in range(k % 11)]
+            if how == "batches":
+                writer.add_batch(batch, stamp)
+            else:
+                for channel, data in batch:
+                    writer.add_message(channel, stamp, data, stamp)
         writer.finish()
         outputs.append(stream.getvalue())
-    assert outputs[0] == outputs[1] and len(outputs[0]) > 4 * 4096
+    assert outputs[0] == outputs[1] == outputs[2] and len(outputs[0]) > 4 * 4096

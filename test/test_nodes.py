@@ -18,7 +18,6 @@ from swarm_msgs_py.types import Pose2D
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.inbound import Reason
 from swarm_sim.nodes.controller_node import ControllerConfig, ControllerNode
-from swarm_sim.nodes.executor import share_sim_time
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
@@ -200,42 +199,43 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
         # stamped 0 -> not visible at tick 0, visible (once) at tick 1
         assert inbox[0] == () and inbox[1] == (PheromoneMessage(0, 1.0, 2.0),) and inbox[2] == ()
         assert statuses and statuses[0].robot == "robot_0"
+        assert node.get_clock().now().nanoseconds == 2 * dt  # its time: the stamps it stepped on
     finally:
         executor.shutdown()
         node.destroy_node()
         peer.destroy_node()
 
 
-def test_controllers_in_one_process_share_one_clock_subscription(context):
-    """Three controller nodes of one process: one /clock subscription, every clock on sim time."""
-    from builtin_interfaces.msg import Time
-    from rosgraph_msgs.msg import Clock
+def test_controllers_hear_no_clock_and_keep_sim_time(context):
+    """Controller nodes (issue 40): no /clock subscription, even with ``use_sim_time:=true`` on
+    the command line; ``use_sim_time`` reads true, read-only, and says where their time comes from;
+    their clocks read the stamp of the newest tick a node of the process stepped on."""
+    from rclpy.parameter import Parameter
 
-    nodes = [ControllerNode(f"robot_{i}", ControllerConfig(overrides=SMALL), context=context) for i in range(3)]
-    peer = Node("peer", context=context)
-    clock_pub = peer.create_publisher(Clock, "/clock", SENSOR_LOCKSTEP)
-    executor = SingleThreadedExecutor(context=context)
-    for n in (*nodes, peer):
-        executor.add_node(n)
+    from swarm_sim.nodes.executor import STAMP_TIME, StampTime
+
+    shared = StampTime()
+    nodes = [ControllerNode(f"robot_{i}", ControllerConfig(overrides=SMALL), context=context, stamp_time=shared,
+                            cli_args=["--ros-args", "-p", "use_sim_time:=true"]) for i in range(2)]
+    alone = ControllerNode("robot_2", ControllerConfig(overrides=SMALL), context=context)
     try:
-        assert peer.count_subscribers("/clock") == 3  # rclpy's default: one per node
-        share_sim_time(nodes)
-        for _ in range(100):
-            executor.spin_once(timeout_sec=0.02)
-            if peer.count_subscribers("/clock") == 1 and clock_pub.get_subscription_count() == 1:
-                break
-        assert peer.count_subscribers("/clock") == 1
-        for sec in (5, 7):
-            clock_pub.publish(Clock(clock=Time(sec=sec, nanosec=250)))
-            for _ in range(100):
-                executor.spin_once(timeout_sec=0.02)
-                if all(n.get_clock().now().nanoseconds == sec * 10**9 + 250 for n in nodes):
-                    break
-            assert [n.get_clock().now().nanoseconds for n in nodes] == [sec * 10**9 + 250] * 3
-        assert all(n.get_parameter("use_sim_time").value for n in nodes)
+        assert nodes[0].count_subscribers("/clock") == 0
+        for n in (*nodes, alone):
+            assert n.get_parameter("use_sim_time").value is True
+            assert n.describe_parameter("use_sim_time").read_only
+            assert n.describe_parameter("use_sim_time").description == STAMP_TIME
+            assert not n.set_parameters([Parameter("use_sim_time", value=False)])[0].successful
+            assert n.get_clock().ros_time_is_active and n.get_clock().now().nanoseconds == 0
+        shared.set(7 * 10**8)
+        assert [n.get_clock().now().nanoseconds for n in nodes] == [7 * 10**8] * 2
+        assert alone.get_clock().now().nanoseconds == 0  # another process's clock
+        plain = ControllerNode("robot_3", ControllerConfig(overrides=SMALL), context=context, plain_twist=True)
+        try:  # a robot's own computer steps on wall time
+            assert plain.get_parameter("use_sim_time").value is False and not plain.get_clock().ros_time_is_active
+        finally:
+            plain.destroy_node()
     finally:
-        executor.shutdown()
-        for n in (*nodes, peer):
+        for n in (*nodes, alone):
             n.destroy_node()
 
 

@@ -5,7 +5,9 @@ topics, `swarm_msgs_py.sensing`) by stamp; when all of them carry the same stamp
 `Observation`, hands it the messages
 from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviour, publishes
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
-with the tick it answers. The tick drives all work; there are no timers.
+with the tick it answers. The tick drives all work; there are no timers. Its time is the stamp
+of the tick it steps on: it hears no ``/clock`` (``use_sim_time`` reads true, read-only;
+`swarm_sim.nodes.executor.StampTime`).
 
 Everything from the bus is untrusted: the world's observations and other nodes' messages pass
 the endpoint's guard before the behaviour sees them (`swarm_sim.inbound`: within their topic's
@@ -57,7 +59,7 @@ from swarm_sim import registry
 from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.cli import first_paragraph
 from swarm_sim.nodes.endpoint import Endpoint, EndpointConfig, add_endpoint_arguments, endpoint_config
-from swarm_sim.nodes.executor import make_executor, share_sim_time
+from swarm_sim.nodes.executor import StampTime, make_executor
 from swarm_sim.nodes.lifetime import die_with_parent, set_process_name
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
@@ -77,19 +79,25 @@ class ControllerNode(Node):
 
     def __init__(self, robot: str, config: ControllerConfig | None = None, *, scenario: Scenario | None = None,
                  parameter_services: bool = True, plain_twist: bool = False, watch: RunWatch | None = None,
-                 **kwargs) -> None:
+                 stamp_time: StampTime | None = None, **kwargs) -> None:
         """`scenario`: the one `config` names, already loaded (saves each forked process the
         parse); `parameter_services`: serve ``ros2 param``; `plain_twist`: a robot's own computer
-        (see the module docstring); `watch`: the process's watch of its world, shared by its
-        nodes (None: this node makes one)."""
+        (see the module docstring); `watch`: the process's watch of its world and `stamp_time`
+        its nodes' clock, shared by its nodes (None: this node makes its own)."""
         robot_index(robot)  # refuse names that are not robot ids
         super().__init__(
             "controller", namespace=robot, enable_rosout=False, start_parameter_services=parameter_services,
             # No type description service: our types are standard ones every peer has, and its two
-            # endpoints per robot are start-up cost with a process per robot.
-            parameter_overrides=[Parameter("use_sim_time", value=not plain_twist),
+            # endpoints per robot are start-up cost with a process per robot. use_sim_time false
+            # here, whatever the command line says: rclpy would subscribe to /clock; on the
+            # world's ticks the node's time is their stamps (`StampTime` declares it true).
+            parameter_overrides=[Parameter("use_sim_time", value=False),
                                  Parameter("start_type_description_service", value=False)], **kwargs,
         )
+        self._stamp_time = None if plain_twist else stamp_time or StampTime()
+        """The process's clock of the ticks its nodes step on (None with ``--plain-twist``: wall time)."""
+        if self._stamp_time is not None:
+            self._stamp_time.attach(self)
         self.robot = robot
         self.plain_twist = plain_twist
         self._wall_ticks = 0
@@ -173,6 +181,8 @@ class ControllerNode(Node):
             self._tick(stamp)
 
     def _tick(self, stamp_ns: int) -> None:
+        if self._stamp_time is not None:
+            self._stamp_time.set(stamp_ns)
         messages = self.endpoint.take(stamp_ns)
         _, pose, v, w = self._latest[topics.ODOM]
         sensed = self.sensing.sense(**{field: self._latest[name][1] for field, name in self._sense_topics})
@@ -224,12 +234,12 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     try:
         executor = make_executor()
         watch = None  # the first node's, shared by the others: one /world/run subscription a process
+        stamp_time = None if plain_twist else StampTime()
         for robot in robots:
             nodes.append(ControllerNode(robot, config, scenario=scenario, parameter_services=parameter_services,
-                                        plain_twist=plain_twist, watch=watch))
+                                        plain_twist=plain_twist, watch=watch, stamp_time=stamp_time))
             watch = nodes[-1].watch
             executor.add_node(nodes[-1])
-        share_sim_time(nodes)
         # spin_once in a loop: the EventsExecutor's spin() does not dispatch in this rclpy build.
         # One call dispatches one message, so the loop asks a flag, not rclpy.ok() (4-9 us a call:
         # 5 ms a tick in a process of 112 robots).
@@ -271,7 +281,6 @@ def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
     from rcl_interfaces import srv as parameter_services
     from rcl_interfaces.msg import ParameterEvent
     from rclpy.type_support import check_for_type_support
-    from rosgraph_msgs.msg import Clock
     from type_description_interfaces.srv import GetTypeDescription
 
     registry.make_behaviour(scenario, robot, behaviour_rng(config.seed, robot))
@@ -282,7 +291,7 @@ def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
              *(t.type_name for t in sensing.topics), *(f.type_name for f in (*inbound.values(), *outbound.values()))]
     services = [getattr(parameter_services, n) for n in ("DescribeParameters", "GetParameterTypes", "GetParameters",
                                                          "ListParameters", "SetParameters", "SetParametersAtomically")]
-    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, Clock, GetTypeDescription, *services):
+    for cls in (*(topics.import_type(name) for name in names), ParameterEvent, GetTypeDescription, *services):
         check_for_type_support(cls)  # loads the type support C modules (and rosidl's parser) now
 
 

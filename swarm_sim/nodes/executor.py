@@ -1,5 +1,5 @@
-"""How a process of ours hosts its nodes: the executor they spin in, and one ``/clock``
-subscription for all of them.
+"""How a process of ours hosts its nodes: the executor they spin in, and the clock of nodes that
+step on the world's ticks.
 
 rclpy's C++ `EventsExecutor` (in Jazzy's rclpy as `rclpy.experimental`) dispatches callbacks
 without rebuilding a Python wait set per wake-up, which is what limits a process hosting
@@ -9,11 +9,14 @@ many robots' subscriptions. `SWARM_EXECUTOR=single` falls back to the SingleThre
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.clock_type import ClockType
 from rclpy.context import Context
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.time import Time
+from rclpy.time_source import USE_SIM_TIME_NAME, TimeSource
 
 
 def make_executor(context: Context | None = None) -> Executor:
@@ -27,22 +30,45 @@ def make_executor(context: Context | None = None) -> Executor:
     return SingleThreadedExecutor(context=context)
 
 
-def share_sim_time(nodes: Sequence[Node]) -> None:
-    """Let the first node's time source drive every node's clock, with one ``/clock``
-    subscription for the process instead of one per node.
+STAMP_TIME = "sim time from the stamps of the observations the node steps on; it hears no /clock (read-only)"
+"""The description of ``use_sim_time`` on a node whose clock `StampTime` sets."""
 
-    rclpy gives every node with ``use_sim_time`` its own ``/clock`` subscription; with 112
-    controller nodes in one process every sim tick cost 112 deliveries and Python callbacks that
-    all set the same time (about 2 ms of the process's ~15 ms of CPU per tick). The nodes keep
-    their ``use_sim_time`` parameter and their clocks follow ``/clock`` as before. rclpy keeps a
-    node's time source in the private ``_time_source``; where it does not, nothing changes.
+
+class StampTime:
+    """Sim time for nodes that step on the world's ticks, without ``/clock``.
+
+    A controller steps on one tick's complete set of observations, all stamped with that tick, so
+    it needs no other time. rclpy gives every node with ``use_sim_time`` a ``/clock``
+    subscription: one message and a Python callback per tick and process, one of the five
+    messages a tick that wake a process per robot (issue 40: a quarter of those processes' CPU). An attached node keeps ``use_sim_time``,
+    declared true and read-only (`STAMP_TIME` says why), and its clock reads the newest tick any
+    node of the process stepped on (`set`), as it read the newest ``/clock`` before.
     """
-    source = getattr(nodes[0], "_time_source", None) if nodes else None
-    if source is None:
-        return
-    for node in nodes[1:]:
-        own = getattr(node, "_time_source", None)
-        if own is None:
-            continue
-        own.detach_node()  # drops its /clock subscription
-        source.attach_clock(node.get_clock())
+
+    def __init__(self) -> None:
+        self._source = TimeSource()  # attached to no node: it never subscribes to /clock
+        self._source.ros_time_is_active = True
+        self._clocks = []
+        self._ns = -1
+
+    def attach(self, node: Node) -> None:
+        """Take `node`'s clock off its own time source. The node must have been created with
+        ``use_sim_time`` false (its time source then made no subscription)."""
+        own = node._time_source  # rclpy keeps it private and offers no other handle on it
+        if own.ros_time_is_active:
+            raise ValueError(f"{node.get_fully_qualified_name()}: created with use_sim_time true; it subscribed /clock")
+        node.remove_on_set_parameters_callback(own._on_parameter_event)
+        own.detach_node()
+        node.undeclare_parameter(USE_SIM_TIME_NAME)
+        node.declare_parameter(USE_SIM_TIME_NAME, True, ParameterDescriptor(description=STAMP_TIME, read_only=True),
+                               ignore_override=True)
+        self._source.attach_clock(node.get_clock())
+        self._clocks.append(node.get_clock())
+
+    def set(self, stamp_ns: int) -> None:
+        """A node steps on tick `stamp_ns`: the clocks read it (once per tick and process)."""
+        if stamp_ns != self._ns:
+            self._ns = stamp_ns
+            now = Time(nanoseconds=stamp_ns, clock_type=ClockType.ROS_TIME)
+            for clock in self._clocks:
+                clock.set_ros_time_override(now)

@@ -81,11 +81,12 @@ class WorldRecording:
             pub.publish(data)
         self.write(topic, data)
 
-    def publish_all(self, items: list[tuple[object, str, bytes]], *, send: bool = True) -> None:
-        """`publish` for many (publisher, topic, data), recorded in one go afterwards."""
+    def publish_all(self, items: list[tuple[Callable[[bytes], None], str, bytes]], *, send: bool = True) -> None:
+        """`publish` for many (a publisher's publish of bytes, topic, data), recorded in one go
+        afterwards."""
         if send:
-            for pub, _, data in items:
-                pub.publish(data)
+            for publish, _, data in items:
+                publish(data)
         if self.recorder is not None:
             self.recorder.write_all([(topic, data) for _, topic, data in items])
 
