@@ -9,9 +9,10 @@ tick), so a batch run and the bag of a graph run give the same numbers.
   the recruiter gave up on a summoned robot, the end of that robot's ``call_timeout``);
 - transport time: from there until the last type 4 of the final landmark;
 - planned path: the object's centre when the cage is complete, then the transport's targets
-  (`swarm_controllers.caging.plan`; by default the landmarks of T_r* reversed, then p_r*^0), as a polyline (the paper's "path minimum length"; its Table 2 lengths,
-  sums of 0.5 m and 0.5 sqrt 2 m steps, leave out the two end pieces off the grid: ours keep them,
-  since the object travels them too);
+  (`swarm_controllers.caging.plan`; by default the landmarks of T_r* reversed, then p_r*^0), as
+  a polyline (the paper's "path minimum length"; its Table 2 lengths, sums of 0.5 m and
+  0.5 sqrt 2 m steps, have no piece off the grid: ours keeps the object's centre to the first
+  landmark and, by default, the last landmark to p_r*^0, since the object travels them too);
 - object path: the length of the polyline of the object's centre over the transport;
 - trajectory error: |object path - planned path| (sec. 5), and as a percentage of the planned
   path (the paper's "normalised error", about 3.8 %);
