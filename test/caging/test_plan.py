@@ -106,17 +106,21 @@ def test_an_unknown_plan_is_refused_naming_the_key():
         load_scenario("caging", ["controller.caging.plan=straight"])
 
 
-SMALL = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=200"]
-"""Six robots on a 2 x 2 m grid (test_caging_e2e's set-up): a whole protocol in about two minutes of sim."""
+SMALL = ["arena.size=5.0", "transport.landmarks.extent=[2.0, 2.0]", "robots.count=6", "sim.duration=300"]
+"""Six robots on a 2 x 2 m grid (test_caging_e2e's set-up): a whole protocol in about three minutes of sim."""
+SEED = 11
+"""Its recruiter reaches 5 landmarks with a detour: 5 targets under ``search``, 2 under ``shortest``."""
 
 
 @pytest.mark.parametrize("plan", ["search", "shortest"])
 def test_a_run_follows_and_measures_its_plan(plan):
-    scenario = load_scenario("caging", [*SMALL, f"controller.caging.plan={plan}"], seed=3)
+    scenario = load_scenario("caging", [*SMALL, f"controller.caging.plan={plan}"], seed=SEED)
     trace = run_batch(scenario).trace
     first = min((m for m in trace.messages if isinstance(m, Recruitment)), key=lambda m: m.stamp_ns)
     marks = landmarks(scenario)
-    targets = planned_path(marks, first.trajectory, (first.start_x, first.start_y), plan)
+    readings = {p: planned_path(marks, first.trajectory, (first.start_x, first.start_y), p) for p in PLANS}
+    assert len({len(r) for r in readings.values()}) == 3  # the seed tells the three readings apart
+    targets = readings[plan]
     assert max(m.leg for m in trace.messages if isinstance(m, Reached)) == len(targets) - 1
     report, transport = caging_report(trace), transport_stage(trace)
     assert report.transport_time_s is not None
