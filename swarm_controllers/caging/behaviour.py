@@ -21,8 +21,9 @@ A `Phase` machine; each tick first reads the messages addressed to it, then acts
 - PLACED (Alg. 6 lines 1-7): a placed robot waits until every other recruited robot has sent
   type 2, or until it hears a type 3 (the recruiter only starts the transport once the cage is
   complete, skipped robots included).
-- SPIN, WAIT_ORIENTED, MOVE, WAIT_REACHED (Alg. 6 lines 8-31), for every landmark of T_r*
-  reversed, ending at the recruiter's start p_r*^0: spin to face p_i+ (Fig. 1b), send type 3
+- SPIN, WAIT_ORIENTED, MOVE, WAIT_REACHED (Alg. 6 lines 8-31), for every target of the planned
+  path (`swarm_controllers.caging.plan`; by default T_r* reversed, ending at the recruiter's
+  start p_r*^0): spin to face p_i+ (Fig. 1b), send type 3
   and wait for everyone's type 3; move to p_i+ (eq. (5) around the landmark) with the seven
   PIDs (`Formation`), send type 4 and wait for everyone's type 4. "Everyone" is the cage: r*
   and the robots that sent type 2. Beyond the paper: robots still silent ``barrier_timeout``
@@ -44,6 +45,7 @@ from swarm_controllers.caging import geometry
 from swarm_controllers.caging.config import CagingConfig
 from swarm_controllers.caging.landmarks import landmarks
 from swarm_controllers.caging.motion import Formation, GoTo, Limits, Motion, Neighbour, Spin
+from swarm_controllers.caging.plan import planned_path
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_controllers.caging.task import OBJECT
 from swarm_controllers.caging.world_config import TransportConfig
@@ -103,7 +105,7 @@ class CagingBehaviour:
         self.center: Point = (0.0, 0.0)
         """C_object: from the type 0, updated whenever the object is sensed."""
         self.path: list[Point] = []
-        """The transport's targets: T_r* reversed (landmarks, then p_r*^0)."""
+        """The transport's targets (`swarm_controllers.caging.plan`)."""
         self.leg = 0
         self.cage: set[RobotId] = set()
         """r* and the robots that sent type 2 (minus those dropped after a timeout)."""
@@ -261,7 +263,7 @@ class CagingBehaviour:
         self._go.reset()
 
     def _set_path(self, trajectory: list[int], start: Point) -> None:
-        self.path = [self.landmarks.position(j) for j in reversed(trajectory)] + [start]
+        self.path = planned_path(self.landmarks, trajectory, start, self.config.plan)
 
     def _place(self, center: Point) -> Point:
         """Eq. (5) around `center`: p_i* around the object, p_i+ around a landmark."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 from swarm_controllers.caging.geometry import cage_radius, max_robots, rho_min, theta_min
 from swarm_controllers.caging.world_config import TransportConfig
@@ -53,6 +53,10 @@ class CagingConfig(Section):
     acceleration_ratio: float = 1.0
     """A / a of eq. (1): the object's acceleration over the robots'. The paper gives neither; the
     cage moves as one, so 1."""
+    plan: Literal["search_to_start", "search", "shortest"] = "search_to_start"
+    """The transport's planned path from T_r* (`swarm_controllers.caging.plan`): T_r* reversed then
+    p_r*^0 (sec. 4's prose), T_r* reversed alone (Alg. 6's loop), or a shortest 8-connected grid
+    path between T_r*'s two ends (sec. 5's "path minimum length" read as the grid's shortest)."""
     call_timeout: float = 120.0
     """Beyond the paper: the recruiter calls the next robot of mu if the one it summoned has not
     answered with a type-2 message within this many sim seconds (a dead robot)."""

@@ -1,7 +1,8 @@
 """The caging paper's factor group (`swarm_sim.factor_sweeps`, run by ``scripts/factors``): its
 cells 2 and 3 (6 and 7 robots, 0.3 m object) on the Khepera III (0.298 m/s regulated, 6.73 rad/s,
 planar) against the generic robot of caging.yaml (0.341 m/s, 7.7 rad/s, not planar; same 0.13 m
-body), one factor changed at a time."""
+body), one factor changed at a time; and the group ``cagingplan``: Table 2's five runs (cells 0, 2-5) on the
+Khepera III under each reading of the planned path (`swarm_controllers.caging.plan`)."""
 
 from swarm_sim.factor_sweeps import Factor, FactorGroup
 
@@ -21,4 +22,15 @@ GROUPS = (
         # from). Ten seeds of cells 1 and 3 (steps 1 and 0.5 m), whatever --seeds says: the fit
         # needs plans of every shape.
         then=("swarm_controllers.caging.corners", "--cells", "1", "3", "--seeds", "10")),
+    FactorGroup("cagingplan", ("caging", "--cells", "0", "2", "3", "4", "5"), "caging/results.jsonl", "0,2,3,4,5", (
+        Factor("baseline", "the authors' robot; plan: T_r* reversed, then p_r*^0 (sec. 4's prose; the default)",
+               AUTHORS),
+        Factor("plan_search", "plan: T_r* reversed alone, ending at its first landmark (Alg. 6's loop, "
+               "for j := n-1 -> 0: lambda := T_ij) (controller.caging.plan=search)",
+               (*AUTHORS, "--set", "controller.caging.plan=search")),
+        Factor("plan_shortest", "plan: a shortest 8-connected grid path between T_r*'s ends (sec. 5's "
+               "'path minimum length' as the grid's shortest; Table 2's lengths are such 7-step paths) "
+               "(controller.caging.plan=shortest)",
+               (*AUTHORS, "--set", "controller.caging.plan=shortest")),
+    )),
 )

@@ -28,6 +28,8 @@ class Landmarks:
     """eta(lambda_i): the indices of the up to eight grid neighbours of landmark i."""
     step: float
     """Grid step [m]."""
+    columns: int
+    """Landmarks along x: landmark i sits in column i % columns, row i // columns."""
 
     def __len__(self) -> int:
         return len(self.points)
@@ -35,6 +37,13 @@ class Landmarks:
     def position(self, i: int) -> tuple[float, float]:
         x, y = self.points[i]
         return float(x), float(y)
+
+    def cell(self, i: int) -> tuple[int, int]:
+        """(column, row) of landmark i."""
+        return i % self.columns, i // self.columns
+
+    def index(self, column: int, row: int) -> int:
+        return row * self.columns + column
 
 
 def grid_counts(config: LandmarkConfig) -> tuple[int, int]:
@@ -59,7 +68,7 @@ def _grid(step: float, extent: tuple[float, float]) -> Landmarks:
                 for jx in range(max(ix - 1, 0), min(ix + 2, nx))
                 if (jx, jy) != (ix, iy)
             ))
-    return Landmarks(points, tuple(neighbours), step)
+    return Landmarks(points, tuple(neighbours), step, nx)
 
 
 def landmarks(scenario: Scenario) -> Landmarks:

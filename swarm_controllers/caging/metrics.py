@@ -8,10 +8,11 @@ tick), so a batch run and the bag of a graph run give the same numbers.
 - recruitment time: from there until the cage is complete: the last robot's type 2 (or, when
   the recruiter gave up on a summoned robot, the end of that robot's ``call_timeout``);
 - transport time: from there until the last type 4 of the final landmark;
-- planned path: the object's centre when the cage is complete, then the landmarks of T_r*
-  reversed, then p_r*^0, as a polyline (the paper's "path minimum length"; its Table 2 lengths,
-  sums of 0.5 m and 0.5 sqrt 2 m steps, leave out the two end pieces off the grid: ours keep them,
-  since the object travels them too);
+- planned path: the object's centre when the cage is complete, then the transport's targets
+  (`swarm_controllers.caging.plan`; by default the landmarks of T_r* reversed, then p_r*^0), as
+  a polyline (the paper's "path minimum length"; its Table 2 lengths, sums of 0.5 m and
+  0.5 sqrt 2 m steps, have no piece off the grid: ours keeps the object's centre to the first
+  landmark and, by default, the last landmark to p_r*^0, since the object travels them too);
 - object path: the length of the polyline of the object's centre over the transport;
 - trajectory error: |object path - planned path| (sec. 5), and as a percentage of the planned
   path (the paper's "normalised error", about 3.8 %);
@@ -30,6 +31,7 @@ import numpy as np
 
 from swarm_controllers.caging.config import CagingConfig
 from swarm_controllers.caging.landmarks import landmarks
+from swarm_controllers.caging.plan import planned_path
 from swarm_controllers.caging.protocol import Oriented, Positioned, Reached, Recruitment, Summon
 from swarm_controllers.caging.world_config import TransportConfig
 from swarm_msgs_py.types import NS_PER_S, robot_index
@@ -146,7 +148,8 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
     t_caged = max([t * s for t in positioned.values()] + unanswered + [t_detect])
     result["recruitment_time_s"] = t_caged - t_detect
 
-    final = len(first.trajectory)
+    targets = planned_path(marks, first.trajectory, (first.start_x, first.start_y), cfg.plan)
+    final = len(targets) - 1
     oriented = {m.origin for m in trace.messages if isinstance(m, Oriented) and m.leg == final}
     reached = {m.origin: m.stamp_ns for m in trace.messages if isinstance(m, Reached) and m.leg == final}
     done = bool(oriented) and oriented <= set(reached)
@@ -159,8 +162,7 @@ def _report(trace) -> tuple[CagingReport, Transport | None]:
     if not window.any():
         return CagingReport(**result), None
     obj = np.array(positions)[window]
-    planned = np.array([obj[0], *(marks.position(j) for j in reversed(first.trajectory)),
-                        (first.start_x, first.start_y)])
+    planned = np.array([obj[0], *targets])
     result["max_path_deviation_m"] = float(distance_to_polyline(obj, planned).max())
     result["cage_held"] = _cage_held(trace, scenario, cage, times[window], obj)
     if done:
