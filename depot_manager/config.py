@@ -37,6 +37,18 @@ class QueueConfig(Section):
     CPFA-2.0, their Q_ST: ``CPFA_controller::Returning``, source/CPFA/CPFA_controller.cpp). Only
     the paper's text is the default; ``anywhere`` is what the authors ran."""
 
+    cell_release: Literal["arrival", "departure"] = "arrival"
+    """When a robot's cell on an entry line may be granted to the robot behind it: on its
+    ``arrival`` at its next cell (the depot manager's cells are never shared), or on its
+    ``departure``, as soon as it holds a grant beyond that cell and so moves off; the follower then
+    closes up until its own stop rule halts it behind the leaver (the foot-bot's path stop, the
+    generic robot's brake). ``departure`` is how the queue authors' robots follow one another:
+    their code has no cells, a robot on the path drives from waypoint to waypoint and stops only
+    for what its proximity ring reads within +-30 deg of its heading (Tameem786/
+    Collision_Free_CPFA, branch CPFA-2.0, ``CPFA_controller::FollowingEntryPath`` and
+    ``CollisionDetection``). With cells released on arrival a dense line moves as a caterpillar,
+    each robot waiting for the one ahead to finish its move."""
+
     seek_timeout: float = 120.0
     """Tail joining: a searcher that has not joined after this long [s, sim time] falls back to
     entry-point joining. Our addition, against livelock: the paper's searcher only switches to its

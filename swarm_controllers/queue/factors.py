@@ -44,9 +44,6 @@ QST_BASELINE = Factor("baseline", "the shipped Q_ST on the authors' robot (footb
 QST_MOTION_GENERIC = Factor("motion_generic", "motion rule: the generic robot's (continuous steering, our avoidance "
                             "and brake) instead of the foot-bot's stop-turn-go, same body and speeds",
                             ("--robot-model", "generic"))
-QST_TICKS_32 = Factor("ticks_32", "tick rate: 32 ticks/s (sim.dt = 1/32 s, the authors' ticks_per_second=\"32\", "
-                      "experiments/Clustered_CPFA_r64_tag512_16by16.xml) instead of our 10",
-                      ("--robot-model", "authors", "--set", "sim.dt=0.03125"))
 
 GROUPS = (
     FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
@@ -55,5 +52,5 @@ GROUPS = (
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
                 (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
-                (QST_BASELINE, QST_MOTION_GENERIC, QST_TICKS_32), strategies=("queue_qst",)),
+                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP), strategies=("queue_qst",)),
 )
