@@ -44,6 +44,11 @@ QST_BASELINE = Factor("baseline", "the shipped Q_ST on the authors' robot (footb
 QST_MOTION_GENERIC = Factor("motion_generic", "motion rule: the generic robot's (continuous steering, our avoidance "
                             "and brake) instead of the foot-bot's stop-turn-go, same body and speeds",
                             ("--robot-model", "generic"))
+QST_DEPARTURE = Factor("cell_release_departure", "moving along the line: a robot's entry-line cell goes to the "
+                       "robot behind once it holds a grant beyond it, which closes up to its path stop "
+                       "(controller.queue.cell_release=departure: the authors' robots follow waypoints with no cells, "
+                       "CPFA-2.0 CPFA_controller::FollowingEntryPath) instead of on its arrival at the next cell",
+                       ("--robot-model", "authors", "--set", "controller.queue.cell_release=departure"))
 
 GROUPS = (
     FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
@@ -52,5 +57,5 @@ GROUPS = (
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
                 (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
-                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP), strategies=("queue_qst",)),
+                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE), strategies=("queue_qst",)),
 )
