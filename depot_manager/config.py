@@ -37,6 +37,15 @@ class QueueConfig(Section):
     CPFA-2.0, their Q_ST: ``CPFA_controller::Returning``, source/CPFA/CPFA_controller.cpp). Only
     the paper's text is the default; ``anywhere`` is what the authors ran."""
 
+    boarding: Literal["radio", "innermost"] = "radio"
+    """Tail joining: where a carrier asks to board. ``radio``, the paper's (sec. V-B): it asks the
+    queued robots it meets on its way in and joins by their replies; ``innermost``, the queue
+    authors' Q_ST code: no radio, it drives straight in and boards the innermost arc at the cell
+    nearest to it (their ``CPFA_controller::Returning``, branch CPFA-2.0: a carrier heads for
+    0.5 R + 0.1 m from the centre and boards the fifth arc, r = 1.0 m, at the first of its
+    waypoints it comes within 0.15 m of; our innermost arc is at 0.99 m). A refused join is asked
+    again from where it stands."""
+
     cell_release: Literal["arrival", "departure"] = "arrival"
     """When a robot's cell on an entry line may be granted to the robot behind it: on its
     ``arrival`` at its next cell (the depot manager's cells are never shared), or on its

@@ -142,7 +142,7 @@ class QueueBehaviour:
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
-        "_retry_at", "_rng", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
+        "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
     )
 
@@ -177,6 +177,9 @@ class QueueBehaviour:
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
         )
         self._exit_lines = {line.name for line in self._layout.exit_lines}
+        self._innermost = _innermost_arc(self._cells, self._entry_lines, self._center, self._lane) \
+            if queue.boarding == "innermost" else None
+        """``boarding: innermost``: the innermost arc's cells, as (line, cell index, x, y) arrays."""
         self._front = ray_window(i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE)
         """The rays of the braking cone."""
         self._brake_range = float(np.float32(BRAKE_RANGE))
@@ -416,6 +419,8 @@ class QueueBehaviour:
             return self._to_entry(obs, r, out)
         if obs.t < self._yield_until:
             return 0.0, 0.0
+        if self._innermost is not None:
+            return self._board_innermost(obs, r, out)
         near = bool(np.min(obs.ranges) < self._gamma)
         if near and obs.t >= self._query_at:
             self._query_at = obs.t + QUERY_PERIOD
@@ -437,6 +442,23 @@ class QueueBehaviour:
             if math.hypot(gx - x, gy - y) < self._gamma / 2:
                 self._goal = None  # looked there: head in again, asking as we go
         return self._to_point(x, y, obs.pose.yaw, gx, gy)
+
+    def _board_innermost(self, obs: Observation, r: float, out: list[object]) -> tuple[float, float]:
+        """``boarding: innermost``: straight in to one lane outside the inner region, then ask for
+        the nearest cell of the innermost arc (the queue authors' Q_ST, `QueueConfig.boarding`)."""
+        if self._join is not None:
+            return self._joining(obs, out)
+        x, y = obs.pose.x, obs.pose.y
+        cx, cy = self._center
+        boundary = self._layout.inner_radius + self._lane
+        if r <= boundary + SLOT_TOLERANCE:
+            if obs.t >= self._retry_at:
+                lines, cells, xy = self._innermost
+                i = int(np.argmin(np.hypot(*(xy - (x, y)).T)))
+                self._request_join(lines[i], int(cells[i]), obs, out)
+                return self._joining(obs, out)
+            return 0.0, 0.0
+        return self._to_point(x, y, obs.pose.yaw, cx + (x - cx) / r * boundary, cy + (y - cy) / r * boundary)
 
     def _joining(self, obs: Observation, out: list[object]) -> tuple[float, float]:
         """Asked to join (line, cell); drive there while the manager answers."""
@@ -514,6 +536,16 @@ class QueueBehaviour:
             if best is None or d[i] < best[0]:
                 best = (float(d[i]), line, i)
         return best[1], best[2]
+
+
+def _innermost_arc(cells: dict, lines: tuple[str, ...], center: tuple[float, float], lane: float) -> tuple:
+    """The entry lines' cells within half a lane of the innermost one's distance from the centre:
+    (line names, cell indices, (n, 2) positions)."""
+    found = [(line, i, xy) for line in lines for i, xy in enumerate(cells[line])]
+    r = np.array([math.hypot(xy[0] - center[0], xy[1] - center[1]) for _, _, xy in found])
+    keep = [k for k in range(len(found)) if r[k] < r.min() + lane / 2]
+    return (tuple(found[k][0] for k in keep), np.array([found[k][1] for k in keep]),
+            np.array([found[k][2] for k in keep], dtype=float))
 
 
 def _segment_hits_disc(p, q, c, radius: float) -> bool:
