@@ -46,6 +46,13 @@ class QueueConfig(Section):
     waypoints it comes within 0.15 m of; our innermost arc is at 0.99 m). A refused join is asked
     again from where it stands."""
 
+    queued_motion: Literal["model", "continuous"] = "model"
+    """How a robot drives on the queue's lines (joining its cell, queued, leaving): ``model``, by
+    its robot model's motion (the foot-bot's stop-turn-go and path stop); ``continuous``, by the
+    generic robot's continuous steering and brake, whatever the model. A diagnostic, neither the
+    paper's nor the authors' (their foot-bots run stop-turn-go on the path too): it tells how much
+    of the motion rule's cost falls on the queue rather than on foraging."""
+
     cell_release: Literal["arrival", "departure"] = "arrival"
     """When a robot's cell on an entry line may be granted to the robot behind it: on its
     ``arrival`` at its next cell (the depot manager's cells are never shared), or on its

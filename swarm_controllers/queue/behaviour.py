@@ -63,7 +63,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioRep
 from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
-from swarm_controllers.motion import drive_for
+from swarm_controllers.motion import ContinuousDrive, drive_for
 from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.messaging import per_inbox
@@ -141,7 +141,7 @@ class QueueBehaviour:
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
-        "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
+        "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_phase", "_query_at", "_to_point",
         "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
     )
@@ -155,6 +155,9 @@ class QueueBehaviour:
         self._drive = drive_for(scenario, rng)
         """The robot's motion layer, shared with its CPFA (one ``BaseController`` per robot)."""
         self._to_point = self._drive.to_point
+        self._line_drive = ContinuousDrive(scenario) if queue.queued_motion == "continuous" else self._drive
+        """How the robot drives along the queue's lines (`QueueConfig.queued_motion`)."""
+        self._line_to_point = self._line_drive.to_point
         self._center = (float(depot.center[0]), float(depot.center[1]))
         self._R = DockingConfig.of(scenario).perimeter_radius
         self._lane = queue.lane_spacing
@@ -266,7 +269,7 @@ class QueueBehaviour:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
                 self._braked_since = math.inf  # swerved for a second: try the line again
-        elif (phase is _QUEUED or phase is _LEAVING) and self._drive.path_stop(obs.ranges, PATH_CONE):
+        elif (phase is _QUEUED or phase is _LEAVING) and self._line_drive.path_stop(obs.ranges, PATH_CONE):
             linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())
             self._braked_since = min(self._braked_since, obs.t)
         elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:
@@ -468,7 +471,7 @@ class QueueBehaviour:
         tx, ty = self._slots[line][cell]
         if math.hypot(tx - obs.pose.x, ty - obs.pose.y) <= SLOT_TOLERANCE:
             return 0.0, 0.0
-        return self._to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, tx, ty)
+        return self._line_to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, tx, ty)
 
     def _queued(self, obs: Observation, out: list[object]) -> tuple[float, float]:
         x, y = obs.pose.x, obs.pose.y
@@ -495,14 +498,14 @@ class QueueBehaviour:
             if nxt is None:
                 return 0.0, 0.0
             tx, ty = self._slots[nxt[0]][nxt[1]]
-        return self._to_point(x, y, obs.pose.yaw, tx, ty)
+        return self._line_to_point(x, y, obs.pose.yaw, tx, ty)
 
     def _leaving(self, obs: Observation, r: float) -> tuple[float, float]:
         if r >= self._R + KEEP_OUT_BAND + 0.05:
             self._phase = Phase.FORAGING
             self._line, self._cell, self._grant = "", -1, None
             return 0.0, 0.0
-        return self._to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._leave_to)
+        return self._line_to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._leave_to)
 
     # ------------------------------------------------------------------ helpers
 

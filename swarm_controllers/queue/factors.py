@@ -54,6 +54,15 @@ QST_INNERMOST = Factor("boarding_innermost", "where a carrier boards: straight i
                        "CPFA_controller::Returning boards the fifth arc, r = 1.0 m) instead of by the queued "
                        "robots' radio replies on the way in (sec. V-B)",
                        ("--robot-model", "authors", "--set", "controller.queue.boarding=innermost"))
+QST_QUEUED_CONTINUOUS = Factor("queued_motion_continuous", "the motion lead narrowed: the generic robot's continuous "
+                               "steering and brake on the queue's lines only, the foot-bot's stop-turn-go while "
+                               "foraging and seeking (controller.queue.queued_motion=continuous; a diagnostic, not "
+                               "the authors' rule)",
+                               ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous"))
+
+# Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion step.
+QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
+                      ("--robot-model", "authors"))
 
 GROUPS = (
     FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
@@ -62,6 +71,9 @@ GROUPS = (
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
                 (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
-                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST),
+                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
+                 QST_QUEUED_CONTINUOUS),
                 strategies=("queue_qst",)),
+    FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
+                (QSE_BASELINE, QST_MOTION_GENERIC), strategies=("queue_qse",)),
 )

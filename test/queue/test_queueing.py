@@ -354,3 +354,20 @@ def test_innermost_boarding_asks_for_the_innermost_arcs_nearest_cell_and_never_r
         r = np.hypot(*cells.T)
         assert math.hypot(*cells[joins[0].cell]) < r.min() + b._lane / 2  # on the innermost arc
         assert math.hypot(cells[joins[0].cell][0] - x, cells[joins[0].cell][1]) < 0.25  # the nearest
+
+
+def test_queued_motion_continuous_drives_the_lines_only_with_the_generic_steering():
+    """``controller.queue.queued_motion`` (a diagnostic): on the foot-bot the queue's lines take the
+    generic robot's continuous drive, foraging keeps the model's stop-turn-go."""
+    from swarm_controllers.motion import ContinuousDrive
+    from swarm_controllers.robots.stop_turn_go import StopTurnGo
+    from swarm_sim.registry import make_behaviour
+
+    for motion, line_drive in (("model", StopTurnGo), ("continuous", ContinuousDrive)):
+        s = generic_scenario("queue_qst", ["robots.count=2", "robots.model=footbot_cpfa",
+                                           f"controller.queue.queued_motion={motion}"])
+        b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+        assert isinstance(b._drive, StopTurnGo) and isinstance(b._line_drive, line_drive)
+        # a continuous drive turns and goes at once; stop-turn-go first stands for its plan
+        lin, ang = b._line_to_point(0.0, 0.0, 0.0, 1.0, 0.3)
+        assert (lin > 0 and ang > 0) == (motion == "continuous")
