@@ -40,12 +40,13 @@ TEXT_COUNTS = {("queue_cpfa", 48): "text: 49 of 320 (15.3 %)", ("queue_cpfa", 11
 _MOTION = Cause(PARTIAL, "the foot-bot's stop-turn-go motion rule: with the generic robot's motion on the same "
                          "body, speed and turn rate every queue strategy collects 1.4-3.9x more (factor "
                          "`motion_generic`, queue48 / queue112, 2 seeds; FACTORS.md)", "motion_generic", 2)
-_QST48_MOTION = Cause(MEASURED, "the foot-bot's stop-turn-go motion rule in our cell-granted queue: Q_ST at 48 robots "
-                               "collects 18.1 % on it and 33.6 % with the generic robot's motion on the same body, "
-                               "speed and turn rate (factor `motion_generic`, qst48, 10 seeds; the authors' code run "
-                               "here, 37.6 %, moves its foot-bots by the same rule, so the rule holds ours down only "
-                               "with something else of ours, not isolated yet: FACTORS.md, CAUSES.md)",
-                      "qst48/motion_generic", 10)
+_QST48_MOTION = Cause(MEASURED, "the foot-bot's stop-turn-go motion rule on our queue's lines: Q_ST at 48 robots "
+                               "collects 18.1 % on it, 31.8 % with the generic robot's continuous steering on the "
+                               "queue's lines only (factor `queued_motion_continuous`, qst48, 10 seeds) and 33.6 % "
+                               "with it everywhere (`motion_generic`); the authors' code run here, 37.6 %, moves its "
+                               "foot-bots by the same rule on waypoints without cells, so the rule costs ours this "
+                               "only with our cell-by-cell queue, not isolated further (FACTORS.md, CAUSES.md)",
+                      "qst48/queued_motion_continuous", 10)
 _CPFA_LATE = Cause(OPEN, "our CPFA jams later than the paper's (37 % at 48 robots against 15 %; at 112 robots "
                          "both motion rules give the paper's ~15 %); what delays the jam is not measured (the "
                          "dock distance is not it: `cpfa_docks_0.585`, 2 seeds, raises it)")
