@@ -44,8 +44,9 @@ _QST48_MOTION = Cause(MEASURED, "the foot-bot's stop-turn-go motion rule on our 
                                "collects 18.1 % on it, 31.8 % with the generic robot's continuous steering on the "
                                "queue's lines only (factor `queued_motion_continuous`, qst48, 10 seeds) and 33.6 % "
                                "with it everywhere (`motion_generic`); the authors' code run here, 37.6 %, moves its "
-                               "foot-bots by the same rule on waypoints without cells, so the rule costs ours this "
-                               "only with our cell-by-cell queue, not isolated further (FACTORS.md, CAUSES.md)",
+                               "foot-bots by the same rule, so it costs ours this only together with something else of "
+                               "our queue, not isolated yet (its cells released on departure, boarding at the "
+                               "innermost arc, no give-up: none moved it; FACTORS.md, CAUSES.md)",
                       "qst48/queued_motion_continuous", 10)
 _CPFA_LATE = Cause(OPEN, "our CPFA jams later than the paper's (37 % at 48 robots against 15 %; at 112 robots "
                          "both motion rules give the paper's ~15 %); what delays the jam is not measured (the "

@@ -49,8 +49,8 @@ QST_DEPARTURE = Factor("cell_release_departure", "moving along the line: a robot
                        "(controller.queue.cell_release=departure: the authors' robots follow waypoints with no cells, "
                        "CPFA-2.0 CPFA_controller::FollowingEntryPath) instead of on its arrival at the next cell",
                        ("--robot-model", "authors", "--set", "controller.queue.cell_release=departure"))
-QST_INNERMOST = Factor("boarding_innermost", "where a carrier boards: straight in, at the innermost arc's nearest cell, "
-                       "no radio (controller.queue.boarding=innermost: the authors' CPFA-2.0 "
+QST_INNERMOST = Factor("boarding_innermost", "where a carrier boards: straight in, at the innermost arc's nearest "
+                       "cell, no radio (controller.queue.boarding=innermost: the authors' CPFA-2.0 "
                        "CPFA_controller::Returning boards the fifth arc, r = 1.0 m) instead of by the queued "
                        "robots' radio replies on the way in (sec. V-B)",
                        ("--robot-model", "authors", "--set", "controller.queue.boarding=innermost"))
