@@ -172,7 +172,8 @@ class DepotAdmission:
     queue (see the module docstring for every rule)."""
 
     def __init__(
-        self, layout: QueueLayout, *, lookahead: int = 8, inner_rule: str = "any", join_order: str = "behind_tail"
+        self, layout: QueueLayout, *, lookahead: int = 8, inner_rule: str = "any", join_order: str = "behind_tail",
+        cell_release: str = "arrival",
     ) -> None:
         if lookahead < 1:
             raise ValueError(f"lookahead must be >= 1, got {lookahead}")
@@ -180,6 +181,8 @@ class DepotAdmission:
             raise ValueError(f"inner_rule must be 'any' or 'own', got {inner_rule!r}")
         if join_order not in ("behind_tail", "anywhere"):
             raise ValueError(f"join_order must be 'behind_tail' or 'anywhere', got {join_order!r}")
+        if cell_release not in ("arrival", "departure"):
+            raise ValueError(f"cell_release must be 'arrival' or 'departure', got {cell_release!r}")
         self.behind_tail = join_order == "behind_tail"
         """A join must be behind every robot on the line (else any free cell will do)."""
         self.layout = layout
@@ -198,6 +201,13 @@ class DepotAdmission:
         """The model's per-cell arrays as lists: `step` reads them cell by cell every tick
         (a numpy element costs ~5x a list item)."""
         self._owner: list[str | None] = [None] * len(self._m.xy)
+        self._on_departure: list[bool] = [False] * len(m.xy)
+        """Cells released when their robot moves off (``cell_release="departure"``): the entry lines'
+        cells that are no intersection cells (`depot_manager.config.QueueConfig.cell_release`)."""
+        if cell_release == "departure":
+            for name in m.entry_names:
+                for c in m.line_ids[name].tolist():
+                    self._on_departure[c] = not self._intersection[c]
         self._robots: dict[str, _Robot] = {}
         self._reported: dict[str, tuple[str, int]] = {}
         self._left = 0
@@ -309,7 +319,8 @@ class DepotAdmission:
             return
         self.version += 1
         for c in r.route[r.pos : p]:
-            self._owner[c] = None
+            if self._owner[c] == robot:  # (a cell released on departure may be the follower's already)
+                self._owner[c] = None
         r.pos, r.key = p, t
         if r.complete and p == len(r.route) - 1:
             for c in r.route[p : r.end + 1]:
@@ -434,13 +445,21 @@ class DepotAdmission:
     def _free(self, c: int, robot: str) -> bool:
         own = self._owner
         o = own[c]
-        if o is not None and o != robot:
+        if o is not None and o != robot and not self._vacated(c, o):
             return False
         for x in self._m.conflicts[c]:
             o = own[x]
             if o is not None and o != robot:
                 return False
         return True
+
+    def _vacated(self, c: int, owner: str) -> bool:
+        """Cell c is its owner's current cell on an entry line, released on departure, and the owner
+        holds a grant beyond it (it is moving off)."""
+        if not self._on_departure[c]:
+            return False
+        o = self._robots[owner]
+        return o.route[o.pos] == c and o.end > o.pos
 
     def _stoppable(self, r: _Robot, i: int) -> bool:
         return not self._intersection[r.route[i]] or (r.complete and i == len(r.route) - 1)

@@ -37,6 +37,34 @@ class QueueConfig(Section):
     CPFA-2.0, their Q_ST: ``CPFA_controller::Returning``, source/CPFA/CPFA_controller.cpp). Only
     the paper's text is the default; ``anywhere`` is what the authors ran."""
 
+    boarding: Literal["radio", "innermost"] = "radio"
+    """Tail joining: where a carrier asks to board. ``radio``, the paper's (sec. V-B): it asks the
+    queued robots it meets on its way in and joins by their replies; ``innermost``, the queue
+    authors' Q_ST code: no radio, it drives straight in and boards the innermost arc at the cell
+    nearest to it (their ``CPFA_controller::Returning``, branch CPFA-2.0: a carrier heads for
+    0.5 R + 0.1 m from the centre and boards the fifth arc, r = 1.0 m, at the first of its
+    waypoints it comes within 0.15 m of; our innermost arc is at 0.99 m). A refused join is asked
+    again from where it stands."""
+
+    queued_motion: Literal["model", "continuous"] = "model"
+    """How a robot drives on the queue's lines (joining its cell, queued, leaving): ``model``, by
+    its robot model's motion (the foot-bot's stop-turn-go and path stop); ``continuous``, by the
+    generic robot's continuous steering and brake, whatever the model. A diagnostic, neither the
+    paper's nor the authors' (their foot-bots run stop-turn-go on the path too): it tells how much
+    of the motion rule's cost falls on the queue rather than on foraging."""
+
+    cell_release: Literal["arrival", "departure"] = "arrival"
+    """When a robot's cell on an entry line may be granted to the robot behind it: on its
+    ``arrival`` at its next cell (the depot manager's cells are never shared), or on its
+    ``departure``, as soon as it holds a grant beyond that cell and so moves off; the follower then
+    closes up until its own stop rule halts it behind the leaver (the foot-bot's path stop, the
+    generic robot's brake). ``departure`` is how the queue authors' robots follow one another:
+    their code has no cells, a robot on the path drives from waypoint to waypoint and stops only
+    for what its proximity ring reads within +-30 deg of its heading (Tameem786/
+    Collision_Free_CPFA, branch CPFA-2.0, ``CPFA_controller::FollowingEntryPath`` and
+    ``CollisionDetection``). With cells released on arrival a dense line moves as a caterpillar,
+    each robot waiting for the one ahead to finish its move."""
+
     seek_timeout: float = 120.0
     """Tail joining: a searcher that has not joined after this long [s, sim time] falls back to
     entry-point joining. Our addition, against livelock: the paper's searcher only switches to its

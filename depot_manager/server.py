@@ -48,7 +48,7 @@ class DepotServer:
         self.queue = queue = QueueConfig.of(scenario)
         self.layout: QueueLayout = make_layout(queue.wrapping, DepotGeometryConfig.from_scenario(scenario))
         self.admission = DepotAdmission(self.layout, lookahead=lookahead, inner_rule=queue.inner_rule,
-                                       join_order=queue.join_order)
+                                       join_order=queue.join_order, cell_release=queue.cell_release)
         self.robots = frozenset(scenario.robot_names)
         self.rejections = Rejections()
         """Reports that could not be applied, by reason (the last one's detail kept)."""

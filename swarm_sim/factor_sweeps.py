@@ -49,6 +49,9 @@ class FactorGroup:
     factors: tuple[Factor, ...]
     baseline: str = "baseline"
     """Where under the group the baseline's ``swarm-compare`` keeps its results.jsonl."""
+    strategies: tuple[str, ...] = ()
+    """Which strategies' runs of those cells seed the baseline (empty: all), for a group that
+    studies one strategy."""
     then: tuple[str, ...] = ()
     """A command run after the sweeps, as ``python -m`` arguments, given ``--jobs`` and ``--out
     OUT/<group>`` (a study that is no sweep, say)."""
@@ -77,8 +80,9 @@ def seed_baseline(group: FactorGroup, out: Path, main: Path) -> None:
         return
     cells = group.cells.split(",")
     lines = src.read_text().splitlines(keepends=True)
-    dst.write_text("".join(line for line in lines if line.strip() and (
-        group.cells == "all" or str(json.loads(line).get("cell")) in cells)))
+    rows = [(line, json.loads(line)) for line in lines if line.strip()]
+    dst.write_text("".join(line for line, row in rows if (group.cells == "all" or str(row.get("cell")) in cells)
+                           and (not group.strategies or row.get("strategy") in group.strategies)))
 
 
 def sweep(group: FactorGroup, factor: Factor, out: Path, seeds: int, jobs: int) -> None:

@@ -16,8 +16,8 @@ REPO = Path(__file__).resolve().parents[1]
 
 def test_each_paper_declares_its_groups_in_its_own_package():
     found = groups()
-    assert set(found) == {"queue48", "queue112", "drtm31", "drtm43", "spiral1", "spiral2", "caging",
-                          "cagingplan"}
+    assert set(found) == {"queue48", "queue112", "qst48", "qse48", "drtm31", "drtm43", "spiral1", "spiral2",
+                          "caging", "cagingplan"}
     for group in found.values():
         names = [f.name for f in group.factors]
         assert names[0] == "baseline" and len(set(names)) == len(names), group.name
@@ -56,6 +56,15 @@ def test_the_baseline_is_seeded_from_the_main_sweep_once(tmp_path):
     seeded.write_text("kept\n")
     seed_baseline(group, out, main_dir)
     assert seeded.read_text() == "kept\n"
+
+
+def test_a_group_of_one_strategy_seeds_only_its_runs(tmp_path):
+    main_dir, out = tmp_path / "main", tmp_path / "out"
+    (main_dir / "p").mkdir(parents=True)
+    (main_dir / "p" / "results.jsonl").write_text(
+        '{"cell": 1, "strategy": "a"}\n{"cell": 1, "strategy": "b"}\n{"cell": 2, "strategy": "b"}\n')
+    seed_baseline(FactorGroup("g", ("p",), "p/results.jsonl", "1", (), strategies=("b",)), out, main_dir)
+    assert (out / "g" / "baseline" / "results.jsonl").read_text() == '{"cell": 1, "strategy": "b"}\n'
 
 
 def test_the_command_line_refuses_an_unknown_group_in_one_line(capsys):

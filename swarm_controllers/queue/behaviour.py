@@ -63,7 +63,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioRep
 from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
-from swarm_controllers.motion import drive_for
+from swarm_controllers.motion import ContinuousDrive, drive_for
 from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.messaging import per_inbox
@@ -141,8 +141,8 @@ class QueueBehaviour:
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
-        "_last", "_layout", "_leave_to", "_line", "_phase", "_query_at", "_to_point",
-        "_retry_at", "_rng", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
+        "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_phase", "_query_at", "_to_point",
+        "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
     )
 
@@ -155,6 +155,9 @@ class QueueBehaviour:
         self._drive = drive_for(scenario, rng)
         """The robot's motion layer, shared with its CPFA (one ``BaseController`` per robot)."""
         self._to_point = self._drive.to_point
+        self._line_drive = ContinuousDrive(scenario) if queue.queued_motion == "continuous" else self._drive
+        """How the robot drives along the queue's lines (`QueueConfig.queued_motion`)."""
+        self._line_to_point = self._line_drive.to_point
         self._center = (float(depot.center[0]), float(depot.center[1]))
         self._R = DockingConfig.of(scenario).perimeter_radius
         self._lane = queue.lane_spacing
@@ -177,6 +180,9 @@ class QueueBehaviour:
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
         )
         self._exit_lines = {line.name for line in self._layout.exit_lines}
+        self._innermost = _innermost_arc(self._cells, self._entry_lines, self._center, self._lane) \
+            if queue.boarding == "innermost" else None
+        """``boarding: innermost``: the innermost arc's cells, as (line, cell index, x, y) arrays."""
         self._front = ray_window(i for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= BRAKE_CONE)
         """The rays of the braking cone."""
         self._brake_range = float(np.float32(BRAKE_RANGE))
@@ -263,7 +269,7 @@ class QueueBehaviour:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
                 self._braked_since = math.inf  # swerved for a second: try the line again
-        elif (phase is _QUEUED or phase is _LEAVING) and self._drive.path_stop(obs.ranges, PATH_CONE):
+        elif (phase is _QUEUED or phase is _LEAVING) and self._line_drive.path_stop(obs.ranges, PATH_CONE):
             linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())
             self._braked_since = min(self._braked_since, obs.t)
         elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:
@@ -416,6 +422,8 @@ class QueueBehaviour:
             return self._to_entry(obs, r, out)
         if obs.t < self._yield_until:
             return 0.0, 0.0
+        if self._innermost is not None:
+            return self._board_innermost(obs, r, out)
         near = bool(np.min(obs.ranges) < self._gamma)
         if near and obs.t >= self._query_at:
             self._query_at = obs.t + QUERY_PERIOD
@@ -438,6 +446,23 @@ class QueueBehaviour:
                 self._goal = None  # looked there: head in again, asking as we go
         return self._to_point(x, y, obs.pose.yaw, gx, gy)
 
+    def _board_innermost(self, obs: Observation, r: float, out: list[object]) -> tuple[float, float]:
+        """``boarding: innermost``: straight in to one lane outside the inner region, then ask for
+        the nearest cell of the innermost arc (the queue authors' Q_ST, `QueueConfig.boarding`)."""
+        if self._join is not None:
+            return self._joining(obs, out)
+        x, y = obs.pose.x, obs.pose.y
+        cx, cy = self._center
+        boundary = self._layout.inner_radius + self._lane
+        if r <= boundary + SLOT_TOLERANCE:
+            if obs.t >= self._retry_at:
+                lines, cells, xy = self._innermost
+                i = int(np.argmin(np.hypot(*(xy - (x, y)).T)))
+                self._request_join(lines[i], int(cells[i]), obs, out)
+                return self._joining(obs, out)
+            return 0.0, 0.0
+        return self._to_point(x, y, obs.pose.yaw, cx + (x - cx) / r * boundary, cy + (y - cy) / r * boundary)
+
     def _joining(self, obs: Observation, out: list[object]) -> tuple[float, float]:
         """Asked to join (line, cell); drive there while the manager answers."""
         if self._join is None:
@@ -446,7 +471,7 @@ class QueueBehaviour:
         tx, ty = self._slots[line][cell]
         if math.hypot(tx - obs.pose.x, ty - obs.pose.y) <= SLOT_TOLERANCE:
             return 0.0, 0.0
-        return self._to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, tx, ty)
+        return self._line_to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, tx, ty)
 
     def _queued(self, obs: Observation, out: list[object]) -> tuple[float, float]:
         x, y = obs.pose.x, obs.pose.y
@@ -473,14 +498,14 @@ class QueueBehaviour:
             if nxt is None:
                 return 0.0, 0.0
             tx, ty = self._slots[nxt[0]][nxt[1]]
-        return self._to_point(x, y, obs.pose.yaw, tx, ty)
+        return self._line_to_point(x, y, obs.pose.yaw, tx, ty)
 
     def _leaving(self, obs: Observation, r: float) -> tuple[float, float]:
         if r >= self._R + KEEP_OUT_BAND + 0.05:
             self._phase = Phase.FORAGING
             self._line, self._cell, self._grant = "", -1, None
             return 0.0, 0.0
-        return self._to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._leave_to)
+        return self._line_to_point(obs.pose.x, obs.pose.y, obs.pose.yaw, *self._leave_to)
 
     # ------------------------------------------------------------------ helpers
 
@@ -514,6 +539,16 @@ class QueueBehaviour:
             if best is None or d[i] < best[0]:
                 best = (float(d[i]), line, i)
         return best[1], best[2]
+
+
+def _innermost_arc(cells: dict, lines: tuple[str, ...], center: tuple[float, float], lane: float) -> tuple:
+    """The entry lines' cells within half a lane of the innermost one's distance from the centre:
+    (line names, cell indices, (n, 2) positions)."""
+    found = [(line, i, xy) for line in lines for i, xy in enumerate(cells[line])]
+    r = np.array([math.hypot(xy[0] - center[0], xy[1] - center[1]) for _, _, xy in found])
+    keep = [k for k in range(len(found)) if r[k] < r.min() + lane / 2]
+    return (tuple(found[k][0] for k in keep), np.array([found[k][1] for k in keep]),
+            np.array([found[k][2] for k in keep], dtype=float))
 
 
 def _segment_hits_disc(p, q, c, radius: float) -> bool:

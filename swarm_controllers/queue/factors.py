@@ -35,10 +35,45 @@ QST_NO_GIVE_UP = Factor("qst_no_give_up", "Q_ST's searcher never gives up (contr
                         ("--strategies", "queue_qst", "--robot-model", "authors", "--set",
                          "controller.queue.seek_timeout=100000"))
 
+# Q_ST at 48 robots bisected against the authors' own code run here (issue 37, item 4;
+# results/reference/queue/results.jsonl: 37.6 % against our 18.4 %): the shipped Q_ST on the authors'
+# robot, then one rule, parameter or set-up fact at a time switched to the authors' (or, for the
+# motion layer as a whole, to the generic robot's, the lead to narrow down). 10 seeds a step.
+QST_BASELINE = Factor("baseline", "the shipped Q_ST on the authors' robot (footbot_cpfa, join_order anywhere: "
+                      "queue_qst.yaml)", ("--robot-model", "authors"))
+QST_MOTION_GENERIC = Factor("motion_generic", "motion rule: the generic robot's (continuous steering, our avoidance "
+                            "and brake) instead of the foot-bot's stop-turn-go, same body and speeds",
+                            ("--robot-model", "generic"))
+QST_DEPARTURE = Factor("cell_release_departure", "moving along the line: a robot's entry-line cell goes to the "
+                       "robot behind once it holds a grant beyond it, which closes up to its path stop "
+                       "(controller.queue.cell_release=departure: the authors' robots follow waypoints with no cells, "
+                       "CPFA-2.0 CPFA_controller::FollowingEntryPath) instead of on its arrival at the next cell",
+                       ("--robot-model", "authors", "--set", "controller.queue.cell_release=departure"))
+QST_INNERMOST = Factor("boarding_innermost", "where a carrier boards: straight in, at the innermost arc's nearest "
+                       "cell, no radio (controller.queue.boarding=innermost: the authors' CPFA-2.0 "
+                       "CPFA_controller::Returning boards the fifth arc, r = 1.0 m) instead of by the queued "
+                       "robots' radio replies on the way in (sec. V-B)",
+                       ("--robot-model", "authors", "--set", "controller.queue.boarding=innermost"))
+QST_QUEUED_CONTINUOUS = Factor("queued_motion_continuous", "the motion lead narrowed: the generic robot's continuous "
+                               "steering and brake on the queue's lines only, the foot-bot's stop-turn-go while "
+                               "foraging and seeking (controller.queue.queued_motion=continuous; a diagnostic, not "
+                               "the authors' rule)",
+                               ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous"))
+
+# Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion step.
+QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
+                      ("--robot-model", "authors"))
+
 GROUPS = (
     FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
                 (BASELINE, MOTION_GENERIC, TURN, STEP, CPFA_DOCKS, QST_JOIN, QST_NO_GIVE_UP)),
     # At 112 robots, where the strategies' order is the paper's headline.
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
                 (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
+    FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
+                (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
+                 QST_QUEUED_CONTINUOUS),
+                strategies=("queue_qst",)),
+    FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
+                (QSE_BASELINE, QST_MOTION_GENERIC), strategies=("queue_qse",)),
 )

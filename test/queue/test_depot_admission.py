@@ -453,6 +453,29 @@ def test_join_order_anywhere_takes_a_free_cell_ahead_of_the_tail():
         DepotAdmission(layout("multi", "small"), join_order="front")
 
 
+def test_cell_release_on_departure_lets_the_follower_close_up():
+    """`QueueConfig.cell_release`: on ``departure`` the robot behind is granted the cell of a robot
+    that holds a grant beyond it (the queue authors' robots follow one another with no cells); on
+    ``arrival`` only once that robot has reported its next cell. The leaver's arrival does not
+    take the cell back from its follower."""
+    grants = {}
+    for release in ("arrival", "departure"):
+        adm = DepotAdmission(layout("multi", "small"), lookahead=2, cell_release=release)
+        assert adm.join("a", "entry_line_0", 5, 0.0) is Refusal.NONE
+        assert adm.join("b", "entry_line_0", 4, 1.0) is Refusal.NONE
+        adm.step(2.0)
+        assert adm.grant("a")[1] > 5
+        adm.step(3.0)
+        grants[release] = adm.grant("b")
+        if release == "departure":
+            adm.arrived("a", "entry_line_0", 6, 4.0)
+            assert adm.join("c", "entry_line_0", 5, 4.0) is Refusal.OCCUPIED
+            adm.arrived("b", "entry_line_0", 5, 5.0)
+    assert grants == {"arrival": ("entry_line_0", 4), "departure": ("entry_line_0", 5)}
+    with pytest.raises(ValueError, match="cell_release"):
+        DepotAdmission(layout("multi", "small"), cell_release="never")
+
+
 def test_join_refusals_and_is_last():
     adm = DepotAdmission(layout("multi", "small"))
     n = len(adm.cells("entry_line_0"))

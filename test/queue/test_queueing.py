@@ -327,3 +327,47 @@ def test_a_tail_seeker_falls_back_to_entry_joining_after_seek_timeout(timeout):
     assert (phases[-1] is Phase.TO_ENTRY) == (timeout < 4.0)
     with pytest.raises(ScenarioError, match="controller.queue.seek_timeout"):
         generic_scenario("queue_qst", ["controller.queue.seek_timeout=0"])
+
+
+def test_innermost_boarding_asks_for_the_innermost_arcs_nearest_cell_and_never_radios():
+    """``controller.queue.boarding=innermost`` (the queue authors' Q_ST): a carrier heads straight
+    in and asks to join the innermost arc at its nearest cell; with ``radio`` it queries first."""
+    from depot_manager.protocol import DepotReport, ReportKind
+    from swarm_sim.registry import make_behaviour
+
+    for boarding in ("innermost", "radio"):
+        s = generic_scenario("queue_qst", ["robots.count=2", f"controller.queue.boarding={boarding}"])
+        b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+        near = np.full(s.sensors.scan.rays, 0.3, dtype=np.float32)  # something within radio range
+        sent = []
+        x = b._layout.inner_radius + b._lane  # at the inner region's boundary, carrying
+        for k in range(20):
+            sent += b.step(Observation("robot_0", k * s.dt_ns, Pose2D(x, 0.0, math.pi), 0.0, 0.0, near,
+                                       ForagingSense((), True))).messages
+        joins = [m for m in sent if isinstance(m, DepotReport) and m.kind is ReportKind.JOIN]
+        queries = [m for m in sent if isinstance(m, RadioQuery)]
+        if boarding == "radio":
+            assert queries
+            continue
+        assert not queries and joins
+        cells = b._cells[joins[0].line]
+        r = np.hypot(*cells.T)
+        assert math.hypot(*cells[joins[0].cell]) < r.min() + b._lane / 2  # on the innermost arc
+        assert math.hypot(cells[joins[0].cell][0] - x, cells[joins[0].cell][1]) < 0.25  # the nearest
+
+
+def test_queued_motion_continuous_drives_the_lines_only_with_the_generic_steering():
+    """``controller.queue.queued_motion`` (a diagnostic): on the foot-bot the queue's lines take the
+    generic robot's continuous drive, foraging keeps the model's stop-turn-go."""
+    from swarm_controllers.motion import ContinuousDrive
+    from swarm_controllers.robots.stop_turn_go import StopTurnGo
+    from swarm_sim.registry import make_behaviour
+
+    for motion, line_drive in (("model", StopTurnGo), ("continuous", ContinuousDrive)):
+        s = generic_scenario("queue_qst", ["robots.count=2", "robots.model=footbot_cpfa",
+                                           f"controller.queue.queued_motion={motion}"])
+        b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+        assert isinstance(b._drive, StopTurnGo) and isinstance(b._line_drive, line_drive)
+        # a continuous drive turns and goes at once; stop-turn-go first stands for its plan
+        lin, ang = b._line_to_point(0.0, 0.0, 0.0, 1.0, 0.3)
+        assert (lin > 0 and ang > 0) == (motion == "continuous")
