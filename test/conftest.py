@@ -17,10 +17,13 @@ os.environ["PYTHONPATH"] = os.pathsep.join([*_PLUGINS, *filter(None, [os.environ
 
 # Before anything imports rclpy: loopback only (sockets bound to 127.0.0.1, launch_py.dds), and
 # a domain reserved for this session (`launch_py.dds.reserve_free_domain`: the lock is held while
-# pytest lives), so concurrent suites and `--domain-id auto` runs never pick it too.
+# pytest lives), so concurrent suites and `--domain-id auto` runs never pick it too. A pytest-xdist
+# worker is a session of its own: it inherits the controller's ROS_DOMAIN_ID, so it reserves a
+# domain of its own (two workers on one domain would hear each other's runs, and the second run
+# on it would refuse to start).
 from launch_py.dds import apply_to_current_process, loopback_env, reserve_free_domain  # noqa: E402
 
-if "ROS_DOMAIN_ID" not in os.environ:
+if "ROS_DOMAIN_ID" not in os.environ or os.environ.get("PYTEST_XDIST_WORKER"):
     _DOMAIN, _RESERVATION = reserve_free_domain()
     os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN)
 
@@ -71,3 +74,8 @@ def pytest_collection_modifyitems(config, items) -> None:
             graph[str(path)] = any(word in text for word in _GRAPH_WORDS)
         if graph[str(path)]:
             item.add_marker(pytest.mark.graph)
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        # Under pytest-xdist (scripts/test), the longest tests first: the `slow` ones, then the
+        # other graph runs, then the rest, so that no worker is left with a long test at the end
+        # while the other has nothing to do. (Each worker collects in this same order.)
+        items.sort(key=lambda item: 0 if item.get_closest_marker("slow") else 1 if item.get_closest_marker("graph") else 2)
