@@ -34,9 +34,7 @@ def test_graph_lockstep_equals_batch(tmp_path):
     assert graph["resources_delivered"] > 0
 
 
-# Never beside test_dds's 40 processes on the other xdist worker: together they would hold the
-# ports 7000-7160 and so the discovery ports of the domains up to 160 (test/conftest.py).
-@pytest.mark.xdist_group("many_participants")
+@pytest.mark.alone  # a hundred DDS processes (test/conftest.py)
 def test_graph_with_a_process_per_robot_equals_batch_at_112_robots(tmp_path):
     """Issue 27's scale: 112 robot processes (the CPFA scenario's swarm, its arena), 10 s: every
     odometry sample the bag holds is the batch run's pose, and the metrics agree."""
