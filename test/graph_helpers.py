@@ -42,11 +42,13 @@ def overrides(items: list[str]) -> list[str]:
 
 
 class Launch:
-    """swarm-run in its own session; `stop` kills whatever is left of its process group."""
+    """swarm-run in its own session; `stop` kills whatever is left of its process group. As in
+    `run_graph`, the world waits up to 20 s for a tick's answers (a test's own ``--tick-timeout``,
+    later on the line, wins): a slow tick on a busy machine is not a stale one."""
 
     def __init__(self, bag: Path, *args: str) -> None:
         self.bag = bag
-        cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json",
+        cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json", "--tick-timeout", "20",
                "--domain-id", os.environ["ROS_DOMAIN_ID"], *args]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                      cwd=REPO, start_new_session=True)

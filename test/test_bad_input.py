@@ -143,11 +143,15 @@ def test_a_taken_discovery_port_is_one_line(tmp_path):
 
     from launch_py import dds
 
-    domain, lock = dds.claim_free_domain()
-    os.close(lock)
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as squatter:  # anyone's, not a run's
-        squatter.bind(("127.0.0.1", dds.discovery_port(domain)))
-        result = run("launch_py.run", "--duration", "1", "--domain-id", str(domain), cwd=tmp_path)
+    # reserved while the test lasts: a concurrent `--domain-id auto` run (another xdist worker's,
+    # another suite's) cannot take the domain before the squatter binds its port
+    domain, reservation = dds.reserve_free_domain()
+    try:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as squatter:  # anyone's, not a run's
+            squatter.bind(("127.0.0.1", dds.discovery_port(domain)))
+            result = run("launch_py.run", "--duration", "1", "--domain-id", str(domain), cwd=tmp_path)
+    finally:
+        os.close(reservation)
     assert_one_line(result, 2, f"domain {domain} is in use", f"port 127.0.0.1:{dds.discovery_port(domain)} is taken",
                     "--domain-id auto")
     assert "[world]" not in result.stdout

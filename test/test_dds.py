@@ -307,6 +307,8 @@ def test_profile_carries_messages_between_two_processes_over_loopback_only() -> 
         assert {ip for ip, _ in _bound_udp([control.pid])} - {"127.0.0.1"}
 
 
+@pytest.mark.alone  # 41 DDS processes (test/conftest.py)
+@pytest.mark.slow
 @pytest.mark.skipif(
     os.environ.get("SWARMFORAGE_SKIP_DDS_SCALE") == "1",
     reason="SWARMFORAGE_SKIP_DDS_SCALE=1 (machine overloaded)",

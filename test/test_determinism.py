@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from graph_helpers import SMALL_ARENA, overrides, run_graph
 
 from swarm_sim.analysis.metrics import summarize
@@ -33,6 +34,7 @@ def test_graph_lockstep_equals_batch(tmp_path):
     assert graph["resources_delivered"] > 0
 
 
+@pytest.mark.alone  # a hundred DDS processes (test/conftest.py)
 def test_graph_with_a_process_per_robot_equals_batch_at_112_robots(tmp_path):
     """Issue 27's scale: 112 robot processes (the CPFA scenario's swarm, its arena), 10 s: every
     odometry sample the bag holds is the batch run's pose, and the metrics agree."""

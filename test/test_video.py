@@ -23,6 +23,7 @@ from swarm_sim.analysis.video import SIZE_PX, WIDTH_PX, render_video, save_frame
 from swarm_sim.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.xdist_group("video")  # one worker makes the module's run (`out_dir`) for all
 
 
 @pytest.fixture(scope="module")

@@ -79,6 +79,7 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["resources_delivered"] > 0
 
 
+@pytest.mark.slow  # 120 lockstep ticks over 20 ms links and a 3 s cut: ~35 s
 @pytest.mark.parametrize("paper", list(PAPERS))
 @shaped
 def test_lossy_links_lockstep_equals_batch(testbed, tmp_path, paper):
@@ -108,6 +109,7 @@ def test_lossy_links_lockstep_equals_batch(testbed, tmp_path, paper):
     assert protocol_messages(run.bag, scenario[0]) > 0  # the protocol went across the links
 
 
+@pytest.mark.slow  # 14 s of sim at 1x real time, and the hosts' set-up
 @shaped
 def test_realtime_partition_stops_the_cut_off_robots(testbed, tmp_path):
     """Realtime at 1x over lossy links, hostb cut off for 3 s: its robots are stopped once their

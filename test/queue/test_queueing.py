@@ -31,6 +31,7 @@ from swarm_sim.world.tasks.foraging import ForagingSense
 
 ROBOTS = 16
 DURATION = 150.0
+pytestmark = pytest.mark.xdist_group("queueing")  # one worker makes the module's runs (`run`) for all
 
 
 @pytest.fixture(scope="module", params=[(name, model) for name in ("queue_qse", "queue_qst", "queue_qme", "queue_qmt")
