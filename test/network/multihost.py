@@ -136,6 +136,7 @@ class MultiHostRun:
                                       stderr=subprocess.PIPE, text=True)
         self.out, self.err = _Lines(self.launcher.stdout), _Lines(self.launcher.stderr)
         self.controllers = {}
+        self.controller_err: dict[str, _Lines] = {}
         for host in self.robots:
             line = self.out.wait_for(f"[swarm-run] on {host}: ", 60)
             words = shlex.split(line.split(": ", 1)[1])
@@ -150,6 +151,7 @@ class MultiHostRun:
                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             finally:
                 os.close(fd)
+            self.controller_err[host] = _Lines(self.controllers[host].stderr)
         self.left: dict[str, tuple[int, float]] = {}
         """Controller host -> (exit code, when it exited [monotonic]), noted as they leave."""
         threading.Thread(target=self._watch_controllers, daemon=True).start()
@@ -167,10 +169,18 @@ class MultiHostRun:
         """Until the run has recorded `seconds` of sim time, noting every host's sockets meanwhile."""
         deadline = time.monotonic() + timeout
         while self.sim_time() < seconds:
-            assert self.launcher.poll() is None, f"swarm-run ended early:\n{self.err.join(1)[-3000:]}"
-            assert time.monotonic() < deadline, f"sim time {self.sim_time()} s after {timeout} s wall"
+            assert self.launcher.poll() is None, f"swarm-run ended early:\n{self.diagnosis()}"
+            assert time.monotonic() < deadline, f"sim time {self.sim_time()} s after {timeout} s wall:\n{self.diagnosis()}"
             self.note_sockets()
             time.sleep(0.2)
+
+    def diagnosis(self) -> str:
+        """What every process of the run has said on stderr so far (the launcher's whole, so a
+        Fast DDS error before a traceback is not cut off), for a failure's message."""
+        parts = [f"--- swarm-run (world host) stderr:\n{''.join(self.err.lines)[-12000:]}"]
+        parts += [f"--- {host}'s swarm-controllers stderr:\n{''.join(lines.lines)[-3000:]}"
+                  for host, lines in self.controller_err.items()]
+        return "\n".join(parts)
 
     def note_sockets(self) -> None:
         for host in HOSTS:
@@ -180,7 +190,7 @@ class MultiHostRun:
         """The run's JSON summary (it must exit 0)."""
         code = self.launcher.wait(timeout)
         out, err = self.out.join(5), self.err.join(5)
-        assert code == 0, f"swarm-run exited {code}:\n{out[-3000:]}\n{err[-3000:]}"
+        assert code == 0, f"swarm-run exited {code}:\n{out[-3000:]}\n{self.diagnosis()}"
         return json.loads(out.strip().splitlines()[-1])
 
     def _watch_controllers(self) -> None:
@@ -200,7 +210,7 @@ class MultiHostRun:
             time.sleep(0.05)
         out = {}
         for host, (code, at) in self.left.items():
-            err = self.controllers[host].stderr.read().strip().splitlines()
+            err = self.controller_err[host].join(5).strip().splitlines()
             out[host] = (code, at - since, err[-1] if err else "")
         return out
 
