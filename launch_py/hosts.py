@@ -49,6 +49,8 @@ ROLES = ("server", "client", "robot", "cli")
 (client), a controller process (client that reads no ROS graph, `dds.robot_profile`), a CLI
 (super client: sees the whole graph)."""
 _SIOCGIFADDR = 0x8915
+_SIOCGIFFLAGS = 0x8913
+_IFF_UP, _IFF_RUNNING = 0x1, 0x40
 
 
 class HostError(ValueError):
@@ -63,6 +65,24 @@ def interface_address(name: str) -> str | None:
         except OSError:
             return None
     return socket.inet_ntoa(packed[20:24])
+
+
+def not_running(address: str) -> str | None:
+    """The name of the interface holding `address` if that interface is not running (down, or up
+    without a carrier yet: the kernel reports a new link's carrier a moment after it is set up),
+    else None. Fast DDS leaves such an interface out of its list, so a participant bound to its
+    address fails to be created ("failed to create participant", no reason given)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for _, name in socket.if_nameindex():
+            if interface_address(name) != address:
+                continue
+            try:
+                packed = fcntl.ioctl(s.fileno(), _SIOCGIFFLAGS, struct.pack("256s", name.encode()[:15]))
+            except OSError:
+                return None
+            flags = struct.unpack_from("H", packed, 16)[0]
+            return None if flags & _IFF_UP and flags & _IFF_RUNNING else name
+    return None
 
 
 def is_local(address: str) -> bool:
@@ -96,6 +116,10 @@ def bind_address(text: str) -> str:
         raise HostError(f"--bind {text}: a multicast or broadcast address cannot be bound")
     if not is_local(str(address)):
         raise HostError(f"--bind {text}: no interface of this host holds {address}")
+    down = not_running(str(address))
+    if down is not None:
+        raise HostError(f"--bind {text}: interface {down} is not running (down, or no carrier): DDS cannot bind "
+                        "its address until the link is up")
     return str(address)
 
 

@@ -175,9 +175,11 @@ class MultiHostRun:
             time.sleep(0.2)
 
     def diagnosis(self) -> str:
-        """What every process of the run has said on stderr so far (the launcher's whole, so a
-        Fast DDS error before a traceback is not cut off), for a failure's message."""
-        parts = [f"--- swarm-run (world host) stderr:\n{''.join(self.err.lines)[-12000:]}"]
+        """What the run's processes have said so far (the launcher's stderr whole, so an error
+        before a traceback is not cut off), for a failure's message."""
+        parts = [f"--- swarm-run (world host) stdout (the nodes' Fast DDS log goes there):\n"
+                 f"{''.join(self.out.lines)[-4000:]}",
+                 f"--- swarm-run (world host) stderr:\n{''.join(self.err.lines)[-12000:]}"]
         parts += [f"--- {host}'s swarm-controllers stderr:\n{''.join(lines.lines)[-3000:]}"
                   for host, lines in self.controller_err.items()]
         return "\n".join(parts)

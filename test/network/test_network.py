@@ -11,12 +11,14 @@ from __future__ import annotations
 import json
 import os
 import signal
+import subprocess
+import sys
 import threading
 import time
 
 import numpy as np
 import pytest
-from multihost import PAPERS, MultiHostRun, batch_differences, flags, protocol_messages, robots_of
+from multihost import PAPERS, REPO, MultiHostRun, batch_differences, flags, node_env, protocol_messages, robots_of
 from netns import Testbed, available, leftovers
 
 from swarm_sim.analysis.replay import load_odometry
@@ -193,3 +195,28 @@ def test_a_killed_world_its_remote_processes_leave_within_the_timeout(testbed, t
     assert run.launcher.wait(60) == 5
     print(f"\n[end times] world SIGKILL, {WORLD_TIMEOUT:g} s timeout: "
           + ", ".join(f"{h} left {a:.1f} s after" for h, (_, a, _) in left.items()))
+
+
+def test_a_bind_on_a_link_without_carrier_is_refused_in_one_line(testbed):
+    """hosta's switch port down (its eth0 up, no carrier): ``--bind`` there gets one line naming the
+    interface, not the traceback of a participant Fast DDS cannot create; with the port up again
+    the address is accepted."""
+    subprocess.run(["ip", "-n", testbed.switch, "link", "set", "hosta", "down"], check=True, timeout=20)
+    probe = [sys.executable, "-c", "from launch_py import hosts; print(hosts.bind_address('eth0'))"]
+    run = [sys.executable, "-m", "launch_py.run", "--bind", "eth0", "--duration", "1"]
+    try:
+        done = testbed.popen("hosta", run, env=node_env(), cwd=REPO, stderr=subprocess.PIPE, text=True)
+        _, err = done.communicate(timeout=60)
+        assert done.returncode == 2 and err.strip().splitlines() == [
+            "swarm-run: --bind eth0: interface eth0 is not running (down, or no carrier): DDS cannot bind its "
+            "address until the link is up"], err
+    finally:
+        subprocess.run(["ip", "-n", testbed.switch, "link", "set", "hosta", "up"], check=True, timeout=20)
+    deadline = time.monotonic() + 30
+    while True:  # the kernel reports the carrier a moment later
+        try:
+            assert testbed.run("hosta", probe, timeout=60).strip() == testbed.address["hosta"]
+            break
+        except RuntimeError:
+            assert time.monotonic() < deadline, "hosta's link not running 30 s after its port came up"
+            time.sleep(0.1)
