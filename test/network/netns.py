@@ -10,7 +10,10 @@ created inside a namespace of the testbed, so no traffic can leave them.
 `Testbed.close` removes what it made by the names it made: it kills every process still inside
 its namespaces (``ip netns pids``) and the process groups it started, then deletes the
 namespaces (their veth pairs go with them). It runs at the end of the fixture whatever happened;
-while a testbed is up, SIGTERM raises SystemExit in the main thread so that it runs then too.
+while a testbed is up, SIGTERM raises KeyboardInterrupt in the main thread, so that it runs then
+too and the test session stops (pytest ends its session on KeyboardInterrupt; a SystemExit would
+only fail the test at hand and go on to the next). A SIGTERM during `close` is held until the
+clean-up is done.
 `available` says why namespaces cannot be made here (not root, no ``ip``), for a skip.
 """
 
@@ -76,7 +79,7 @@ class Testbed:
         self._dir = tempfile.mkdtemp(prefix=f"{self.tag}-")
         self._config = os.path.join(self._dir, "links.json")
         self._emulator: subprocess.Popen | None = None
-        self._sigterm = signal.signal(signal.SIGTERM, _exit_on_sigterm)
+        self._sigterm = signal.signal(signal.SIGTERM, _stop_on_sigterm)
         own = socket.if_nameindex()  # this machine's own namespace: must stay as it is
         try:
             self._add_ns(self.switch)
@@ -191,6 +194,9 @@ class Testbed:
 
     def close(self) -> None:
         """Every process of the testbed killed, every namespace of it deleted (by its name)."""
+        held: list[int] = []
+        if self._sigterm is not None:  # a SIGTERM now waits for the clean-up
+            signal.signal(signal.SIGTERM, lambda *_: held.append(1))
         if self._emulator is not None and self._emulator.poll() is None:
             self._emulator.terminate()  # it writes its counters
             try:
@@ -221,10 +227,12 @@ class Testbed:
         if self._sigterm is not None:
             signal.signal(signal.SIGTERM, self._sigterm)
             self._sigterm = None
+        if held:
+            _stop_on_sigterm()
 
 
-def _exit_on_sigterm(*_: object) -> None:
-    raise SystemExit(143)  # unwinds through the `finally` that closes the testbed
+def _stop_on_sigterm(*_: object) -> None:
+    raise KeyboardInterrupt("SIGTERM")  # unwinds through the `finally` that closes the testbed
 
 
 def leftovers() -> list[str]:
