@@ -122,15 +122,17 @@ def start_echo(testbed: Testbed, server: str, topic: str, count: int, timeout: f
 class MultiHostRun:
     """swarm-run on ``world`` bound to its address, every controller remote (see the module doc)."""
 
-    def __init__(self, testbed: Testbed, tmp: Path, robots: int, *args: str) -> None:
+    def __init__(self, testbed: Testbed, tmp: Path, robots: int, *args: str, domain: int | None = None) -> None:
+        """`domain`: the run's ROS domain (default: the session's, ``ROS_DOMAIN_ID``)."""
         self.tb = testbed
+        domain = int(os.environ["ROS_DOMAIN_ID"]) if domain is None else domain
         self.bag = tmp / "bag"
         self.robots = robots_of(robots)
         key = tmp / "run.key"
         world = testbed.address["world"]
         remote = [a for h, rs in self.robots.items() for a in ("--remote-controllers", f"{h}={','.join(rs)}")]
         cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(self.bag), "--json", "--domain-id",
-               os.environ["ROS_DOMAIN_ID"], "--bind", world, "--key-file", str(key), *remote, "--robots", str(robots),
+               str(domain), "--bind", world, "--key-file", str(key), *remote, "--robots", str(robots),
                *args]
         self.launcher = testbed.popen("world", cmd, env=node_env(), cwd=REPO, stdout=subprocess.PIPE,
                                       stderr=subprocess.PIPE, text=True)
@@ -140,14 +142,15 @@ class MultiHostRun:
         for host in self.robots:
             line = self.out.wait_for(f"[swarm-run] on {host}: ", 60)
             words = shlex.split(line.split(": ", 1)[1])
-            assert words[:3] == [f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']}", "SWARMFORAGE_KEY_FD=3",
+            assert words[:3] == [f"ROS_DOMAIN_ID={domain}", "SWARMFORAGE_KEY_FD=3",
                                  "swarm-controllers"] and words[-1] == f"3<{key}", words
             node_args = [testbed.address[host] if w == "ITS_ADDRESS" else w for w in words[3:-1]]
             fd = os.open(key, os.O_RDONLY)
             try:  # the key as the printed recipe hands it over: an inherited descriptor
                 self.controllers[host] = testbed.popen(
                     host, [sys.executable, "-m", "launch_py.hosts", "controllers", *node_args],
-                    env={**node_env(), "SWARMFORAGE_KEY_FD": str(fd)}, pass_fds=(fd,), cwd=REPO,
+                    env={**node_env(), "ROS_DOMAIN_ID": str(domain), "SWARMFORAGE_KEY_FD": str(fd)}, pass_fds=(fd,),
+                    cwd=REPO,
                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
             finally:
                 os.close(fd)
@@ -155,7 +158,7 @@ class MultiHostRun:
         self.left: dict[str, tuple[int, float]] = {}
         """Controller host -> (exit code, when it exited [monotonic]), noted as they leave."""
         threading.Thread(target=self._watch_controllers, daemon=True).start()
-        self.server = f"{world}:{7000 + int(os.environ['ROS_DOMAIN_ID'])}"
+        self.server = f"{world}:{7000 + domain}"
         self.sockets: dict[str, set[tuple[str, str, str]]] = {h: set() for h in HOSTS}
 
     def echo(self, topic: str, count: int, timeout: float) -> subprocess.Popen:

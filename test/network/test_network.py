@@ -21,10 +21,10 @@ import pytest
 from multihost import PAPERS, REPO, MultiHostRun, batch_differences, flags, node_env, protocol_messages, robots_of
 from netns import Testbed, available, leftovers
 
+from launch_py.dds import reserve_free_domain
+
 from swarm_sim.analysis.replay import load_odometry
 
-MDBSA = ("mdbsa_d", [])
-"""The spiral paper's MDBSA-D (8 x 8 m): robots and its center exchange messages every few ticks."""
 LOSSY = {"loss": 0.05, "delay": 0.020, "jitter": 0.010}
 """Both controller hosts' links, both ways: 5 % loss, 20 +- 10 ms delay (`netns.Testbed.netem`)."""
 
@@ -81,34 +81,71 @@ def test_lockstep_across_hosts_equals_batch_and_a_ros2_echo_joins(testbed, tmp_p
     assert graph["resources_delivered"] > 0
 
 
-@pytest.mark.slow  # 120 lockstep ticks over 20 ms links and a 3 s cut: ~35 s
+LOSSY_RUN = {"robots": 8, "duration": 30.0, "seed": 11}
+"""Each paper's run over lossy links: at 1x real time (``--real-time-factor 1``), so that the four
+runs, started together, are all under way when hostb is cut off (see `lossy_runs`)."""
+
+
+@pytest.fixture(scope="module")
+def lossy_runs(tmp_path_factory):
+    """Every paper of `PAPERS` over lossy links at once: one shaped testbed, a run per paper on a
+    ROS domain of its own, 5 % loss and 20 +- 10 ms delay on both controller hosts' links; once
+    every run has recorded 4 s, hostb cut off for 3 s. The runs share the links, the partition and
+    the two cores (four runs one after the other took 140 s; together ~50 s). Yields paper ->
+    (run, its summary, sim time [s] at the cut's start, at its end, monotonic time it ended)."""
+    why = available()
+    if why is not None:
+        pytest.skip(f"no network namespaces here: {why}")
+    robots, duration, seed = LOSSY_RUN["robots"], LOSSY_RUN["duration"], LOSSY_RUN["seed"]
+    reserved = [reserve_free_domain() for _ in list(PAPERS)[1:]]  # the session's domain, and one each more
+    domains = [int(os.environ["ROS_DOMAIN_ID"]), *(d for d, _ in reserved)]
+    bed = Testbed(("world", "hosta", "hostb", "cli"), shaped=True)
+    try:
+        for host in robots_of(robots):
+            bed.netem(host, **LOSSY)
+        runs = {paper: MultiHostRun(bed, tmp_path_factory.mktemp(paper), robots, *flags(duration, seed, *scenario),
+                                    "--tick-timeout", "20", "--resend-period", "0.1", "--real-time-factor", "1",
+                                    domain=domain)
+                for (paper, scenario), domain in zip(PAPERS.items(), domains)}
+        for run in runs.values():
+            run.wait_sim(4.0, 240)
+        before = {paper: run.sim_time() for paper, run in runs.items()}
+        cut = threading.Thread(target=bed.partition, args=("hostb", 3.0))
+        cut.start()
+        while cut.is_alive():
+            for run in runs.values():
+                run.note_sockets()
+            cut.join(0.5)
+        after = {paper: run.sim_time() for paper, run in runs.items()}
+        out = {}
+        for paper, run in runs.items():
+            graph = run.finish(240)
+            out[paper] = (run, graph, before[paper], after[paper], time.monotonic())
+        yield out
+    finally:
+        bed.close()
+        for _, reservation in reserved:
+            os.close(reservation)
+        assert leftovers() == []
+
+
+@pytest.mark.slow  # four runs of 30 s at 1x real time over 20 ms links, together: ~50 s
 @pytest.mark.parametrize("paper", list(PAPERS))
-@shaped
-def test_lossy_links_lockstep_equals_batch(testbed, tmp_path, paper):
+def test_lossy_links_lockstep_equals_batch(lossy_runs, paper):
     """5 % loss and 20 +- 10 ms delay on both controller hosts' links, and hostb cut off for 3 s
     mid-run, with each paper's server (MDBSA-D's center, the depot manager, DRTM's nest) or peer
     messages (caging) and its protocol: the barrier re-sends unanswered ticks and every node
     waits for its reliable messages to be acknowledged before answering a tick, so the run is
     the batch run of its seed."""
-    robots, duration, seed = 8, 12.0, 11
-    scenario = PAPERS[paper]
-    for host in robots_of(robots):
-        testbed.netem(host, **LOSSY)
-    run = MultiHostRun(testbed, tmp_path, robots, *flags(duration, seed, *scenario), "--tick-timeout", "20",
-                       "--resend-period", "0.1")
-    run.wait_sim(duration / 3, 120)
-    cut = threading.Thread(target=testbed.partition, args=("hostb", 3.0))
-    cut.start()
-    while cut.is_alive():
-        run.note_sockets()
-        cut.join(0.5)
-    graph = run.finish(240)
-    assert_left_with_the_run(run, time.monotonic())
+    run, graph, cut_at, cut_end, ended = lossy_runs[paper]
+    robots, duration, seed = LOSSY_RUN["robots"], LOSSY_RUN["duration"], LOSSY_RUN["seed"]
+    assert 4.0 <= cut_at and cut_end < duration, (cut_at, cut_end)  # the cut fell inside the run
+    assert_left_with_the_run(run, ended)
     assert run.foreign_sockets() == []
     assert graph["run_ended"] == "complete" and graph["stale_ticks"] == 0
     assert graph["by_host"]["hostb"]["resent"] > 0  # the loss and the partition were felt ...
-    assert batch_differences(run.bag, graph, robots, duration, seed, *scenario) == []  # ... and recovered from
-    assert protocol_messages(run.bag, scenario[0]) > 0  # the protocol went across the links
+    assert batch_differences(run.bag, graph, robots, duration, seed, *PAPERS[paper]) == []  # ... and recovered from
+    assert protocol_messages(run.bag, PAPERS[paper][0]) > 0  # the protocol went across the links
 
 
 @pytest.mark.slow  # 14 s of sim at 1x real time, and the hosts' set-up
