@@ -52,6 +52,10 @@ class Recorder:
         """Topics discovery leaves out (the world's relay of robots' messages: copies of topics
         recorded already)."""
         self._latched: set[str] = set()
+        self._offered: set[str] = set()
+        """Topics whose offered QoS a publisher of theirs has reported (`_offer`)."""
+        self._heard: set[str] = set()
+        """Discovered topics a message has arrived on."""
         self.closed = False
 
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
@@ -76,6 +80,10 @@ class Recorder:
         self.write(channel, data)
 
     def _discovered(self, topic: str, data: bytes) -> None:
+        if topic not in self._heard:  # its first message: a publisher is there to ask now (once:
+            self._heard.add(topic)  # a flood of a foreign type must not walk the graph per message)
+            if topic not in self._offered:
+                self._offer(topic, self._node.get_publishers_info_by_topic(topic))
         verdict = True if self._accept is None else self._accept(topic, data)
         if verdict:
             self.write(topic, data)
@@ -110,20 +118,37 @@ class Recorder:
             msg_type = topics.import_type(type_name)
             if msg_type is None:
                 continue
-            latched = any(
-                info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL
-                for info in node.get_publishers_info_by_topic(topic)
-            )
+            publishers = node.get_publishers_info_by_topic(topic)
+            latched = any(info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for info in publishers)
             self._add(topic, type_name, latched)
+            self._offer(topic, publishers)  # while its publishers are there (at the end they may be gone)
             node.create_subscription(
                 msg_type, topic, lambda data, t=topic: self._discovered(t, data),
                 RECORD_LATCHED if latched else EVENTS, raw=True,
             )
 
+    def _offer(self, topic: str, publishers: list) -> None:
+        """Write `topic`'s offered QoS (one profile per publisher, as the graph reports it) and
+        type description hash into the bag, as ``ros2 bag record`` does; no publisher of the
+        topic's recorded type: what was written before stays. Asked when discovery finds the topic
+        (its only endpoint may be a subscriber then), at its first message and at the run's end."""
+        recorded = self._recorded_types.get(topic)
+        infos = [i for i in publishers if i.topic_type == recorded]  # a foreign type's publisher is not the topic's
+        if self.bag is None or not infos:
+            return
+        self._offered.add(topic)
+        depth = published_depth(topic, topic in self._latched)
+        profiles = []
+        for info in infos:
+            profile = rosbag2_profile(info.qos_profile, depth)
+            if profile not in profiles:
+                profiles.append(profile)
+        self.bag.set_offered_qos(topic, profiles, str(infos[0].topic_type_hash))
+
     def record_offered_qos(self, each: Collection[str] = ()) -> None:
-        """Write each topic's offered QoS (one profile per publisher, as the graph reports it) and
-        type description hash into the bag, as ``ros2 bag record`` does; topics without a
-        publisher left keep the profile they were added with. The robots' topics of one name
+        """`_offer` for every topic, at the run's end: topics whose publishers have left (a
+        controller that heard the run's end) keep what discovery wrote, topics the world writes
+        itself without one keep the profile they were added with. The robots' topics of one name
         (``/robot_<i>/odom``, ...) have publishers made by the same code with the same QoS, so the
         graph is asked for one of them for all (each question walks the whole graph: with 1000
         robots, asking for each of ~8,000 topics took minutes at the run's end); a topic in `each`
@@ -138,17 +163,7 @@ class Recorder:
             except Exception:  # noqa: BLE001 - the graph is gone (shutdown): keep the defaults
                 return
             answers[family] = infos
-            recorded = self._recorded_types.get(topic)
-            infos = [i for i in infos if i.topic_type == recorded]  # a foreign type's publisher is not the topic's
-            if not infos:
-                continue
-            depth = published_depth(topic, topic in self._latched)
-            profiles = []
-            for info in infos:
-                profile = rosbag2_profile(info.qos_profile, depth)
-                if profile not in profiles:
-                    profiles.append(profile)
-            self.bag.set_offered_qos(topic, profiles, str(infos[0].topic_type_hash))
+            self._offer(topic, infos)
 
     def poll(self) -> None:
         """Flush and split on time (call it while spinning, even when the run is stalled)."""
