@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -29,8 +30,10 @@ from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, auth, clock, diagnostics, odometry, topics, twist
 from swarm_msgs_py.types import BehaviourStatus, NodeDownEvent, Pose2D
 from swarm_sim.analysis.metrics import summarize
-from swarm_sim.analysis.replay import load_run
+from swarm_sim.analysis.replay import load_odometry, load_run
+from swarm_sim.batch import run_batch
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
+from swarm_sim.scenario import load_scenario
 
 BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
 QUEUE = ("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", *overrides(BUSY_DEPOT))
@@ -322,10 +325,13 @@ def test_an_ack_publisher_present_at_start_does_not_start_the_world_early(launch
     assert summary["nest_food_series"] == expected["nest_food_series"] and np.isfinite(summary["sim_seconds"])
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("discovery", ["server", "simple"])
 def test_a_second_run_on_a_domain_in_use_refuses_before_starting_anything(launch, discovery):
-    first = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE)
+    """The second run refuses in one line and starts nothing; the first, interrupted once the second
+    has left, followed its batch run's path tick by tick up to the interruption and heard nothing
+    foreign. (It runs long and paced, so that it cannot end before the second has tried.)"""
+    first = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, "--duration", "36000",
+                   "--real-time-factor", "10")
     first.wait_until(lambda: first.sim_time() > 1.0, what="the first run under way")
     second = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, bag="second")
     code, summary, err = second.finish(timeout=60)
@@ -333,6 +339,15 @@ def test_a_second_run_on_a_domain_in_use_refuses_before_starting_anything(launch
     (line,) = [x for x in err.splitlines() if x.strip()]
     assert f"domain {domain()} is in use" in line and "--domain-id auto" in line
     assert not second.bag.exists() and not second.children()
+    first.proc.send_signal(signal.SIGINT)
     code, summary, err = first.finish()
-    assert code == 0, err[-3000:]
-    assert_equals_batch(first.bag, QUEUE)
+    assert code == 130, err[-3000:]
+    assert summary["foreign_publishers"] == [] and summary["rejected_messages"] == {}, summary
+    assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0
+    odom = load_odometry(first.bag)
+    ticks = min(len(rows) for rows in odom.values())
+    assert ticks > 10
+    scenario = load_scenario("queue_qmt", BUSY_DEPOT, robots__count=6, sim__duration=ticks * 0.1 + 1.0)
+    poses = run_batch(scenario, record_poses=True).poses
+    for i, rows in enumerate(odom.values()):
+        assert np.array_equal(rows[:ticks, 1:], poses[:ticks, i, :]), f"robot_{i} left the batch path"
