@@ -29,8 +29,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, ReportKi
 from launch_py.dds import discovery_port
 from swarm_msgs_py import ack, auth, clock, diagnostics, odometry, topics, twist
 from swarm_msgs_py.types import BehaviourStatus, NodeDownEvent, Pose2D
-from swarm_sim.analysis.metrics import summarize
-from swarm_sim.analysis.replay import load_odometry, load_run
+from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch
 from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP, STATE_LATCHED
 from swarm_sim.scenario import load_scenario
@@ -38,27 +37,42 @@ from swarm_sim.scenario import load_scenario
 BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
 QUEUE = ("--scenario", "queue_qmt", "--robots", "6", "--duration", "300", *overrides(BUSY_DEPOT))
 """Long enough (~20 s wall) for a late joiner to be matched by every node before the run ends."""
-COMPARED = ("resources_delivered", "trips_by_robot", "oae_by_robot", "collision_time_s_by_robot",
-            "dropoff_times_s", "queue_length_max", "stale_ticks", "dead_nodes")
 
 
 def domain() -> int:
     return int(os.environ["ROS_DOMAIN_ID"])
 
 
-@functools.cache  # the same QUEUE batch run for every test of a worker (read only)
+@functools.cache  # a batch run's summary (read only)
 def batch(*args: str) -> dict:
     out = subprocess.run([sys.executable, "-m", "swarm_sim.batch", *args, "--json"], capture_output=True,
                          text=True, timeout=300, cwd=REPO)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def assert_equals_batch(bag, args: tuple[str, ...]) -> None:
-    """The bag analyses (offline, from its bytes alone) to what the batch runner computes."""
-    analysed, expected = summarize(load_run(bag)), batch(*args)
-    for key in COMPARED:
-        assert analysed.get(key) == expected.get(key), key
-    assert analysed["resources_delivered"] > 0
+LONG = ("--duration", "36000", "--real-time-factor", "10")
+"""Appended to QUEUE: a run that cannot end before the test has what it needs (paced, so that its
+bag stays small and the hostile node gets the CPU); the test interrupts it then (`interrupt`)."""
+
+
+def interrupt(run) -> dict:
+    """Ctrl-C `run` (started with `LONG`); its summary (exit 130: interrupted, the bag closed)."""
+    run.proc.send_signal(signal.SIGINT)
+    code, summary, err = run.finish()
+    assert code == 130 and summary is not None, err[-3000:]
+    return summary
+
+
+def assert_follows_batch(bag) -> None:
+    """The interrupted QUEUE run's robots followed its batch run's path tick by tick up to the
+    interruption (a message that reached a core, or a grant delayed past its tick, changes it)."""
+    odom = load_odometry(bag)
+    ticks = min(len(rows) for rows in odom.values())
+    assert len(odom) == 6 and ticks > 10, (len(odom), ticks)
+    scenario = load_scenario("queue_qmt", BUSY_DEPOT, robots__count=6, sim__duration=ticks * 0.1 + 1.0)
+    poses = run_batch(scenario, record_poses=True).poses
+    for i, rows in enumerate(odom.values()):
+        assert np.array_equal(rows[:ticks, 1:], poses[:ticks, i, :]), f"robot_{i} left the batch path"
 
 
 class Hostile(Node):
@@ -150,19 +164,17 @@ def hostile():
         h.close()
 
 
-@pytest.mark.slow  # a 300 s Q_MT graph run (~20-35 s on an idle machine)
 def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
     """4-byte messages on every sense topic of a robot, an odometry at x = 1e308, a 19 MB array of
-    grants to robot_999 and a RadioQuery at x = 1e308: refused by reason, and the run is the
-    batch run. The sense topics carry no tag, so a foreign publisher there taints the run.
+    grants to robot_999 and a RadioQuery at x = 1e308: refused by reason; no node dies or misses a
+    tick and the run follows its batch run's path until the test interrupts it. The sense topics
+    carry no tag, so a foreign publisher there taints the run.
     The run waits for its reliable messages of a tick to be acknowledged (``SWARMFORAGE_ACK_WAIT``,
     off by default on one host): without it, the flood overflowing the robots' socket buffers
     can delay a real grant past its tick, and the run leaves the batch run's path (the known limit,
     README; seen in about 1 of 3 runs on a busy machine)."""
     monkeypatch.setenv("SWARMFORAGE_ACK_WAIT", "10")
-    # At most 10x real time: 30 s of wall for the forger to be matched by all six robots before
-    # the run ends (unpaced, under load 46, the run ended first and nothing was counted).
-    run = launch("--domain-id", str(domain()), "--real-time-factor", "10", *QUEUE)
+    run = launch("--domain-id", str(domain()), *QUEUE, *LONG)
     h = hostile(run)
     senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
               for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)]
@@ -187,25 +199,24 @@ def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
         **{(f"/robot_0/{name}", "malformed"): 3 for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)},
         ("/robot_0/odom", "out of bounds"): 3, (DEPOT_GRANTS, "too big"): 3 * 6,
         (topics.heard(RADIO_TOPIC), "unauthenticated"): 3})
-    code, summary, err = run.finish()
-    assert code == 6, err[-3000:]
-    assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0 and summary["run_ended"] == "complete"
+    summary = interrupt(run)
+    assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0
+    assert summary["foreign_publishers"], summary  # tainted (exit 6 had it run to its end)
     rejected = summary["rejected_messages"]
     for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER):
         assert rejected[f"/robot_0/{name}"]["malformed"] >= 3
     assert rejected["/robot_0/odom"]["out of bounds"] >= 3
     assert rejected[DEPOT_GRANTS]["too big"] >= 3 * 6  # by each robot, unread
     assert rejected[topics.heard(RADIO_TOPIC)]["unauthenticated"] >= 3
-    assert_equals_batch(run.bag, QUEUE)
+    assert_follows_batch(run.bag)
 
 
-@pytest.mark.slow  # a 300 s Q_MT graph run (~20-35 s on an idle machine)
 def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     """Reports, grants, radio, acks (one from the future), a node_down to the depot, a status
     with 5000 OAEs and fake rejection counts, all as the run's nodes would send them but without
-    the run's tag: refused and counted, the foreign publishers reported; the run is the batch run
-    and exits 0 (nothing it sent could reach a core)."""
-    run = launch("--domain-id", str(domain()), *QUEUE)
+    the run's tag: refused and counted, the foreign publishers reported; the run is not tainted
+    (nothing it sent could reach a core) and follows its batch run's path until interrupted."""
+    run = launch("--domain-id", str(domain()), *QUEUE, *LONG)
     h = hostile(run)
     for topic in (DEPOT_REPORTS, DEPOT_GRANTS, topics.heard(RADIO_TOPIC), topics.WORLD_EVENTS,
                   "/robot_0/status"):
@@ -229,8 +240,7 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
         (DEPOT_REPORTS, "unauthenticated"): 5, (DEPOT_GRANTS, "unauthenticated"): 5 * 6,
         (topics.WORLD_EVENTS, "unauthenticated"): 5, (topics.LOCKSTEP_ACK, "unauthenticated"): 5,
         ("/robot_0/status", "unauthenticated"): 5})
-    code, summary, err = run.finish()
-    assert code == 0, err[-3000:]
+    summary = interrupt(run)
     rejected = summary["rejected_messages"]
     assert rejected[DEPOT_REPORTS]["unauthenticated"] >= 5
     assert rejected[DEPOT_GRANTS]["unauthenticated"] >= 5 * 6
@@ -240,18 +250,18 @@ def test_forged_messages_of_our_own_families_are_refused(launch, hostile):
     assert rejected[DEPOT_REPORTS]["foreign publisher"] == 1  # reported, not tainting
     assert summary["foreign_publishers"] == [] and summary["dead_nodes"] == []
     assert "/radio" not in rejected and max(summary["oae_by_robot"].values()) < 5000
-    assert_equals_batch(run.bag, QUEUE)
+    assert_follows_batch(run.bag)
 
 
-@pytest.mark.slow  # a 300 s Q_MT graph run (~20-35 s on an idle machine)
 def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_taint(launch, hostile):
     """/clock 10^4 s ahead (the depot once stopped acking and the run ended "server depot died"),
     and a std_msgs/String publisher on /clock (its type hash once replaced Clock's in
-    metadata.yaml and rosbags refused the bag): the run is the batch run, tainted (exit 6)."""
+    metadata.yaml and rosbags refused the bag): the run follows its batch run's path until
+    interrupted, tainted."""
     from rosbags.highlevel import AnyReader
     from std_msgs.msg import String
 
-    run = launch("--domain-id", str(domain()), *QUEUE)
+    run = launch("--domain-id", str(domain()), *QUEUE, *LONG)
     h, other = hostile(run), hostile(run, hear_clock=False)  # a participant has one type per topic
     forged = h.publisher(topics.CLOCK, SENSOR_LOCKSTEP)
     strings = other.create_publisher(String, topics.CLOCK, 10)
@@ -262,10 +272,9 @@ def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_
         strings.publish(String(data="tick"))
 
     h.repeat_until_counted(run, send, {(topics.CLOCK, "wrong tick"): 3})  # by the depot manager
-    code, summary, err = run.finish()
-    assert code == 6, err[-3000:]
+    summary = interrupt(run)
     assert any(f.endswith(f"on {topics.CLOCK}") for f in summary["foreign_publishers"])
-    assert summary["dead_nodes"] == [] and summary["run_ended"] == "complete"
+    assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0
     assert summary["rejected_messages"][topics.CLOCK]["wrong tick"] >= 3  # by the depot manager
     meta = yaml.safe_load((run.bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     (clock_topic,) = [t["topic_metadata"] for t in meta["topics_with_message_count"]
@@ -275,8 +284,8 @@ def test_a_clock_from_the_future_and_a_foreign_type_on_clock_change_nothing_but_
     assert clock_topic["type_description_hash"] == _type_hash("rosgraph_msgs/msg/Clock")
     with AnyReader([run.bag]) as reader:  # it refused the bag with String's hash for /clock
         (connection,) = [c for c in reader.connections if c.topic == topics.CLOCK]
-        assert connection.msgtype == "rosgraph_msgs/msg/Clock" and connection.msgcount > 1000
-    assert_equals_batch(run.bag, QUEUE)
+        assert connection.msgtype == "rosgraph_msgs/msg/Clock" and connection.msgcount > 10
+    assert_follows_batch(run.bag)
 
 
 @pytest.mark.slow  # a 300 s Q_MT graph run (~20-35 s on an idle machine)
@@ -329,9 +338,8 @@ def test_an_ack_publisher_present_at_start_does_not_start_the_world_early(launch
 def test_a_second_run_on_a_domain_in_use_refuses_before_starting_anything(launch, discovery):
     """The second run refuses in one line and starts nothing; the first, interrupted once the second
     has left, followed its batch run's path tick by tick up to the interruption and heard nothing
-    foreign. (It runs long and paced, so that it cannot end before the second has tried.)"""
-    first = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, "--duration", "36000",
-                   "--real-time-factor", "10")
+    foreign."""
+    first = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, *LONG)
     first.wait_until(lambda: first.sim_time() > 1.0, what="the first run under way")
     second = launch("--domain-id", str(domain()), "--discovery", discovery, *QUEUE, bag="second")
     code, summary, err = second.finish(timeout=60)
@@ -339,15 +347,7 @@ def test_a_second_run_on_a_domain_in_use_refuses_before_starting_anything(launch
     (line,) = [x for x in err.splitlines() if x.strip()]
     assert f"domain {domain()} is in use" in line and "--domain-id auto" in line
     assert not second.bag.exists() and not second.children()
-    first.proc.send_signal(signal.SIGINT)
-    code, summary, err = first.finish()
-    assert code == 130, err[-3000:]
+    summary = interrupt(first)
     assert summary["foreign_publishers"] == [] and summary["rejected_messages"] == {}, summary
     assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0
-    odom = load_odometry(first.bag)
-    ticks = min(len(rows) for rows in odom.values())
-    assert ticks > 10
-    scenario = load_scenario("queue_qmt", BUSY_DEPOT, robots__count=6, sim__duration=ticks * 0.1 + 1.0)
-    poses = run_batch(scenario, record_poses=True).poses
-    for i, rows in enumerate(odom.values()):
-        assert np.array_equal(rows[:ticks, 1:], poses[:ticks, i, :]), f"robot_{i} left the batch path"
+    assert_follows_batch(first.bag)
