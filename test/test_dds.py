@@ -7,9 +7,11 @@ then SIGKILL (harmless: UDP only, nothing left in /dev/shm). Set
 ``SWARMFORAGE_SKIP_DDS_SCALE=1`` to skip the 40-process test on an overloaded machine.
 
 Run as a script, this file is the child: ``test_dds.py worker INDEX LIFETIME`` publishes
-its index a few times on ``/dds_probe`` and subscribes to it; ``test_dds.py checker
-COUNT TIMEOUT`` subscribes until it has heard indices 0..COUNT-1, prints one JSON line
-and exits. Sockets are inspected on workers only: they live until stdin closes.
+its index a few times on ``/dds_probe`` and subscribes to it; ``test_dds.py workers COUNT
+LIFETIME`` forks COUNT such workers after its imports (indices 0..COUNT-1) and prints their
+pids; ``test_dds.py checker COUNT TIMEOUT`` subscribes until it has heard indices
+0..COUNT-1, prints one JSON line and exits. Sockets are inspected on workers only: they live
+until stdin closes.
 """
 
 from __future__ import annotations
@@ -120,6 +122,37 @@ def _child(role: str, number: int, seconds: float) -> int:
     return 0
 
 
+def _forked_workers(count: int, seconds: float) -> int:
+    """`count` workers forked after the imports, as swarm-run starts a process per robot (a
+    Python start and its imports each were most of the 40-process test's time); prints their
+    pids as one JSON line before any worker prints, then waits for them."""
+    import rclpy  # noqa: F401 - imported once, before the forks
+    import rclpy.executors  # noqa: F401
+    import std_msgs.msg  # noqa: F401
+
+    pids = []
+    for index in range(count):
+        pid = os.fork()
+        if pid == 0:
+            code = 1
+            try:
+                code = _child("worker", index, seconds)
+            finally:
+                os._exit(code)
+        pids.append(pid)
+    print(json.dumps({"pids": pids}), flush=True)
+    for _ in pids:
+        os.wait()
+    return 0
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
 # --------------------------------------------------------------------------- helpers
 
 
@@ -135,6 +168,7 @@ def _spawn(env: Mapping[str, str], role: str, number: int, seconds: float) -> su
         stdout=subprocess.PIPE,
         stderr=log,
         text=True,
+        start_new_session=True,  # `_children` kills the whole group (forked workers too)
     )
     _LOGS[proc.pid] = log
     return proc
@@ -155,7 +189,7 @@ def _children(grace_s: float = 5.0) -> Iterator[list[subprocess.Popen[str]]]:
             try:
                 p.wait(timeout=max(0.1, deadline - time.monotonic()))
             except subprocess.TimeoutExpired:
-                p.kill()  # e.g. stuck in Fast DDS participant deletion
+                os.killpg(p.pid, signal.SIGKILL)  # e.g. stuck in Fast DDS participant deletion
                 p.wait()
             if p.stdout is not None:
                 p.stdout.close()
@@ -319,14 +353,14 @@ def test_profile_discovers_40_processes_over_loopback_only(record_property) -> N
         t0 = time.monotonic()
         # Generous bounds: the checker answers once it has heard all 40 (seconds on an idle machine),
         # and starting 41 Pythons beside a busy machine's load can take minutes.
-        workers = [_spawn(env, "worker", i, 300.0) for i in range(SCALE)]
-        procs.extend(workers)
+        procs.append(forker := _spawn(env, "workers", SCALE, 300.0))
+        workers = _result(forker, timeout=250.0)["pids"]
         procs.append(checker := _spawn(env, "checker", SCALE, 240.0))
         result = _result(checker, timeout=250.0)
         assert result["missing"] == [], result
-        assert all(w.poll() is None for w in workers), "a worker died"
-        _assert_loopback_only([w.pid for w in workers], {_domain(3)})
-        memory = [_memory_mib(w.pid) for w in workers]
+        assert all(_alive(pid) for pid in workers), "a worker died"
+        _assert_loopback_only(workers, {_domain(3)})
+        memory = [_memory_mib(pid) for pid in workers]
     all_heard_s = result["last_heard"] - t0  # includes starting 41 Pythons on this machine
     rss, pss = (sum(m[i] for m in memory) / SCALE for i in (0, 1))
     record_property("all_heard_after_spawn_s", round(all_heard_s, 2))
@@ -341,6 +375,8 @@ def test_profile_discovers_40_processes_over_loopback_only(record_property) -> N
 
 
 if __name__ == "__main__":
+    if sys.argv[1] == "workers":
+        sys.exit(_forked_workers(int(sys.argv[2]), float(sys.argv[3])))
     sys.exit(_child(sys.argv[1], int(sys.argv[2]), float(sys.argv[3])))
 
 
