@@ -4,7 +4,7 @@ bag gives the same metrics as the in-process batch run of the same seed."""
 
 from __future__ import annotations
 
-from graph_helpers import run_graph
+from graph_helpers import overrides, run_graph
 
 from depot_manager.codec import DEPOT, DEPOT_GRANTS, DEPOT_MARKERS, DEPOT_REPORTS, DEPOT_STATE, RADIO_TOPIC
 from depot_manager.protocol import DepotGrant, DepotReport, ReportKind
@@ -17,12 +17,16 @@ from swarm_sim.recording import bag_info, read_bag
 from swarm_sim.scenario import load_scenario
 
 ROBOTS = 16
-DURATION = 150.0  # the foot-bots (as shipped) deliver 2 resources by 120 s, 6 by 150 s (seed 0)
+DURATION = 80.0
+BUSY_DEPOT = ["arena.size=7.0", "resources.distribution=uniform", "resources.count=200"]
+"""A small arena thick with resources: the foot-bots (as shipped, seed 0) deliver 3 by 80 s, with
+up to 15 robots queued at the depot (the paper's arena took 150 s for 6)."""
 
 
 def test_qmt_graph_run_delivers_at_docks_only(tmp_path):
     bag = tmp_path / "qmt"
-    summary = run_graph(bag, "--scenario", "queue_qmt", "--robots", str(ROBOTS), "--duration", str(DURATION))
+    summary = run_graph(bag, "--scenario", "queue_qmt", "--robots", str(ROBOTS), "--duration", str(DURATION),
+                        *overrides(BUSY_DEPOT))
     assert summary["stale_ticks"] == 0, summary
     assert summary["resources_delivered"] >= 3, summary
     assert summary["deliveries_outside_docks"] == 0
@@ -49,7 +53,8 @@ def test_qmt_graph_run_delivers_at_docks_only(tmp_path):
     assert all(len(q) == 4 for q in lengths)
 
     # the same seed in process gives the same run
-    batch = summarize(run_batch(load_scenario("queue_qmt", [f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])).trace)
+    scenario = load_scenario("queue_qmt", [*BUSY_DEPOT, f"robots.count={ROBOTS}", f"sim.duration={DURATION}"])
+    batch = summarize(run_batch(scenario).trace)
     assert summary["authors_collision_time_per_robot_s"] is not None
     for key in ("resources_delivered", "collision_time_per_robot_s", "dropoff_times_s", "perimeter_delay_mean_s",
                 "queue_length_max", "authors_collision_time_per_robot_s", "authors_collision_time_total_min"):
