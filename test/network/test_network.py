@@ -91,8 +91,10 @@ def lossy_runs(tmp_path_factory):
     """Every paper of `PAPERS` over lossy links at once: one shaped testbed, a run per paper on a
     ROS domain of its own, 5 % loss and 20 +- 10 ms delay on both controller hosts' links; once
     every run has recorded 4 s, hostb cut off for 3 s. The runs share the links, the partition and
-    the two cores (four runs one after the other took 140 s; together ~50 s). Yields paper ->
-    (run, its summary, sim time [s] at the cut's start, at its end, monotonic time it ended)."""
+    the two cores (four runs one after the other took 140 s; together ~50 s). Returns paper ->
+    (run, its summary, sim time [s] at the cut's start, at its end, monotonic time it ended),
+    the testbed gone (a module-scoped one would still hold its namespaces' names when the
+    module's next test makes its own)."""
     why = available()
     if why is not None:
         pytest.skip(f"no network namespaces here: {why}")
@@ -121,12 +123,16 @@ def lossy_runs(tmp_path_factory):
         for paper, run in runs.items():
             graph = run.finish(240)
             out[paper] = (run, graph, before[paper], after[paper], time.monotonic())
-        yield out
-    finally:
+        # The controllers leave by themselves (or not) before the testbed goes: it would kill them.
+        deadline = max(ended for *_, ended in out.values()) + LEAVE_WITHIN
+        while time.monotonic() < deadline and any(len(r.left) < len(r.controllers) for r in runs.values()):
+            time.sleep(0.05)
+    finally:  # the testbed goes before the tests: the next tests of the module make their own
         bed.close()
         for _, reservation in reserved:
             os.close(reservation)
-        assert leftovers() == []
+    assert leftovers() == []
+    return out
 
 
 @pytest.mark.slow  # four runs of 30 s at 1x real time over 20 ms links, together: ~50 s
