@@ -92,10 +92,17 @@ SERVER_PREFIX = "44.53.00.5f.45.50.52.4f.53.49.4d.41"
 """GUID prefix of discovery server id 0: the one ``ROS_DISCOVERY_SERVER=127.0.0.1:PORT`` names."""
 
 
+DISCOVERY_PORT_BASE = 6400
+"""A graph's discovery server listens on this + domain (6400-6630): below every domain's RTPS
+ports (7400 + 250 d ...), so concurrent runs on other domains never share it, and below the
+ports every Fast DDS 2.14 participant on the machine binds one each of, counting up from 7000
+(a reader's own listening port): at 7000 + domain, a 112-process run elsewhere on the machine
+took domain 103's port, and every run asking for domain 103 was refused as "in use"."""
+
+
 def discovery_port(domain_id: int) -> int:
-    """The graph's discovery server port: 7000 + domain, below every domain's own ports
-    (7400 + 250 d ...), so concurrent runs on other domains never share it."""
-    return 7000 + domain_id
+    """The graph's discovery server port: `DISCOVERY_PORT_BASE` + domain."""
+    return DISCOVERY_PORT_BASE + domain_id
 
 
 _PROFILE_NS = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"

@@ -4,7 +4,7 @@ By default every process of a run speaks DDS on loopback only (`launch_py.dds`).
 controllers on other machines (a lab's cluster, the robots' own computers), each process is told
 the one address it may use, ``--bind ADDR|INTERFACE``, and where the run's discovery server is,
 ``--discovery-server ADDR:PORT`` (the world node is that server: it serves on its own bind address,
-port 7000 + domain unless told otherwise). Its Fast DDS profile is then the loopback profile with
+port 6400 + domain unless told otherwise). Its Fast DDS profile is then the loopback profile with
 127.0.0.1 replaced by that address everywhere (interface allow-list, unicast and metatraffic
 locators), so every socket binds that address alone: never 0.0.0.0, no multicast, no shared memory.
 
@@ -211,7 +211,7 @@ def run_domain(env: Mapping[str, str] | None = None) -> int:
 
 def resolve(role: str, bind: str | None, server: str | None, domain_id: int) -> tuple[str, tuple[str, int]]:
     """(bind address, discovery server) of a process in `role` from its flags. The server (the
-    world) serves on its own address (port 7000 + domain unless ``--discovery-server`` names
+    world) serves on its own address (port 6400 + domain unless ``--discovery-server`` names
     another port); every other role needs ``--discovery-server``. Without ``--bind``, loopback."""
     address = bind_address(bind) if bind else LOOPBACK
     if role == "server":
@@ -231,7 +231,7 @@ def add_host_arguments(parser: argparse.ArgumentParser) -> None:
                         help="DDS across hosts: bind every socket to this IPv4 address (or the interface's) only "
                              "(default: loopback as the launcher sets it up); needs ROS_DOMAIN_ID")
     parser.add_argument("--discovery-server", metavar="ADDR:PORT",
-                        help="the run's discovery server: the world node's --bind address and port (default 7000 + "
+                        help="the run's discovery server: the world node's --bind address and port (default 6400 + "
                              "domain); required with --bind for every node but the world")
 
 

@@ -5,7 +5,7 @@ depot manager for the queue strategies).
 Controllers run all in one process by default; ``--controller-processes K`` spreads them over
 K processes and ``0`` gives every robot its own process, as on real hardware. DDS stays on
 loopback and on a private domain id (`launch_py.dds`). Discovery goes through the world node, a
-Fast DDS discovery server on 127.0.0.1:7000+domain (peer-to-peer SIMPLE discovery took 120 s to
+Fast DDS discovery server on 127.0.0.1:6400+domain (peer-to-peer SIMPLE discovery took 120 s to
 connect 112 robot processes on 2 cores, the server about a third of that: each process learns
 only of the endpoints of its own topics); ``--discovery simple`` is the peer-to-peer way. Ctrl-C stops every process and still
 leaves a valid bag. Needs no ros2cli or launch: plain subprocesses with the right environment.
@@ -202,7 +202,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f"address the live view binds (default {LOOPBACK}: this machine only)")
     parser.add_argument("--json", action="store_true", help="print the run's summary as JSON")
     parser.add_argument("--bind", metavar="ADDR|IFACE",
-                        help="across hosts: the world (the discovery server, port 7000 + domain), the servers and "
+                        help="across hosts: the world (the discovery server, port 6400 + domain), the servers and "
                              "the local controllers bind this IPv4 address (or the interface's) only, instead of "
                              "loopback (README, *Across hosts*)")
     parser.add_argument("--remote-controllers", type=remote_option, action="append", default=[],

@@ -23,19 +23,9 @@ os.environ["PYTHONPATH"] = os.pathsep.join([*_PLUGINS, *filter(None, [os.environ
 # worker is a session of its own: it inherits the controller's ROS_DOMAIN_ID, so it reserves a
 # domain of its own (two workers on one domain would hear each other's runs, and the second run
 # on it would refuse to start).
-# A worker takes the upper half of the range first: every DDS participant on this machine also
-# binds one 127.0.0.1 port counting up from 7000, so while a hundred are up (the other worker's
-# 112-robot run) the discovery ports of the low domains (7000 + domain) are taken. A serial session
-# keeps the first free domain: with the network stage on an upper-half domain, whose ports lie in
-# Linux's ephemeral range, a world bound in a test host failed to create its participant (2 of 2
-# clean-clone runs; the cause inside Fast DDS not found).
-from launch_py.dds import DOMAIN_RANGE, apply_to_current_process, loopback_env, reserve_free_domain  # noqa: E402
+from launch_py.dds import apply_to_current_process, loopback_env, reserve_free_domain  # noqa: E402
 
-if os.environ.get("PYTEST_XDIST_WORKER"):
-    _HALF = (DOMAIN_RANGE[1] - DOMAIN_RANGE[0]) // 2
-    _DOMAIN, _RESERVATION = reserve_free_domain(first=DOMAIN_RANGE[0] + _HALF + os.getpid() % (_HALF + 1))
-    os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN)
-elif "ROS_DOMAIN_ID" not in os.environ:
+if os.environ.get("PYTEST_XDIST_WORKER") or "ROS_DOMAIN_ID" not in os.environ:
     _DOMAIN, _RESERVATION = reserve_free_domain()
     os.environ["ROS_DOMAIN_ID"] = str(_DOMAIN)
 

@@ -540,3 +540,12 @@ def test_a_reserved_domain_is_never_picked_again_nor_by_auto_but_runs_may_claim_
     again, lock = dds.reserve_free_domain(first=first)  # released with its descriptor
     os.close(lock)
     assert again == first
+
+
+def test_discovery_ports_lie_below_every_port_fast_dds_picks_itself() -> None:
+    """Below 7000, where each Fast DDS 2.14 participant binds a port of its own counting up (a
+    112-process run took 7000-7115, once every discovery port of domains 0-115), and below every
+    domain's RTPS ports (7400 + 250 d + ...): another program's participants never hold one."""
+    ports = [dds.discovery_port(d) for d in range(dds.MAX_DOMAIN_ID + 1)]
+    assert len(set(ports)) == len(ports) and 1024 <= min(ports) and max(ports) < 7000
+    assert max(ports) < min(dds.participant_ports(0, 0))

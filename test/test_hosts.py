@@ -61,7 +61,7 @@ def test_every_role_s_profile_names_only_its_address(role):
 
 
 def test_roles_find_the_server_as_their_flags_say(tmp_path):
-    assert hosts.resolve("server", "lo", None, 150) == ("127.0.0.1", ("127.0.0.1", 7150))
+    assert hosts.resolve("server", "lo", None, 150) == ("127.0.0.1", ("127.0.0.1", 6550))
     with pytest.raises(hosts.HostError, match="on its own --bind address"):
         hosts.resolve("server", "lo", "198.18.0.1:7150", 150)
     with pytest.raises(hosts.HostError, match="needs --discovery-server"):

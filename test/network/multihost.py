@@ -17,6 +17,8 @@ import numpy as np
 from graph_helpers import recorded_sim_time
 from netns import Testbed
 
+from launch_py.dds import discovery_port
+
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
 from swarm_sim.batch import run_batch
@@ -158,7 +160,7 @@ class MultiHostRun:
         self.left: dict[str, tuple[int, float]] = {}
         """Controller host -> (exit code, when it exited [monotonic]), noted as they leave."""
         threading.Thread(target=self._watch_controllers, daemon=True).start()
-        self.server = f"{world}:{7000 + domain}"
+        self.server = f"{world}:{discovery_port(domain)}"
         self.sockets: dict[str, set[tuple[str, str, str]]] = {h: set() for h in HOSTS}
 
     def echo(self, topic: str, count: int, timeout: float) -> subprocess.Popen:

@@ -20,6 +20,7 @@ import pytest
 from multihost import REPO, node_env, start_echo
 from netns import Testbed, available, leftovers
 
+from launch_py.dds import discovery_port
 from swarm_msgs_py.twist import decode_plain_twist
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry, load_run
@@ -39,7 +40,7 @@ def test_a_plain_twist_controller_on_its_own_host_drives_the_robot(tmp_path):
     bag = tmp_path / "bag"
     try:
         world_address = bed.address["world"]
-        server = f"{world_address}:{7000 + int(os.environ['ROS_DOMAIN_ID'])}"
+        server = f"{world_address}:{discovery_port(int(os.environ['ROS_DOMAIN_ID']))}"
         world = bed.popen("world", [sys.executable, "-m", "launch_py.hosts", "world", "--bind", "eth0", *SCENARIO,
                                     "--mode", "realtime", "--plain-twist", "robot_0", "--bag", str(bag), *TURTLEBOT],
                           env=node_env(), cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
