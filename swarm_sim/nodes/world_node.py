@@ -434,12 +434,16 @@ class WorldNode(Node):
         # as World.observe does for the batch runner (rounding twice can move yaw by an ulp).
         poses = self.world.odometry_poses()
         out = []  # (publisher, topic, data), published and recorded in one go
+        senses: dict[int, bytes] = {}  # id(sense) -> its bytes: a task may hand robots that sense alike one reading
         for r, o in obs.items():
             targets = self._obs_targets[r]
+            sense = senses.get(id(o.sensed))
+            if sense is None:
+                sense = senses[id(o.sensed)] = self.sensing.encode(t_ns, o.sensed)
             encoded = {
                 topics.ODOM: odometry.encode_odometry(r, t_ns, poses[r], o.linear_velocity, o.angular_velocity),
                 topics.SCAN: scan.encode_scan(r, t_ns, o.ranges, sc),
-                topics.SENSE: self.sensing.encode(t_ns, o.sensed),
+                topics.SENSE: sense,
             }
             out += [(*targets[name], data) for name, data in encoded.items()]
             self._sent[r] = encoded
