@@ -174,9 +174,8 @@ def check_codecs(algorithm: registry.Algorithm, scenario: Scenario) -> None:
                 states.append((world.t_ns, world.task.state()))
     for obs in (o for step in observations for o in step.values()):
         stamp, sense = sensing.decode(sensing.encode(obs.stamp_ns, obs.sensed))
-        for f in sensing.fields:
-            if stamp != obs.stamp_ns or getattr(sense, f.field) != getattr(obs.sensed, f.field):
-                _fail("codecs", f"sense field {f.field} came back as {getattr(sense, f.field)!r}")
+        if stamp != obs.stamp_ns or sense != obs.sensed:
+            _fail("codecs", f"the sense {obs.sensed!r} stamped {obs.stamp_ns} came back as {sense!r} stamped {stamp}")
     for t_ns, state in states:
         for st in state_topics:
             stamp, value = st.decode(st.encode(t_ns, state[st.field]))
