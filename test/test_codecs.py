@@ -47,14 +47,14 @@ from swarm_msgs_py.types import (
     RobotStats,
 )
 from swarm_sim.nodes.markers import encode_markers, encode_static_markers
-from swarm_sim.world.tasks.foraging import ForagingSense
-from swarm_sim.world.tasks.foraging_sensing import SENSING as FORAGING
 from swarm_sim.scenario import (
     DropZoneConfig,
     ObstacleConfig,
     ScanConfig,
     Scenario,
 )
+from swarm_sim.world.tasks.foraging import ForagingSense
+from swarm_sim.world.tasks.foraging_sensing import SENSING as FORAGING
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 ROBOTS = ["robot_0", "robot_7", "robot_42", "robot_111", "r"]
