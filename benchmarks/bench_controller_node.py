@@ -92,6 +92,9 @@ def main() -> None:
             for sub in node.subscriptions:
                 callbacks[(r, sub.topic_name.rsplit("/", 1)[-1])] = sub.callback
             node._cmd_pub.publish = lambda data, r=r: sent.__setitem__(r, data)  # keep the answer
+        unknown = sorted({name for tick in ticks for _, name, _ in tick} - {name for _, name in callbacks})
+        if unknown:  # a bag of a tree before issue 40's single sense message, say
+            sys.exit(f"{args.bag}: robot topics {unknown} that no controller node reads: record the bag with this tree")
         cpu = 0.0
         for stamp, messages in zip(recorded, ticks):
             sent.clear()

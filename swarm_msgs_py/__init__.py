@@ -12,11 +12,12 @@ Stamps are integer sim-time nanoseconds (``header.stamp`` = the tick). Every dec
 module's docstring gives its field-by-field mapping.
 
 Names and types as data: `topics` (the shared topics: clock, robot observations and commands,
-status, world topics, diagnostics, the lockstep ack); a task's sense topics are declared by its
-`sensing.Sensing` record, each paper's protocol topics by its own codec module (a
-`records.RecordFamily`), a server's state and markers topics, and the run-trace series read off
-what it publishes, with its registry record (`server_outputs`). QoS profiles: `qos`. The topic
-map, every topic with its type, direction and QoS, is docs/topics.md.
+status, world topics, diagnostics, the lockstep ack); a task's sense fields are declared by its
+`sensing.Sensing` record (the whole sense in one message on ``sense``), each paper's protocol
+topics by its own codec module (a `records.RecordFamily`), a server's state and markers topics,
+and the run-trace series read off what it publishes, with its registry record
+(`server_outputs`). QoS profiles: `qos`. The topic map, every topic with its type, direction and
+QoS, is docs/topics.md.
 """
 
 from swarm_msgs_py.cdr import CodecError

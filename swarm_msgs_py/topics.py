@@ -16,12 +16,12 @@ from swarm_msgs_py.types import RobotId
 # Relative names under a robot's namespace.
 ODOM = "odom"
 SCAN = "scan"
-RESOURCES = "resources"
-GRIPPER = "gripper"
+SENSE = "sense"
 CMD_VEL = "cmd_vel"
 STATUS = "status"
-"""Every tick the world publishes ODOM and SCAN to each robot, plus its task's sense topics
-(`swarm_msgs_py.sensing`; foraging: RESOURCES and GRIPPER); a controller steps once it has all of
+OBSERVATIONS = (ODOM, SCAN, SENSE)
+"""Every tick the world publishes these to each robot: odometry, the scan and its task's sense
+(every field of it in one message, `swarm_msgs_py.sensing`); a controller steps once it has all of
 them stamped with the same tick."""
 
 # Absolute names.
@@ -38,8 +38,7 @@ server's channel (`swarm_sim.registry.ServerSpec.channel`)."""
 ROBOT_TOPIC_TYPES: dict[str, str] = {
     ODOM: "nav_msgs/msg/Odometry",
     SCAN: "sensor_msgs/msg/LaserScan",
-    RESOURCES: "geometry_msgs/msg/PoseArray",
-    GRIPPER: "sensor_msgs/msg/JointState",
+    SENSE: "diagnostic_msgs/msg/DiagnosticArray",
     CMD_VEL: "geometry_msgs/msg/TwistStamped",
     STATUS: "diagnostic_msgs/msg/DiagnosticArray",
 }
@@ -112,8 +111,7 @@ def refused(topic: str) -> str:
 
 
 def robot_topic(robot: RobotId, name: str) -> str:
-    """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"`` (any relative name: tasks add
-    their own sense topics)."""
+    """``robot_topic("robot_3", ODOM)`` -> ``"/robot_3/odom"`` (any relative name)."""
     if not name or "/" in name:
         raise ValueError(f"robot topic {name!r}: expected a relative name such as {ODOM!r}")
     return f"/{robot}/{name}"

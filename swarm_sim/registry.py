@@ -87,8 +87,8 @@ class TaskSpec:
     core: str
     """``module:Class``, built as ``Class(world, seeds)`` when the world builds tick 0."""
     sensing: str
-    """``module:SENSING`` (`swarm_msgs_py.sensing.Sensing`): the sense's type and the topic,
-    ROS type and codec of each of its fields."""
+    """``module:SENSING`` (`swarm_msgs_py.sensing.Sensing`): the sense's type and the codec of
+    each of its fields in the sense message."""
     metrics: str | None = None
     """``module:function`` ``(trace) -> dict`` of the task's JSON result fields."""
     state: str | None = None

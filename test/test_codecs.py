@@ -18,20 +18,22 @@ import numpy as np
 import pytest
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point, PointStamped, Pose, PoseArray, Quaternion, TwistStamped
+from geometry_msgs.msg import Point, PointStamped, Quaternion, TwistStamped
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from nav_msgs.msg import Odometry
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.typesys import Stores, get_typestore
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState, LaserScan
+from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Header
 from visualization_msgs.msg import Marker, MarkerArray
 
+from swarm_controllers.caging.sensing import SENSING as CAGING
+from swarm_controllers.caging.task import CagingSense
 from swarm_controllers.cpfa import codec as pheromone
 from swarm_controllers.cpfa.messages import PheromoneMessage
-from swarm_msgs_py import clock, diagnostics, gripper, odometry, resources, scan, twist
+from swarm_msgs_py import clock, diagnostics, odometry, scan, twist
 from swarm_msgs_py import topics as topic_names
 from swarm_msgs_py.cdr import CodecError, Reader, Writer
 from swarm_msgs_py.diagnostics import Status
@@ -51,6 +53,8 @@ from swarm_sim.scenario import (
     ScanConfig,
     Scenario,
 )
+from swarm_sim.world.tasks.foraging import ForagingSense
+from swarm_sim.world.tasks.foraging_sensing import SENSING as FORAGING
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 ROBOTS = ["robot_0", "robot_7", "robot_42", "robot_111", "r"]
@@ -216,88 +220,29 @@ def test_scan_decodes_intensities():
     assert ns == 7 and ranges.tolist() == [1.0, 2.0]
 
 
-# --------------------------------------------------------------------------- resources
+# --------------------------------------------------------------------------- sense
 
 
-def resources_msg(ns, points):
-    return PoseArray(
-        header=header(ns, "world"),
-        poses=[
-            Pose(position=Point(x=x, y=y, z=0.0), orientation=Quaternion(w=1.0))
-            for x, y in points
-        ],
-    )
+def sense_msg(ns, statuses):
+    return DiagnosticArray(header=header(ns, ""), status=[
+        DiagnosticStatus(level=DiagnosticStatus.OK, name=name, values=[KeyValue(key=k, value=v) for k, v in values])
+        for name, values in statuses])
 
 
-@pytest.mark.parametrize("points", [(), ((1.0, 2.0),), ((0.1, -0.2), (3.0, 4.5), (-6.0, 6.0))])
-def test_resources_wire(points):
-    msg = resources_msg(42, points)
-    assert_wire(resources.encode_resources(42, points), msg)
-    assert resources.decode_resources(serialize_message(msg)) == (42, points)
-
-
-@FAST
-@given(STAMPS, st.lists(st.tuples(FINITE, FINITE), max_size=6).map(tuple))
-def test_resources_round_trip(ns, points):
-    assert resources.decode_resources(resources.encode_resources(ns, points)) == (ns, points)
-
-
-def test_resources_decode_with_odd_frame():
-    """Empty or short frames move the pose alignment; the decoder must follow it."""
-    for frame in ["", "a", "abc", "abcdefg"]:
-        for points in [(), ((1.5, 2.5),)]:
-            msg = resources_msg(3, points)
-            msg.header.frame_id = frame
-            assert resources.decode_resources(serialize_message(msg)) == (3, points)
-
-
-# --------------------------------------------------------------------------- gripper
-
-
-@pytest.mark.parametrize("carrying", [False, True])
-def test_gripper_wire(carrying):
-    msg = JointState(header=header(99, ""), name=["gripper"], position=[1.0 if carrying else 0.0])
-    assert_wire(gripper.encode_gripper(99, carrying), msg)
-    assert gripper.decode_gripper(serialize_message(msg)) == (99, carrying)
-
-
-@FAST
-@given(STAMPS, st.booleans())
-def test_gripper_round_trip(ns, carrying):
-    assert gripper.decode_gripper(gripper.encode_gripper(ns, carrying)) == (ns, carrying)
-
-
-@FAST
-@given(STAMPS, st.floats(allow_nan=True), st.binary(min_size=0, max_size=4))
-def test_gripper_fast_path_reads_what_the_general_decoder_reads(ns, position, tail):
-    """The world's layout takes a one-unpack path; it must agree with the general decoder, and
-    any other layout (a longer frame id, extra bytes) must take the general path."""
-    data = bytearray(gripper.encode_gripper(ns, False))
-    data[-16:-8] = struct.pack("<d", position)
-    msg = deserialize_message(bytes(data), JointState)
-    assert gripper.decode_gripper(bytes(data)) == (ns, bool(position > 0.5))
-    assert gripper.decode_gripper(serialize_message(msg)) == (ns, bool(position > 0.5))
-    msg.header.frame_id = "b" * len(tail)
-    assert gripper.decode_gripper(serialize_message(msg)) == (ns, bool(position > 0.5))
-
-
-def test_gripper_fast_path_refuses_a_bad_stamp():
-    data = bytearray(gripper.encode_gripper(5, True))
-    data[8:12] = struct.pack("<I", 10**9)  # nanosec
-    with pytest.raises(CodecError, match="JointState.*nanosec"):
-        gripper.decode_gripper(bytes(data))
-
-
-def test_gripper_finds_its_joint_among_others():
-    msg = JointState(
-        header=header(1, "base"), name=["wheel", "gripper"], position=[3.0, 1.0],
-        velocity=[0.5, 0.0], effort=[],
-    )  # fmt: skip
-    assert gripper.decode_gripper(serialize_message(msg)) == (1, True)
-    msg.name = ["wheel"]
-    msg.position = [1.0]
-    with pytest.raises(CodecError, match="JointState.*gripper"):
-        gripper.decode_gripper(serialize_message(msg))
+@pytest.mark.parametrize("sense, statuses", [
+    (ForagingSense((), False), [("resources", []), ("carrying", [("carrying", "false")])]),
+    (ForagingSense(((0.1, -0.2), (3.0, 4.5)), True),
+     [("resources", [("0", "0.1 -0.2"), ("1", "3.0 4.5")]), ("carrying", [("carrying", "true")])]),
+    (CagingSense(("", "object", "robot_3"), (("object", 1.5, -0.25),)),
+     [("proximity", [("ir_0", ""), ("ir_1", "object"), ("ir_2", "robot_3")]), ("bodies", [("object", "1.5 -0.25")])]),
+])
+def test_sense_wire(sense, statuses):
+    """The sense message is a DiagnosticArray `ros2 topic echo` shows field by field; both our
+    decoder's paths (the world's bytes, rclpy's) read it."""
+    sensing = FORAGING if isinstance(sense, ForagingSense) else CAGING
+    msg = sense_msg(42, statuses)
+    assert_wire(sensing.encode(42, sense), msg)
+    assert sensing.decode(serialize_message(msg)) == (42, sense)
 
 
 # --------------------------------------------------------------------------- twist
@@ -522,11 +467,6 @@ VALID = {
         scan.decode_scan,
         scan.encode_scan("robot_1", 1, np.ones(24), ScanConfig()),
     ),
-    "geometry_msgs/msg/PoseArray": (
-        resources.decode_resources,
-        resources.encode_resources(1, [(1.0, 2.0), (3.0, 4.0)]),
-    ),
-    "sensor_msgs/msg/JointState": (gripper.decode_gripper, gripper.encode_gripper(1, True)),
     "geometry_msgs/msg/TwistStamped": (twist.decode_twist, twist.encode_twist("robot_1", 1, 1, 2)),
     "geometry_msgs/msg/PointStamped": (
         pheromone.decode_pheromone,

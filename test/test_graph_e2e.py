@@ -39,7 +39,7 @@ def test_graph_run_records_a_complete_bag(tmp_path, processes):
     counts = info.message_counts
     assert counts[topics.CLOCK] == TICKS + 1
     for i in range(ROBOTS):
-        for name in ("odom", "scan", "resources", "gripper"):
+        for name in ("odom", "scan", "sense"):
             assert counts[f"/robot_{i}/{name}"] == TICKS + 1, name
         assert counts[f"/robot_{i}/cmd_vel"] == TICKS
         assert counts[f"/robot_{i}/status"] >= 1

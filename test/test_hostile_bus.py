@@ -165,10 +165,10 @@ def hostile():
 
 
 def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
-    """4-byte messages on every sense topic of a robot, an odometry at x = 1e308, a 19 MB array of
-    grants to robot_999 and a RadioQuery at x = 1e308: refused by reason; no node dies or misses a
-    tick and the run follows its batch run's path until the test interrupts it. The sense topics
-    carry no tag, so a foreign publisher there taints the run.
+    """4-byte messages on every observation topic of a robot, an odometry at x = 1e308, a 19 MB
+    array of grants to robot_999 and a RadioQuery at x = 1e308: refused by reason; no node dies or
+    misses a tick and the run follows its batch run's path until the test interrupts it. The
+    observation topics carry no tag, so a foreign publisher there taints the run.
     The run waits for its reliable messages of a tick to be acknowledged (``SWARMFORAGE_ACK_WAIT``,
     off by default on one host): without it, the flood overflowing the robots' socket buffers
     can delay a real grant past its tick, and the run leaves the batch run's path (the known limit,
@@ -177,7 +177,7 @@ def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
     run = launch("--domain-id", str(domain()), *QUEUE, *LONG)
     h = hostile(run)
     senses = [h.publisher(f"/robot_0/{name}", SENSOR_LOCKSTEP)
-              for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)]
+              for name in topics.OBSERVATIONS]
     grants, radio = h.publisher(DEPOT_GRANTS), h.publisher(topics.heard(RADIO_TOPIC))
     h.wait_matched(run)
     h.spin(90, until=lambda: grants.get_subscription_count() >= 6)  # every robot: the flood is sent 3 times only
@@ -196,14 +196,14 @@ def test_no_message_kills_or_stalls_a_node(launch, hostile, monkeypatch):
             floods.append(grants.publish(huge))
 
     h.repeat_until_counted(run, send, {
-        **{(f"/robot_0/{name}", "malformed"): 3 for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)},
+        **{(f"/robot_0/{name}", "malformed"): 3 for name in topics.OBSERVATIONS},
         ("/robot_0/odom", "out of bounds"): 3, (DEPOT_GRANTS, "too big"): 3 * 6,
         (topics.heard(RADIO_TOPIC), "unauthenticated"): 3})
     summary = interrupt(run)
     assert summary["dead_nodes"] == [] and summary["stale_ticks"] == 0
     assert summary["foreign_publishers"], summary  # tainted (exit 6 had it run to its end)
     rejected = summary["rejected_messages"]
-    for name in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER):
+    for name in topics.OBSERVATIONS:
         assert rejected[f"/robot_0/{name}"]["malformed"] >= 3
     assert rejected["/robot_0/odom"]["out of bounds"] >= 3
     assert rejected[DEPOT_GRANTS]["too big"] >= 3 * 6  # by each robot, unread

@@ -18,6 +18,7 @@ from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 from swarm_msgs_py.types import NodeDownEvent
 from swarm_sim.inbound import Inbound, Reason, Rejections, merged, robot_fields
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.tasks.foraging import ForagingSense
 
 DT = 100_000_000
 ROBOTS = ("robot_0", "robot_1")
@@ -196,17 +197,18 @@ def test_observations_are_checked_for_their_tick_and_their_numbers():
     assert ranges((dt, np.array([np.nan] + [1.0] * (rays - 1), np.float32))) is None
     assert ranges((dt, np.array([-0.5] + [1.0] * (rays - 1), np.float32))) is None
     assert ranges((dt, np.ones(rays + 1, np.float32))) is None
-    seen = guard("/r/resources", "value")
-    assert seen((dt, ((1.0, 2.0), (-2.0, 0.5))))
-    assert seen((dt, ((1.0, 2.0), (float("inf"), 0.5)))) is None
-    assert seen((dt, ((1e9, 2.0),))) is None
+    seen = guard("/r/sense", "value")
+    assert seen((dt, ForagingSense(((1.0, 2.0), (-2.0, 0.5)), True)))
+    assert seen((dt, ForagingSense(((1.0, 2.0), (float("inf"), 0.5)), False))) is None
+    assert seen((dt, ForagingSense(((1e9, 2.0),), False))) is None
     assert gate.rejections.counts == {("/r/odom", "out of bounds"): 4, ("/r/odom", "wrong tick"): 3,
-                                      ("/r/scan", "out of bounds"): 3, ("/r/resources", "out of bounds"): 2}
+                                      ("/r/scan", "out of bounds"): 3, ("/r/sense", "out of bounds"): 2}
 
 
 def test_the_sense_guard_decodes_and_checks_in_one_call():
-    from swarm_msgs_py import gripper, odometry, resources, scan
+    from swarm_msgs_py import odometry, scan
     from swarm_msgs_py.types import Pose2D
+    from swarm_sim.world.tasks.foraging_sensing import SENSING
 
     gate, scenario, _ = _guarded()
     dt, sc = scenario.dt_ns, scenario.sensors.scan
@@ -217,8 +219,7 @@ def test_the_sense_guard_decodes_and_checks_in_one_call():
 
     odom = guard("/r/odom", odometry.decode_odometry, "odometry")
     ranges = guard("/r/scan", scan.decode_scan, "scan")
-    seen = guard("/r/resources", resources.decode_resources)
-    grip = guard("/r/gripper", gripper.decode_gripper)
+    seen = guard("/r/sense", SENSING.decode)
     odom(odometry.encode_odometry("robot_0", dt, Pose2D(1.0, 2.0, 0.5), 0.1, 0.0))
     assert got.pop()[0] == dt
     odom(odometry.encode_odometry("robot_0", dt, Pose2D(1e308, 2.0, 0.5), 0.1, 0.0))
@@ -231,12 +232,13 @@ def test_the_sense_guard_decodes_and_checks_in_one_call():
     assert got.pop()[0] == dt
     good[1] = np.nan
     ranges(scan.encode_scan("robot_0", dt, good, sc))
-    seen(resources.encode_resources(dt, [(1.0, 1.0)]))
-    assert got.pop()[0] == dt
-    seen(resources.encode_resources(dt, [(1.0, float("nan"))]))
-    grip(gripper.encode_gripper(dt, True))
-    assert got.pop() == (dt, True) and got == []
-    assert refusals == ["/r/odom"] * 4 + ["/r/scan", "/r/resources"]
+    seen(SENSING.encode(dt, ForagingSense(((1.0, 1.0),), True)))
+    assert got.pop() == (dt, ForagingSense(((1.0, 1.0),), True)) and got == []
+    seen(SENSING.encode(dt, ForagingSense(((1.0, float("nan")),), False)))
+    seen(SENSING.encode(dt, ForagingSense((), True))[:-3])
+    assert got == []
+    assert refusals == ["/r/odom"] * 4 + ["/r/scan"] + ["/r/sense"] * 2
     assert gate.rejections.counts == {("/r/odom", "out of bounds"): 1, ("/r/odom", "wrong tick"): 1,
                                       ("/r/odom", "malformed"): 1, ("/r/odom", "too big"): 1,
-                                      ("/r/scan", "out of bounds"): 1, ("/r/resources", "out of bounds"): 1}
+                                      ("/r/scan", "out of bounds"): 1, ("/r/sense", "out of bounds"): 1,
+                                      ("/r/sense", "malformed"): 1}

@@ -13,7 +13,7 @@ from rclpy.node import Node
 from swarm_controllers.cpfa import codec as pheromone
 from swarm_controllers.cpfa.codec import PHEROMONES, PHEROMONES_TOPIC
 from swarm_controllers.cpfa.messages import PheromoneMessage
-from swarm_msgs_py import diagnostics, gripper, odometry, resources, scan, topics, twist
+from swarm_msgs_py import diagnostics, odometry, scan, topics, twist
 from swarm_msgs_py.types import Pose2D
 from swarm_sim.analysis.replay import load_run
 from swarm_sim.inbound import Reason
@@ -22,6 +22,8 @@ from swarm_sim.nodes.qos import EVENTS, SENSOR_LOCKSTEP
 from swarm_sim.nodes.world_node import WorldNode, WorldNodeConfig
 from swarm_sim.recording import bag_info
 from swarm_sim.scenario import load_scenario
+from swarm_sim.world.tasks.foraging import ForagingSense
+from swarm_sim.world.tasks.foraging_sensing import SENSING
 
 SMALL = ("robots.count=2", "sim.duration=1.0", "arena.size=5.0", "resources.distribution=uniform",
          "resources.count=20", "resources.min_depot_clearance=0.3")
@@ -48,7 +50,7 @@ class ScriptedControllers(Node):
             self.create_subscription(
                 topics.type_of(topics.ODOM), f"/{r}/{topics.ODOM}",
                 lambda data, r=r: self._answer(r, data), SENSOR_LOCKSTEP, raw=True)
-            for name in (topics.SCAN, topics.RESOURCES, topics.GRIPPER):
+            for name in (topics.SCAN, topics.SENSE):
                 self.create_subscription(topics.type_of(name), f"/{r}/{name}", lambda d: None,
                                          SENSOR_LOCKSTEP, raw=True)
         self.policy = policy
@@ -128,8 +130,7 @@ def _observation_bytes(scenario, robot, stamp, carrying=False):
         topics.ODOM: odometry.encode_odometry(robot, stamp, Pose2D(2.0, 0.0, 0.0), 0.0, 0.0),
         topics.SCAN: scan.encode_scan(robot, stamp, np.full(scenario.sensors.scan.rays, np.inf, np.float32),
                                       scenario.sensors.scan),
-        topics.RESOURCES: resources.encode_resources(stamp, ()),
-        topics.GRIPPER: gripper.encode_gripper(stamp, carrying),
+        topics.SENSE: SENSING.encode(stamp, ForagingSense((), carrying)),
     }
 
 
@@ -170,7 +171,7 @@ def test_controller_node_answers_each_tick_and_delivers_messages_a_tick_later(co
     peer.create_subscription(topics.type_of(topics.STATUS), "/robot_0/status",
                              lambda d: statuses.append(diagnostics.decode_status(d)), EVENTS, raw=True)
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
-            for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
+            for n in topics.OBSERVATIONS}
     # the world's relay of what the other robots send, and its end that hears what robot_0 sends:
     # robot_0 answers only once both are matched
     laid = peer.create_publisher(topics.import_type(PHEROMONES.type_name), topics.heard(PHEROMONES_TOPIC), EVENTS)
@@ -296,8 +297,8 @@ def test_a_dead_controllers_robot_stops_instead_of_driving_on_blind(context, tmp
 
 
 def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
-    """Issue 25: a 4-byte message on every sense topic, an odometry at x = 1e308, a scan with a
-    NaN and a 19 MB array on the relay topic, between ticks: the controller answers every tick and
+    """Issue 25: a 4-byte message on every observation topic, an odometry at x = 1e308, a scan
+    with a NaN and a 19 MB array on the relay topic, between ticks: the controller answers every tick and
     counts each by reason."""
     from swarm_msgs_py.diagnostics import OK, encode_diagnostics
 
@@ -311,7 +312,7 @@ def test_no_message_on_any_topic_kills_or_stalls_a_controller(context):
     peer.create_subscription(topics.type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS,
                              lambda d: reports.append(diagnostics.decode_rejections(d)[1]), EVENTS, raw=True)
     pubs = {n: peer.create_publisher(topics.type_of(n), f"/robot_0/{n}", SENSOR_LOCKSTEP)
-            for n in (topics.ODOM, topics.SCAN, topics.RESOURCES, topics.GRIPPER)}
+            for n in topics.OBSERVATIONS}
     laid = peer.create_publisher(topics.import_type(PHEROMONES.type_name), topics.heard(PHEROMONES_TOPIC), EVENTS)
     peer.create_subscription(topics.import_type(PHEROMONES.type_name), PHEROMONES_TOPIC, lambda d: None, EVENTS, raw=True)
     executor = SingleThreadedExecutor(context=context)

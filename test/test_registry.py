@@ -1,6 +1,6 @@
 """The algorithm registry: one record per algorithm, read everywhere; a plug-in algorithm (the
 dummy in test/plugins/dummy_algorithm, an installed package of its own: behaviour, world task and
-sense topic, server, message family, metric and scenario) is found through its entry point and
+its sense, server, message family, metric and scenario) is found through its entry point and
 runs like a shipped paper (its graph == batch check is in test_conformance)."""
 
 from __future__ import annotations

@@ -1,9 +1,14 @@
 """The transport task's sense (`swarm_controllers.caging.task.CagingSense`) and state on the graph.
 
-| topic | type | what |
+The sense travels on ``/<robot>/sense`` (`swarm_msgs_py.sensing`), one status per field:
+
+| status | values |
+|---|---|
+| ``proximity`` | (``ir_k``, id) per sensor k in order; id "" = nothing detected |
+| ``bodies`` | (id, ``"x y"``) per sensed body (``object``, ``robot_3``) [m, world frame] |
+
+| state topic | type | what |
 |---|---|---|
-| ``/<robot>/proximity`` | diagnostic_msgs/msg/DiagnosticArray | one status ``proximity``, values ``(ir_k, id)`` per sensor k in order; id "" = nothing detected |
-| ``/<robot>/bodies`` | diagnostic_msgs/msg/DiagnosticArray | one status per sensed body: name = its id (``object``, ``robot_3``), values ``x``, ``y`` [m, world frame] |
 | ``/caging/object`` | geometry_msgs/msg/PoseStamped | the object's true position (frame ``world``, z = 0, identity orientation) |
 | ``/caging/robots`` | geometry_msgs/msg/PoseArray | every robot's true position in robot order (frame ``world``, z = 0, identity orientations) |
 
@@ -13,14 +18,11 @@ carried: a quaternion does not give a yaw back bit for bit, and the measures nee
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 from swarm_controllers.caging.task import CagingSense
 from swarm_msgs_py.cdr import Reader, Writer, codec
-from swarm_msgs_py.diagnostics import OK, decode_diagnostics, encode_diagnostics
-from swarm_msgs_py.diagnostics import TYPE_NAME as DIAGNOSTICS
-from swarm_msgs_py.sensing import SenseTopic, Sensing, StateTopic
+from swarm_msgs_py.sensing import Pairs, SenseField, Sensing, StateTopic, numbers_text, parse_numbers
 
 PROXIMITY = "proximity"
 BODIES = "bodies"
@@ -34,45 +36,23 @@ Position = tuple[float, float]
 """(x, y) [m, world frame]."""
 
 
-@codec(f"{DIAGNOSTICS} (proximity)")
-def encode_proximity(stamp_ns: int, proximity: Sequence[str]) -> bytes:
-    return encode_diagnostics(stamp_ns, [(OK, PROXIMITY, "", "", [(f"ir_{k}", v) for k, v in enumerate(proximity)])])
+def encode_proximity(proximity: Sequence[str]) -> Pairs:
+    return tuple([(f"ir_{k}", v) for k, v in enumerate(proximity)])
 
 
-@codec(f"{DIAGNOSTICS} (proximity)")
-def decode_proximity(data: bytes) -> tuple[int, tuple[str, ...]]:
-    stamp_ns, statuses = decode_diagnostics(data)
-    if len(statuses) != 1 or statuses[0].name != PROXIMITY:
-        raise ValueError(f"expected one {PROXIMITY!r} status, got {[s.name for s in statuses]}")
-    values = statuses[0].values
-    keys = [k for k, _ in values]
-    if keys != [f"ir_{k}" for k in range(len(values))]:
-        raise ValueError(f"sensor keys {keys[:10]} are not ir_0, ir_1, ... in order")
-    return stamp_ns, tuple(v for _, v in values)
+def decode_proximity(pairs: Pairs) -> tuple[str, ...]:
+    keys = [k for k, _ in pairs]
+    if keys != [f"ir_{k}" for k in range(len(pairs))]:
+        raise ValueError(f"sensor keys {[k[:40] for k in keys[:10]]} are not ir_0, ir_1, ... in order")
+    return tuple([v for _, v in pairs])
 
 
-def _finite(text: str, key: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError(f"{key}: {text!r} is not a finite number")
-    return value
+def encode_bodies(bodies: Sequence[tuple[str, float, float]]) -> Pairs:
+    return tuple([(name, numbers_text((x, y))) for name, x, y in bodies])
 
 
-@codec(f"{DIAGNOSTICS} (bodies)")
-def encode_bodies(stamp_ns: int, bodies: Sequence[tuple[str, float, float]]) -> bytes:
-    return encode_diagnostics(stamp_ns, [(OK, name, "", "", [("x", repr(float(x))), ("y", repr(float(y)))])
-                                         for name, x, y in bodies])
-
-
-@codec(f"{DIAGNOSTICS} (bodies)")
-def decode_bodies(data: bytes) -> tuple[int, tuple[tuple[str, float, float], ...]]:
-    stamp_ns, statuses = decode_diagnostics(data)
-    out = []
-    for s in statuses:
-        if [k for k, _ in s.values] != ["x", "y"]:
-            raise ValueError(f"body {s.name!r}: keys {[k for k, _ in s.values]}, expected ['x', 'y']")
-        out.append((s.name, _finite(s.values[0][1], f"{s.name}.x"), _finite(s.values[1][1], f"{s.name}.y")))
-    return stamp_ns, tuple(out)
+def decode_bodies(pairs: Pairs) -> tuple[tuple[str, float, float], ...]:
+    return tuple([(name, *parse_numbers(text, 2, f"body {name[:40]!r}")) for name, text in pairs])
 
 
 def _write_pose(w: Writer, position: Position) -> None:
@@ -117,10 +97,8 @@ def decode_robots(data: bytes) -> tuple[int, tuple[Position, ...]]:
     return stamp_ns, tuple(_read_pose(r) for _ in range(r.sequence_length(56)))
 
 
-SENSING = Sensing(CagingSense, (
-    SenseTopic(PROXIMITY, DIAGNOSTICS, "proximity", encode_proximity, decode_proximity),
-    SenseTopic(BODIES, DIAGNOSTICS, "bodies", encode_bodies, decode_bodies),
-))
+SENSING = Sensing(CagingSense, (SenseField(PROXIMITY, encode_proximity, decode_proximity),
+                                 SenseField(BODIES, encode_bodies, decode_bodies)))
 
 STATE = (
     StateTopic(OBJECT_TOPIC, POSE_STAMPED, "object", encode_object, decode_object),

@@ -1,7 +1,7 @@
 """A controller node: one robot's behaviour under the robot's namespace.
 
-The node caches the tick's observation messages (odometry, scan and the world task's sense
-topics, `swarm_msgs_py.sensing`) by stamp; when all of them carry the same stamp it builds the
+The node caches the tick's observation messages (odometry, scan and the world task's sense,
+`swarm_msgs_py.sensing`) by stamp; when all of them carry the same stamp it builds the
 `Observation`, hands it the messages
 from other nodes stamped earlier (see `swarm_sim.messaging`), steps the behaviour, publishes
 the behaviour's outgoing messages, its status when it changed, and finally the command stamped
@@ -106,7 +106,6 @@ class ControllerNode(Node):
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
         algorithm = registry.of(self.scenario)
         self.sensing = registry.resolve(registry.task(algorithm.task).sensing)
-        self._sense_topics = tuple((t.field, t.name) for t in self.sensing.topics)
         self._latest: dict[str, tuple[int, object]] = {}
         self._last_status: tuple | None = None
         self._answered_stamp = -1
@@ -115,20 +114,20 @@ class ControllerNode(Node):
         # rclpy runs the earlier subscription first.
         self.endpoint = Endpoint(self, self.scenario, *registry.robot_topics(algorithm))
         guard = self.endpoint.inbound
-        observations = {  # topic -> (type, decoder, the guard's check of its values)
-            topics.ODOM: (topics.ROBOT_TOPIC_TYPES[topics.ODOM], odometry.decode_odometry, "odometry"),
-            topics.SCAN: (topics.ROBOT_TOPIC_TYPES[topics.SCAN], scan.decode_scan, "scan"),
-            **{t.name: (t.type_name, t.decode, "value") for t in self.sensing.topics},
+        observations = {  # topic -> (decoder, the guard's check of its values)
+            topics.ODOM: (odometry.decode_odometry, "odometry"),
+            topics.SCAN: (scan.decode_scan, "scan"),
+            topics.SENSE: (self.sensing.decode, "value"),
         }
         self._expected = len(observations)
         refused = lambda: self.endpoint.report.publish(max(self._answered_stamp, 0), self.behaviour)  # noqa: E731
-        for name, (type_name, decode, kind) in observations.items():
+        for name, (decode, kind) in observations.items():
             # The guard is the callback (size, decode, numbers, tick): nothing from the bus raises
             # in it or reaches the behaviour unchecked; a refusal is reported at once (the robot
             # may not tick again soon).
             deliver = functools.partial(self._on_observation, name)
             guarded = guard.sense_guard(topics.robot_topic(robot, name), decode, kind, deliver, refused)
-            self.create_subscription(topics.import_type(type_name), name, guarded, SENSOR_LOCKSTEP, raw=True)
+            self.create_subscription(topics.type_of(name), name, guarded, SENSOR_LOCKSTEP, raw=True)
         self._cmd_pub = None
         self.watch = watch or RunWatch(self, guard, cfg.world_timeout)
         """The process's watch of its world: the node answers only while its world is current
@@ -185,10 +184,10 @@ class ControllerNode(Node):
             self._stamp_time.set(stamp_ns)
         messages = self.endpoint.take(stamp_ns)
         _, pose, v, w = self._latest[topics.ODOM]
-        sensed = self.sensing.sense(**{field: self._latest[name][1] for field, name in self._sense_topics})
         obs = Observation(
             robot=self.robot, stamp_ns=stamp_ns, pose=pose, linear_velocity=v, angular_velocity=w,
-            ranges=self._latest[topics.SCAN][1], sensed=sensed, messages=messages,
+            ranges=self._latest[topics.SCAN][1], sensed=self._latest[topics.SENSE][1],
+            messages=messages,
         )
         command = self.behaviour.step(obs)
         if command.messages:
@@ -285,10 +284,10 @@ def _warm_up(scenario: Scenario, robot: str, config: ControllerConfig) -> None:
 
     registry.make_behaviour(scenario, robot, behaviour_rng(config.seed, robot))
     algorithm = registry.of(scenario)
-    sensing = registry.resolve(registry.task(algorithm.task).sensing)
+    registry.resolve(registry.task(algorithm.task).sensing)
     inbound, outbound = registry.robot_topics(algorithm)
     names = [*topics.ROBOT_TOPIC_TYPES.values(), topics.type_string(topics.DIAGNOSTICS),
-             *(t.type_name for t in sensing.topics), *(f.type_name for f in (*inbound.values(), *outbound.values()))]
+             *(f.type_name for f in (*inbound.values(), *outbound.values()))]
     services = [getattr(parameter_services, n) for n in ("DescribeParameters", "GetParameterTypes", "GetParameters",
                                                          "ListParameters", "SetParameters", "SetParametersAtomically")]
     for cls in (*(topics.import_type(name) for name in names), ParameterEvent, GetTypeDescription, *services):

@@ -62,19 +62,16 @@ def run_topics(scenario: Scenario) -> dict[str, RunTopic]:
 
     algorithm = registry.of(scenario)
     task = registry.task(algorithm.task)
-    sensing = registry.resolve(task.sensing)
     add(topics.CLOCK, topics.type_string(topics.CLOCK), WORLD)
     for topic in (topics.WORLD_EVENTS, topics.WORLD_ROBOT_STATS, topics.WORLD_MARKERS, topics.DIAGNOSTICS):
         add(topic, topics.type_string(topic), WORLD)
     for st in registry.resolve(task.state) if task.state else ():
         add(st.topic, st.type_name, WORLD)
-    observations = {topics.ODOM: topics.ROBOT_TOPIC_TYPES[topics.ODOM], topics.SCAN: topics.ROBOT_TOPIC_TYPES[topics.SCAN],
-                    **{t.name: t.type_name for t in sensing.topics}}
     inbound, outbound = registry.robot_topics(algorithm)
     for robot in scenario.robot_names:
         controller = (f"/{robot}", CONTROLLER)
-        for name, type_name in observations.items():
-            add(topics.robot_topic(robot, name), type_name, WORLD)
+        for name in topics.OBSERVATIONS:
+            add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], WORLD)
         for name in (topics.CMD_VEL, topics.STATUS):
             add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], controller)
         add(topics.DIAGNOSTICS, topics.type_string(topics.DIAGNOSTICS), controller)

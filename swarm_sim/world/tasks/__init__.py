@@ -6,7 +6,8 @@ additionally senses (its *sense*: one reading per robot and tick, carried by the
 ``Observation.sensed``), the events it emits and its per-step bookkeeping. Foraging
 (`swarm_sim.world.tasks.foraging`) is the first task. Which task a scenario runs is the
 registered algorithm's choice (`swarm_sim.registry`); how a sense travels on the graph (one
-topic per field) is declared next to its codecs in `swarm_msgs_py`.
+message a robot and tick, a status per field) is `swarm_msgs_py.sensing`, and each task's
+`Sensing` record names its fields' codecs.
 
 The hooks, called by the world in this order:
 

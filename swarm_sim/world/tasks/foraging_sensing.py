@@ -1,20 +1,15 @@
-"""The foraging task's sense (`swarm_sim.world.tasks.foraging.ForagingSense`) on the graph.
+"""The foraging task's sense (`swarm_sim.world.tasks.foraging.ForagingSense`) on the graph:
+``/<robot>/sense`` (`swarm_msgs_py.sensing`), one status per field.
 
-| topic | type | field |
-|---|---|---|
-| ``/<robot>/resources`` | geometry_msgs/msg/PoseArray (`resources` codec) | resources within the detection radius, nearest first |
-| ``/<robot>/gripper`` | sensor_msgs/msg/JointState (`gripper` codec) | carrying |
+| status | values |
+|---|---|
+| ``resources`` | pair i: (``"i"``, ``"x y"``) per resource within the detection radius, nearest first [m, world frame] |
+| ``carrying`` | (``carrying``, ``true`` or ``false``) |
 """
 
 from __future__ import annotations
 
-from swarm_msgs_py import gripper, resources, topics
-from swarm_msgs_py.sensing import SenseTopic, Sensing
+from swarm_msgs_py.sensing import Sensing, flag, vectors
 from swarm_sim.world.tasks.foraging import ForagingSense
 
-SENSING = Sensing(ForagingSense, (
-    SenseTopic(topics.RESOURCES, resources.TYPE_NAME, "resources",
-               resources.encode_resources, resources.decode_resources),
-    SenseTopic(topics.GRIPPER, gripper.TYPE_NAME, "carrying",
-               gripper.encode_gripper, gripper.decode_gripper),
-))
+SENSING = Sensing(ForagingSense, (vectors("resources", 2), flag("carrying")))

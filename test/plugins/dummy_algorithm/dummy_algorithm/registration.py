@@ -1,5 +1,5 @@
 """The dummy algorithm's registry record, loaded through its ``swarmforage.algorithms`` entry
-point: its own behaviour, world task (a beacon, sensed on ``/<robot>/beacon``), server (a ping
+point: its own behaviour, world task (a beacon, a field of ``/<robot>/sense``), server (a ping
 counter), message family (``/dummy/pings``) and metric."""
 
 from swarm_sim.registry import Algorithm, Metric, Panel, ServerSpec, TaskSpec, register, register_task
