@@ -196,7 +196,7 @@ class MultiHostRun:
     def finish(self, timeout: float) -> dict:
         """The run's JSON summary (it must exit 0)."""
         code = self.launcher.wait(timeout)
-        out, err = self.out.join(5), self.err.join(5)
+        out, _ = self.out.join(5), self.err.join(5)  # both readers done: the diagnosis holds every line
         assert code == 0, f"swarm-run exited {code}:\n{out[-3000:]}\n{self.diagnosis()}"
         return json.loads(out.strip().splitlines()[-1])
 
