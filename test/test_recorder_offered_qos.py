@@ -92,3 +92,31 @@ def test_a_flood_of_a_foreign_type_asks_the_graph_once(tmp_path):
         graph.callbacks[STATUS[0]](b"\x00\x01\x00\x00")
     assert graph.asked.count(STATUS[0]) == 2
     rec.close()
+
+
+def test_a_topic_the_world_writes_itself_is_offered_once_its_publisher_is_up(tmp_path):
+    """A robot's commands, which the world records itself: their offered QoS is asked at each
+    discovery until a controller's publisher answers (one question per family), and kept when the
+    controllers have left before the end."""
+    graph = FakeGraph()
+    rec = recorder(tmp_path, graph)
+    commands = [f"/robot_{i}/cmd_vel" for i in range(3)]
+    for topic in commands:
+        rec.add(topic, "geometry_msgs/msg/TwistStamped")
+    rec.discover()  # no controller yet
+    assert len(graph.asked) == 1
+    for topic in commands[1:]:  # robot_0's controller never comes
+        graph.publishers[topic] = [SimpleNamespace(topic_type="geometry_msgs/msg/TwistStamped",
+                                                   qos_profile=QoSProfile(history=HistoryPolicy.UNKNOWN, depth=0,
+                                                                          reliability=ReliabilityPolicy.BEST_EFFORT),
+                                                   topic_type_hash="RIHS01_cd")]
+    for _ in range(3):
+        rec.discover()
+    asked = len(graph.asked)
+    rec.discover()
+    assert len(graph.asked) == asked  # offered: not asked again
+    graph.publishers.clear()
+    rec.close()
+    for topic in commands:
+        (profile,) = offered(tmp_path / "bag")[topic]
+        assert (profile["reliability"], profile["depth"]) == ("best_effort", 10), topic

@@ -56,12 +56,32 @@ class Recorder:
         """Topics whose offered QoS a publisher of theirs has reported (`_offer`)."""
         self._heard: set[str] = set()
         """Discovered topics a message has arrived on."""
+        self._own: dict[str, list[str]] = {}
+        """Family (`_ROBOT_NAMESPACE`) -> the topics the world writes itself whose offered QoS no
+        publisher has reported yet (a robot's commands: its controller publishes them)."""
+        self._asked = 0
         self.closed = False
 
     def add(self, topic: str, type_name: str, latched: bool = False) -> None:
         """A topic the world writes itself."""
         self.known.add(topic)
         self._add(topic, type_name, latched)
+        self._own.setdefault(_ROBOT_NAMESPACE.sub("/robot_*/", topic, count=1), []).append(topic)
+
+    def _offer_own(self) -> None:
+        """The offered QoS of the topics the world writes itself, once a publisher of theirs is up
+        (asked again at the run's end, when it may have left): one question per family and call,
+        of its members in turn, so a robot that never connects holds up nothing and 1000 robots
+        cost one question a family."""
+        if self.bag is None:
+            return
+        self._asked += 1
+        for family, members in list(self._own.items()):
+            infos = self._node.get_publishers_info_by_topic(members[self._asked % len(members)])
+            for topic in members:  # the same code made every member's publisher: the same QoS
+                self._offer(topic, infos)
+            if members[0] in self._offered:
+                del self._own[family]
 
     def _add(self, topic: str, type_name: str, latched: bool) -> None:
         self._recorded_types[topic] = type_name
@@ -107,7 +127,9 @@ class Recorder:
                 self.live.write(topic, now, data)
 
     def discover(self, on_new: Callable[[str], None] = lambda topic: None) -> None:
-        """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one."""
+        """Subscribe to every topic not recorded yet; `on_new(topic)` is told of each one. Also
+        writes the offered QoS of the world's own topics whose publishers have come up."""
+        self._offer_own()
         node = self._node
         for topic, types in node.get_topic_names_and_types():
             if topic in self.known or topic in self.skipped or not types:
