@@ -528,7 +528,7 @@ def main(argv: list[str] | None = None) -> int:
     # stops the run promptly wherever it is.
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
-    node = None
+    node = executor = None
     failed = True  # until the run ends as it should (a crash: the others hear "world failed")
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
@@ -560,6 +560,8 @@ def main(argv: list[str] | None = None) -> int:
             node.close()
             if ack_wait() > 0:  # across hosts: until the end reached every reader (lossy links)
                 node.beacon.wait_acknowledged()
+            if executor is not None:  # it lets go of the node's handles before they are destroyed: left
+                executor.shutdown()  # to the interpreter's exit, one world died of SIGSEGV after its run
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
