@@ -16,6 +16,7 @@ import struct
 
 import numpy as np
 import pytest
+from fuzz_helpers import fuzzed
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, PointStamped, Quaternion, TwistStamped
@@ -506,10 +507,7 @@ def test_corrupt_headers_raise_codec_error(type_name):
 def test_fuzzed_bytes_decode_or_raise_codec_error(type_name, data):
     """Any byte string either decodes or raises CodecError: never another exception."""
     decode, valid = VALID[type_name]
-    mutated = bytearray(valid)
-    for _ in range(data.draw(st.integers(1, 4))):
-        mutated[data.draw(st.integers(4, len(valid) - 1))] = data.draw(st.integers(0, 255))
-    for candidate in (bytes(mutated), data.draw(st.binary(max_size=64))):
+    for candidate in fuzzed(valid, data, 64):
         try:
             decode(candidate)
         except CodecError as exc:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import struct
 
 import pytest
+from fuzz_helpers import fuzzed
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -125,10 +126,7 @@ def test_a_value_count_beyond_the_message_is_refused_before_any_value_is_read():
 def test_fuzzed_bytes_decode_or_raise_codec_error(which, data):
     """Any byte string either decodes or raises CodecError naming the type: never another exception."""
     sensing, valid = VALID[which]
-    mutated = bytearray(valid)
-    for _ in range(data.draw(st.integers(1, 4))):
-        mutated[data.draw(st.integers(4, len(valid) - 1))] = data.draw(st.integers(0, 255))
-    for candidate in (bytes(mutated), data.draw(st.binary(max_size=96))):
+    for candidate in fuzzed(valid, data, 96):
         try:
             decoded = sensing.decode(candidate)
         except CodecError as exc:
