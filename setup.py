@@ -43,9 +43,8 @@ setup(
             "ros-jazzy-rmw-fastrtps-cpp",
         ],
         "dask": ["distributed"],  # sweeps on a Dask cluster (--scheduler, --dask-local)
-        # pytest-xdist: `SWARM_TEST_WORKERS=2 scripts/test` runs the suite on two workers (`-n 2
-        # --dist loadgroup`): one test at a time keeps about one of a 2-core machine's cores busy
-        # (~520 CPU s in ~9.5 min; two workers: ~4.5 min).
+        # pytest-xdist: `scripts/test` runs the suite on two workers (`-n 2 --dist loadgroup`): one
+        # test at a time keeps about one of a 2-core machine's cores busy (7 min; two workers: 4.5).
         "test": ["pytest", "pytest-xdist", "hypothesis", "websockets", "distributed"],
         # The documentation site (mkdocs.yml, docs/): MkDocs, the standard, well-kept static site
         # builder for Markdown; its --strict build is a test (test/test_docs.py).

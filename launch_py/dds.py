@@ -28,16 +28,19 @@ from pathlib import Path
 
 PROFILE_PATH = Path(__file__).with_name("fastdds_loopback.xml")
 PROFILE_MAX_PROCESSES = 256
+"""Participants per domain the profile can discover (its maxInitialPeersRange)."""
 MAX_DOMAIN_ID = 230
 """The highest ROS_DOMAIN_ID whose ports the profile can compute: participant 255 of domain d
 uses UDP port 7400 + 250 d + 11 + 2 * 255, which passes 65535 from d = 231 on (Fast DDS then
 fails every participant with "Calculated port number is too high")."""
-"""Participants per domain the profile can discover (its maxInitialPeersRange)."""
-DOMAIN_RANGE = (100, 200)
-"""Inclusive range of private ROS_DOMAIN_IDs (the project's convention, clear of 0).
-A domain owns UDP ports 7400 + 250 * domain + 10 + 2 * participant (+1): above 120
-processes they spill into the next domain's range, and for domains above 101 they lie
-in Linux's ephemeral range; Fast DDS then moves on to a free port (mutation_tries)."""
+DOMAIN_RANGE = (1, 100)
+"""Inclusive range of private ROS_DOMAIN_IDs, clear of 0 (everyone's default): the range ROS 2's
+own test isolation draws from (domain_coordinator: 1-100), inside the "0 to 101" of ROS 2's
+*About Domain ID*. A domain owns UDP ports 7400 + 250 * domain + 10 + 2 * participant (+1), so
+up to 120 processes a domain stay below `EPHEMERAL_FLOOR`: above domain 101 they lie among the
+ports the kernel hands to any socket on the machine, and Fast DDS meets them taken."""
+EPHEMERAL_FLOOR = 32768
+"""The lowest port of Linux's default ephemeral range (net.ipv4.ip_local_port_range)."""
 
 _DROPPED = (
     # Each of these would override or extend the discovery chosen here.

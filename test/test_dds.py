@@ -549,3 +549,12 @@ def test_discovery_ports_lie_below_every_port_fast_dds_picks_itself() -> None:
     ports = [dds.discovery_port(d) for d in range(dds.MAX_DOMAIN_ID + 1)]
     assert len(set(ports)) == len(ports) and 1024 <= min(ports) and max(ports) < 7000
     assert max(ports) < min(dds.participant_ports(0, 0))
+
+
+def test_private_domains_keep_a_hundred_and_twenty_processes_below_the_ephemeral_ports() -> None:
+    """Every port of a 120-process run on any domain of `DOMAIN_RANGE` lies below Linux's ephemeral
+    range, which the kernel hands to any socket on the machine; domain 0 is left to everyone else."""
+    lo, hi = dds.DOMAIN_RANGE
+    assert 0 < lo <= hi
+    assert max(max(dds.participant_ports(d, p)) for d in (lo, hi) for p in range(120)) < dds.EPHEMERAL_FLOOR
+    assert max(dds.participant_ports(hi + 2, 0)) >= dds.EPHEMERAL_FLOOR  # the bound is tight
