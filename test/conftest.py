@@ -65,6 +65,7 @@ def pytest_configure(config) -> None:
     config.addinivalue_line("markers", "alone: under pytest-xdist, never beside another worker's graph test")
 
 
+@pytest.hookimpl(trylast=True)  # after pytest-xdist's own, which marks a group in the test's id
 def pytest_collection_modifyitems(config, items) -> None:
     """`graph` and `network` by module (its text names the graph or it lies in test/network)."""
     graph: dict[str, bool] = {}
@@ -78,6 +79,10 @@ def pytest_collection_modifyitems(config, items) -> None:
         if graph[str(path)]:
             item.add_marker(pytest.mark.graph)
     if os.environ.get("PYTEST_XDIST_WORKER"):
+        ungrouped = [i.nodeid for i in items if i.get_closest_marker("xdist_group") and "@" not in i.nodeid]
+        if config.getvalue("loadgroup") and ungrouped:  # pytest 9.2 with xdist 3.8 (pytest-xdist#1386)
+            raise pytest.UsageError(f"pytest-xdist does not group {ungrouped[0]} (xdist_group) with this pytest: "
+                                    "a module's shared run would be made on every worker; install pytest<9.2")
         # Under pytest-xdist (scripts/test), the longest tests first: the `slow` ones, then the
         # other graph runs, then the rest, so that no worker is left with a long test at the end
         # while the other has nothing to do; the `alone` ones last, when the other worker is on
