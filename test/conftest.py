@@ -63,9 +63,14 @@ def pytest_configure(config) -> None:
     config.addinivalue_line("markers", "network: the network stage (test/network: hosts as network namespaces, root)")
     config.addinivalue_line("markers", "slow: a test of more than ~20 s on an idle 2-core machine")
     config.addinivalue_line("markers", "alone: under pytest-xdist, never beside another worker's graph test")
+    if config.getoption("dist", "no") == "loadgroup" and pytest.version_tuple[:2] >= (9, 2):
+        # pytest 9.2's node ids are structured; pytest-xdist 3.8 still renames `_nodeid` to mark a
+        # group, so every test goes anywhere and each worker makes a module's shared run
+        # (pytest-xdist#1386, open). setup.py asks for pytest<9.2.
+        raise pytest.UsageError(f"pytest {pytest.__version__}: pytest-xdist's --dist loadgroup does not group "
+                                "tests with it (pytest-xdist#1386); install pytest<9.2 (scripts/setup does)")
 
 
-@pytest.hookimpl(trylast=True)  # after pytest-xdist's own, which marks a group in the test's id
 def pytest_collection_modifyitems(config, items) -> None:
     """`graph` and `network` by module (its text names the graph or it lies in test/network)."""
     graph: dict[str, bool] = {}
@@ -79,10 +84,6 @@ def pytest_collection_modifyitems(config, items) -> None:
         if graph[str(path)]:
             item.add_marker(pytest.mark.graph)
     if os.environ.get("PYTEST_XDIST_WORKER"):
-        ungrouped = [i.nodeid for i in items if i.get_closest_marker("xdist_group") and "@" not in i.nodeid]
-        if config.getvalue("loadgroup") and ungrouped:  # pytest 9.2 with xdist 3.8 (pytest-xdist#1386)
-            raise pytest.UsageError(f"pytest-xdist does not group {ungrouped[0]} (xdist_group) with this pytest: "
-                                    "a module's shared run would be made on every worker; install pytest<9.2")
         # Under pytest-xdist (scripts/test), the longest tests first: the `slow` ones, then the
         # other graph runs, then the rest, so that no worker is left with a long test at the end
         # while the other has nothing to do; the `alone` ones last, when the other worker is on
