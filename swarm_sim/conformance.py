@@ -197,8 +197,9 @@ def check_graph_equals_batch(scenario_args: list[str], scenario: Scenario, batch
     cmd = [sys.executable, "-m", "launch_py.run", "--bag", str(bag), "--json", "--tick-timeout", "20",
            "--domain-id", str(domain_id), *scenario_args]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=dict(os.environ))
-    if result.returncode != 0:
-        _fail("graph_equals_batch", f"swarm-run failed: {(result.stderr.strip().splitlines() or ['?'])[-1]}")
+    if result.returncode != 0:  # the last line says why; the lines before it, what the nodes said
+        lines = result.stderr.strip().splitlines() or ["?"]
+        _fail("graph_equals_batch", f"swarm-run failed: {lines[-1]}\n" + "\n".join(lines[-60:-1]))
     graph = json.loads(result.stdout.strip().splitlines()[-1])
     for key in (*GRAPH_COMPARED, *(field for p in registry.probes() for field, _ in p.details)):
         if key not in graph and key not in batch_summary:
