@@ -229,7 +229,7 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
     `teardown=False` leaves without destroying the DDS participant (see `serve_forked`)."""
     rclpy.init(args=["swarm-controllers", *ros_args])
     nodes: list[ControllerNode] = []
-    verdict = None
+    verdict = executor = None
     try:
         executor = make_executor()
         watch = None  # the first node's, shared by the others: one /world/run subscription a process
@@ -256,6 +256,9 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
         pass
     finally:
         if teardown:
+            if executor is not None:  # first, and destroyed (`make_executor`)
+                executor.shutdown()
+                executor = None
             for node in nodes:
                 node.destroy_node()
             rclpy.try_shutdown()

@@ -20,6 +20,15 @@ from rclpy.time_source import USE_SIM_TIME_NAME, TimeSource
 
 
 def make_executor(context: Context | None = None) -> Executor:
+    """rclpy's EventsExecutor (``SWARM_EXECUTOR=single``: the SingleThreadedExecutor).
+
+    Tear down in this order: ``executor.shutdown()``, drop the last reference to the executor
+    (``executor = None``), then destroy the nodes. The EventsExecutor holds its nodes' QoS event
+    handlers open (``with``) for the callbacks it registered or had queued, and lets go of them
+    when it is destroyed: after the nodes, that closes a handler whose publisher is gone, a
+    SIGSEGV (rclpy/event_handler.py ``__exit__``, seen in the world under load with the executor
+    left to the interpreter's exit). A second world, its executor shut down but still alive when
+    its node was destroyed, died of SIGSEGV after its run too (where was not captured)."""
     if os.environ.get("SWARM_EXECUTOR", "events") != "single":
         try:
             from rclpy.experimental import EventsExecutor

@@ -196,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     channel, config, ros_args = parse_args(sys.argv[1:] if argv is None else argv)
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-server", *ros_args])
-    node = None
+    node = executor = None
     verdict = None
     try:
         node = ServerNode(channel, config)
@@ -208,6 +208,9 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        if executor is not None:  # first, and destroyed (`make_executor`)
+            executor.shutdown()
+            executor = None
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

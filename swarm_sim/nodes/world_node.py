@@ -560,8 +560,10 @@ def main(argv: list[str] | None = None) -> int:
             node.close()
             if ack_wait() > 0:  # across hosts: until the end reached every reader (lossy links)
                 node.beacon.wait_acknowledged()
-            if executor is not None:  # it lets go of the node's handles before they are destroyed: left
-                executor.shutdown()  # to the interpreter's exit, one world died of SIGSEGV after its run
+        if executor is not None:  # first, and destroyed (`make_executor`)
+            executor.shutdown()
+            executor = None
+        if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
