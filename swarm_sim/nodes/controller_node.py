@@ -221,6 +221,13 @@ def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str],
     return args.robots, endpoint_config(args), ros_args, args.fork, args.parameter_services, args.plain_twist
 
 
+_KEPT: list = []
+"""What `serve` leaves up when told not to tear down (`serve_forked`'s robot processes, which end
+by ``os._exit``): its executor, if destroyed when `serve` returned, removed its callbacks from
+nodes that were still up, and a C++ exception in its destructor aborted a robot process
+(SIGABRT, a core dump of a loaded test suite)."""
+
+
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
           scenario: Scenario | None = None, parameter_services: bool = True, plain_twist: bool = False,
           say: bool = True) -> int:
@@ -262,6 +269,8 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
             for node in nodes:
                 node.destroy_node()
             rclpy.try_shutdown()
+        else:
+            _KEPT.extend((executor, *nodes))  # up until the caller's os._exit (`_KEPT`)
     if verdict is None:
         return 0
     code, why = verdict

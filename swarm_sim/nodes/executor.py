@@ -27,8 +27,7 @@ def make_executor(context: Context | None = None) -> Executor:
     handlers open (``with``) for the callbacks it registered or had queued, and lets go of them
     when it is destroyed: after the nodes, that closes a handler whose publisher is gone, a
     SIGSEGV (rclpy/event_handler.py ``__exit__``, seen in the world under load with the executor
-    left to the interpreter's exit). A second world, its executor shut down but still alive when
-    its node was destroyed, died of SIGSEGV after its run too (where was not captured)."""
+    left to the interpreter's exit). The world itself no longer tears down (`lifetime.leave`)."""
     if os.environ.get("SWARM_EXECUTOR", "events") != "single":
         try:
             from rclpy.experimental import EventsExecutor

@@ -47,7 +47,10 @@ FIRST_HEARD_WAIT = 300.0
 """Wall seconds a process waits to hear its world a first time (the world starts, builds its
 scene, or is started after the controllers) before it leaves (world vanished)."""
 END_ACK_WAIT = 5.0
-"""Wall seconds the world waits for every reader to acknowledge the run's end."""
+"""Wall seconds the world waits for every reader to acknowledge the run's end (across hosts)."""
+END_ACK_WAIT_HERE = 1.0
+"""The same on one host (loopback: acknowledged within milliseconds; a reader whose process was
+killed holds it until then)."""
 RUN_STATE_BYTES = 256
 """Cap on a ``/world/run`` message [bytes]."""
 VANISHED = 5

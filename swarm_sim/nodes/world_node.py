@@ -47,12 +47,13 @@ from swarm_sim.cli import first_paragraph, number
 from swarm_sim.inbound import Bounds, Inbound, Reason, Rejections
 from swarm_sim.nodes.command_watch import CommandWatch
 from swarm_sim.nodes.executor import make_executor
+from swarm_sim.nodes.lifetime import leave
 from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.endpoint import ack_wait
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.peer_relay import PeerRelay
 from swarm_sim.nodes.qos import SENSOR_LOCKSTEP
-from swarm_sim.nodes.run_watch import RunBeacon
+from swarm_sim.nodes.run_watch import END_ACK_WAIT, END_ACK_WAIT_HERE, RunBeacon
 from swarm_sim.nodes.status_watch import StatusWatch
 from swarm_sim.nodes.taint import ForeignWatch
 from swarm_sim.nodes.world_loop import Interrupted, WorldLoop
@@ -528,7 +529,7 @@ def main(argv: list[str] | None = None) -> int:
     # stops the run promptly wherever it is.
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
-    node = executor = None
+    node = None
     failed = True  # until the run ends as it should (a crash: the others hear "world failed")
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
@@ -558,15 +559,9 @@ def main(argv: list[str] | None = None) -> int:
         if node is not None:
             node.beacon.end("world failed" if failed else node.ended)  # every other process of the run leaves on it
             node.close()
-            if ack_wait() > 0:  # across hosts: until the end reached every reader (lossy links)
-                node.beacon.wait_acknowledged()
-        if executor is not None:  # first, and destroyed (`make_executor`)
-            executor.shutdown()
-            executor = None
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+            # until the end reached every reader: the participant goes with the process (`leave`)
+            node.beacon.wait_acknowledged(END_ACK_WAIT if ack_wait() > 0 else END_ACK_WAIT_HERE)
+    leave(0)  # no teardown of the node, its executor or the discovery server (`lifetime.leave`)
 
 
 if __name__ == "__main__":
