@@ -223,9 +223,8 @@ def parse_args(argv: list[str]) -> tuple[list[str], ControllerConfig, list[str],
 
 _KEPT: list = []
 """What `serve` leaves up when told not to tear down (`serve_forked`'s robot processes, which end
-by ``os._exit``): its executor, if destroyed when `serve` returned, removed its callbacks from
-nodes that were still up, and a C++ exception in its destructor aborted a robot process
-(SIGABRT, a core dump of a loaded test suite)."""
+by ``os._exit``): destroyed when `serve` returned, its executor threw a C++ exception in its
+destructor and aborted a robot process (SIGABRT; a core dump of a loaded test suite)."""
 
 
 def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, teardown: bool = True,
