@@ -105,6 +105,18 @@ def default_bag_dir(out: Path, scenario: Scenario) -> Path:
     return out / f"{scenario.name}_{scenario.robots.count}r_s{scenario.seed}_{stamp}"
 
 
+LEAVE_GRACE = 10.0
+"""Wall seconds the other nodes get to leave by themselves once the world has ended its run (they
+hear the end on ``/world/run``) before they are stopped."""
+
+
+def _wait_left(procs: list[subprocess.Popen], seconds: float) -> None:
+    """Until every process of `procs` has exited, `seconds` at most."""
+    deadline = time.monotonic() + seconds
+    while any(p.poll() is None for p in procs) and time.monotonic() < deadline:
+        time.sleep(0.05)
+
+
 def _stop(procs: list[subprocess.Popen], grace: float) -> None:
     for p in procs:
         if p.poll() is None:
@@ -440,6 +452,8 @@ def run_processes(args: argparse.Namespace, cmds: Commands, envs: Environments, 
         print("[swarm-run] stopping: the world first (it closes the bag), then the other nodes", flush=True)
         _stop([world] if world else [], grace=60.0)
     finally:
+        if not interrupted and world is not None and world.poll() is not None:
+            _wait_left([p for _, p in children], LEAVE_GRACE)  # a SIGINT would cut their own leaving short
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
         shutil.rmtree(envs.profiles, ignore_errors=True)

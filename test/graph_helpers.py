@@ -34,6 +34,7 @@ def run_graph(bag: Path, *args: str, timeout: float = 300.0) -> dict:
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
                             cwd=Path(__file__).resolve().parents[1])
     assert result.returncode == 0, f"swarm-run failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    assert "Traceback" not in result.stderr, result.stderr[-3000:]  # no node leaves a run with one
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 

@@ -262,6 +262,7 @@ def serve(robots: list[str], config: ControllerConfig, ros_args: list[str], *, t
         pass
     finally:
         if teardown:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)  # the run is over: a Ctrl-C now only cuts the teardown
             if executor is not None:  # first, and destroyed (`make_executor`)
                 executor.shutdown()
                 executor = None

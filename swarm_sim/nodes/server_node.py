@@ -27,6 +27,7 @@ the world, which waits for that publisher before the first tick, cannot start to
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 
@@ -208,6 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # the run is over: a Ctrl-C now only cuts the teardown
         if executor is not None:  # first, and destroyed (`make_executor`)
             executor.shutdown()
             executor = None
