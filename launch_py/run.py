@@ -452,8 +452,9 @@ def run_processes(args: argparse.Namespace, cmds: Commands, envs: Environments, 
         print("[swarm-run] stopping: the world first (it closes the bag), then the other nodes", flush=True)
         _stop([world] if world else [], grace=60.0)
     finally:
-        if not interrupted and world is not None and world.poll() is not None:
-            _wait_left([p for _, p in children], LEAVE_GRACE)  # a SIGINT would cut their own leaving short
+        if not interrupted and world is not None and world.poll() is not None and world.returncode >= 0:
+            # the world ended the run and said so: a SIGINT would cut the others' own leaving short
+            _wait_left([p for _, p in children], LEAVE_GRACE)
         _stop([p for _, p in children], grace=10.0)
         _stop([world] if world else [], grace=60.0)
         shutil.rmtree(envs.profiles, ignore_errors=True)
