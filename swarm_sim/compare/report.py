@@ -197,6 +197,7 @@ def boxplot_figure(
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4.5), squeeze=False)
+    legend: dict[str, Any] = {}  # label -> handle, over every panel
     for ax, (metric, ylabel) in zip(axes[0], panels):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # notches wider than the box with few runs
@@ -211,11 +212,18 @@ def boxplot_figure(
             extra += [handle] if handle else []
         handle = code_marks(ax, _REFERENCE.get(), metric, list(cells), list(strategies))
         extra += [handle] if handle else []
-        if extra:
-            boxes = ax.get_legend()  # grouped_boxplot's strategies, kept beside the paper's
-            ax.legend(handles=[*(boxes.legend_handles if boxes else []), *extra], fontsize="small")
+        boxes = ax.get_legend()  # grouped_boxplot's strategies, then the paper's and the authors' marks
+        for handle in [*(boxes.legend_handles if boxes else []), *extra]:
+            legend.setdefault(handle.get_label(), handle)
+        if boxes:
+            boxes.remove()
     fig.suptitle(title)
-    fig.tight_layout()
+    # One legend for the figure, under the panels: inside an axes, it hid the first cells' boxes.
+    ncol = min(len(legend), 3 * len(panels))
+    rows = -(-len(legend) // max(ncol, 1))
+    if legend:
+        fig.legend(handles=list(legend.values()), fontsize="small", loc="lower center", ncol=ncol, frameon=False)
+    fig.tight_layout(rect=(0, 0.07 * rows, 1, 1))
     save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
