@@ -78,6 +78,12 @@ EXIT_CODES = {
 
 
 
+PARAMETER_SERVICES_UP_TO = 128
+"""Robots up to which the controller nodes serve ``ros2 param`` by default: every swarm of the
+papers (at most 112 robots). Beyond, their twelve DDS endpoints a robot are most of a start-up's
+discovery (issue 40, lever 4: 1000 robots in 4 processes took 38 s to connect with them, 20 s
+without; 112 robots, a process each, showed no difference beyond the noise), and listing the
+parameters of hundreds of identical robots is rarely what anyone does."""
 STARTUP_REPORT_PERIOD = 5.0
 """Wall seconds between start-up lines while the world node is not up yet."""
 
@@ -201,9 +207,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--discovery", choices=("server", "simple"), default="server",
                         help="DDS discovery: the world node as discovery server for every other node (default; "
                              "scales to a process per robot), or Fast DDS's peer-to-peer SIMPLE discovery")
-    parser.add_argument("--no-parameter-services", dest="parameter_services", action="store_false",
-                        help="no ros2 param services on the controller nodes: 12 DDS endpoints a robot fewer, "
-                             "45 %% less start-up CPU with 1000 robots (README, Benchmarks)")
+    services = parser.add_mutually_exclusive_group()
+    services.add_argument("--parameter-services", dest="parameter_services", action="store_true", default=None,
+                          help="ros2 param services on every controller node, whatever the swarm's size (default: "
+                               f"up to {PARAMETER_SERVICES_UP_TO} robots)")
+    services.add_argument("--no-parameter-services", dest="parameter_services", action="store_false",
+                          help="no ros2 param services on the controller nodes: 12 DDS endpoints a robot fewer, "
+                               "half the start-up's CPU with 1000 robots (README, Benchmarks)")
     parser.add_argument("--shared-memory", action="store_true",
                         help="DDS data between the run's processes through shared memory (/dev/shm), UDP 127.0.0.1 "
                              "for discovery and anyone else (default: UDP 127.0.0.1 only); less CPU with a few "
@@ -256,6 +266,8 @@ class Plan:
     servers: tuple[registry.ServerSpec, ...]
     processes: int
     """DDS processes of the run here: controllers, servers, the world."""
+    parameter_services: bool
+    """Whether the controller nodes serve ``ros2 param`` (`PARAMETER_SERVICES_UP_TO`)."""
 
 
 @dataclass(frozen=True)
@@ -295,7 +307,10 @@ def plan_run(args: argparse.Namespace) -> Plan:
         raise Refused(f"{scenario.robots.count} robots in {len(groups)} controller processes make {processes} DDS "
                       f"processes; the loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use "
                       "--controller-processes K with fewer processes)")
-    return Plan(scenario, pace, bind, remote, local, groups, servers, processes)
+    services = args.parameter_services
+    if services is None:
+        services = scenario.robots.count <= PARAMETER_SERVICES_UP_TO
+    return Plan(scenario, pace, bind, remote, local, groups, servers, processes, services)
 
 
 def dds_environments(args: argparse.Namespace, plan: Plan, domain: int) -> Environments:
@@ -346,6 +361,9 @@ def announce(args: argparse.Namespace, plan: Plan, domain: int, port: int | None
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
+    if args.parameter_services is None and not plan.parameter_services:
+        print(f"[swarm-run] {scenario.robots.count} robots: the controller nodes serve no ros2 param (more than "
+              f"{PARAMETER_SERVICES_UP_TO} robots; --parameter-services to have them)", flush=True)
     if port is not None and plan.bind is None:
         print(f"[swarm-run] to inspect it with ros2: ROS_DOMAIN_ID={domain} ROS_DISCOVERY_SERVER=127.0.0.1:{port} "
               f"ROS_SUPER_CLIENT=TRUE ROS_AUTOMATIC_DISCOVERY_RANGE=SYSTEM_DEFAULT "
@@ -386,7 +404,7 @@ def commands(args: argparse.Namespace, plan: Plan, bag: Path, common: list[str],
         world_cmd += ["--pace", str(plan.pace)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
-    options = [] if args.parameter_services else ["--no-parameter-services"]
+    options = [] if plan.parameter_services else ["--no-parameter-services"]
     if args.plain_twist:
         world_cmd += ["--plain-twist", *(r for robots in plan.remote.values() for r in robots)]
     if args.controller_processes == 0:  # one process per robot, forked after the imports

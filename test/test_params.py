@@ -7,6 +7,7 @@ from __future__ import annotations
 import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from test_nodes import SMALL
 
@@ -63,3 +64,30 @@ def test_a_controller_without_parameter_services_still_holds_its_parameters(cont
     finally:
         with_services.destroy_node()
         without.destroy_node()
+
+
+def test_a_controller_refuses_ros2_param_set_and_has_no_parameter_events_writer(context):
+    """A robot reads its parameters once, when it is made: ``ros2 param set`` is refused (read-only)
+    rather than taking a value that would change nothing; with nothing ever to announce, the node
+    has no ``/parameter_events`` writer, one DDS endpoint a robot fewer (issue 40, lever 4). The
+    server nodes keep theirs."""
+    node = ControllerNode("robot_2", ControllerConfig("cpfa", SMALL, 7), context=context)
+    server = ServerNode("depot", ServerNodeConfig("queue_qmt", ("robots.count=2",), 5), context=context)
+    client_node = Node("ros2cli_param", context=context)
+    executor = SingleThreadedExecutor(context=context)
+    for n in (node, server, client_node):
+        executor.add_node(n)
+    try:
+        client = AsyncParameterClient(client_node, "/robot_2/controller")
+        assert client.wait_for_services(timeout_sec=20.0)
+        result = _spin_until(executor, client.set_parameters([Parameter("seed", value=9)])).results[0]
+        assert not result.successful and "read-only" in result.reason, result
+        assert _spin_until(executor, client.get_parameters(["seed"])).values[0].integer_value == 7
+        writes = lambda n: {t for t, _ in client_node.get_publisher_names_and_types_by_node(  # noqa: E731
+            n.get_name(), n.get_namespace())}
+        assert "/robot_2/status" in writes(node) and "/parameter_events" not in writes(node)
+        assert "/parameter_events" in writes(server)
+    finally:
+        executor.shutdown()
+        for n in (node, server, client_node):
+            n.destroy_node()

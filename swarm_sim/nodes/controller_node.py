@@ -19,8 +19,12 @@ The node serves the standard parameter services (``ros2 param list/get``), creat
 twelve DDS endpoints per robot, which made a 112-process start-up 16 % slower under peer-to-peer
 discovery (benchmarks/README.md); the discovery server only tells each process of the endpoints on
 its own topics. ``--no-parameter-services`` leaves them out: more than half of a controller's
-endpoints, and with 1000 robots 45 % of the start-up's CPU (Fast DDS pairs every endpoint it
-learns of with every local one: the world, as discovery server, learns of them all).
+endpoints, and with 1000 robots half of the start-up's CPU (Fast DDS pairs every endpoint it
+learns of with every local one: the world, as discovery server, learns of them all); ``swarm-run``
+leaves them out by default above `launch_py.run.PARAMETER_SERVICES_UP_TO` robots. Its parameters
+are read-only (it reads them once, when it is made: a later value would change nothing), so it
+never has a parameter event to send, and it has no ``/parameter_events`` writer
+(`NoParameterEvents`): one endpoint fewer per robot, which no one in a run reads.
 
 With ``--plain-twist`` the node drives a robot of its own, as on a TurtleBot-class robot's
 computer: it publishes plain ``geometry_msgs/Twist`` on ``cmd_vel`` and steps on wall-clock time
@@ -69,6 +73,19 @@ from swarm_sim.scenario import Scenario, load_scenario
 ControllerConfig = EndpointConfig
 """A controller node's parameters: scenario, overrides, seed and how long `connect` waits."""
 
+PARAMETER_EVENTS = "/parameter_events"
+
+
+class NoParameterEvents:
+    """What a controller node has where rclpy makes every node a ``/parameter_events`` writer
+    (issue 40, lever 4): rclpy publishes an event when a parameter is declared or set; a robot's
+    parameters are declared once, at start, to no reader (the topic is volatile: a tool that comes
+    later never sees those events), and are read-only after. So the writer would be a DDS endpoint
+    per robot for the discovery to announce and pair, and nothing else."""
+
+    def publish(self, _event: object) -> None:
+        pass
+
 
 class ControllerNode(Node):
     """One robot's controller. It creates its ``cmd_vel`` publisher, which is what the world
@@ -101,7 +118,7 @@ class ControllerNode(Node):
         self.robot = robot
         self.plain_twist = plain_twist
         self._wall_ticks = 0
-        self.config = cfg = declare_config(self, ControllerConfig, config)
+        self.config = cfg = declare_config(self, ControllerConfig, config, read_only=True)
         self.scenario = scenario or load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.behaviour: Behaviour = registry.make_behaviour(self.scenario, robot, behaviour_rng(cfg.seed, robot))
         algorithm = registry.of(self.scenario)
@@ -134,6 +151,13 @@ class ControllerNode(Node):
         (`swarm_sim.nodes.run_watch`)."""
         self._connect_by = time.monotonic() + cfg.startup_timeout
         self._status_pub = self.create_publisher(topics.type_of(topics.STATUS), topics.STATUS, EVENTS)
+
+    def create_publisher(self, msg_type, topic: str, *args, **kwargs):  # noqa: ANN001, ANN201
+        """rclpy's own, except for the ``/parameter_events`` writer rclpy's `Node` asks for while it
+        is made (`NoParameterEvents`)."""
+        if topic == PARAMETER_EVENTS:
+            return NoParameterEvents()
+        return super().create_publisher(msg_type, topic, *args, **kwargs)
 
     def connect(self) -> bool:
         """Create the ``cmd_vel`` publisher once every exchange topic is matched (or the start-up
