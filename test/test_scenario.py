@@ -215,8 +215,12 @@ def test_world_sections_are_declared_by_their_task_algorithm_or_delivery_kind():
     ("caging", "transport.object.radius=-1", "transport.object.radius: must be positive"),
     ("caging", "transport.object.floor_friction=-0.1", "transport.object.floor_friction: must not be negative"),
     ("caging", "transport.landmarks.step=0", "transport.landmarks.step: must be positive"),
+    ("caging", "transport.swarm_distance=-0.1", "transport.swarm_distance: must not be negative"),
+    ("caging", "transport.swarm_distance=5.4", "transport.swarm_distance: 5.4 m from an object at the centre of "
+                                               "the 8 x 7 m landmark rectangle leaves no start in it (its corners "
+                                               "are 5.32 m away)"),
     ("caging", "transport.object.radius=big", "transport.object.radius: expected a number, got 'big'"),
-    ("caging", "transport.colour=red", "unknown key transport.colour (known keys: landmarks, object)"),
+    ("caging", "transport.colour=red", "unknown key transport.colour (known keys: landmarks, object, swarm_distance)"),
     ("caging", "transport=3", "transport: expected a mapping"),
     ("mdbsa_d", "regions.count=5", "regions.count: 5 is not a power of 4"),
     ("cpfa", "regions.count=5", "regions.count: 5 is not a power of 4"),

@@ -4,7 +4,8 @@ caging paper's arena, Alg. 2; in the manner of ARGoS loop functions).
 What it places (Alg. 2), from its first seed stream: the object's centre C_object uniformly in
 the rectangle the landmarks span, then every robot's start p_i^0 uniformly in the same
 rectangle with a random heading, at least a robot width apart and out of reach of the
-object's sensors (a robot never starts next to the object). The paper only says "randomly";
+object's sensors (a robot never starts next to the object), and at least ``transport.swarm_distance``
+from the object's centre (0 by default: no further bound). The paper only says "randomly";
 the landmark rectangle keeps the object, and the transport's end at p_r*^0, a cage's width
 from the walls.
 
@@ -33,7 +34,7 @@ object's and every robot's true position, which analysis reads back as the ``obj
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -63,6 +64,32 @@ START_GAP = 0.02
 """Robots start at least a robot width plus this apart [m]."""
 
 
+def starts(rng: np.random.Generator, half: np.ndarray, center: np.ndarray, robots: Sequence[str], width: float,
+           clear: float, distance: float) -> dict[str, Pose2D]:
+    """p_i^0 (Alg. 2): uniform in the landmark rectangle of half-sides `half` [m] with a uniform
+    heading, at least `width` + START_GAP apart, farther than `clear` (the object's sensor reach)
+    and at least `distance` (``transport.swarm_distance``) from the object's centre `center`."""
+    placed: list[np.ndarray] = []
+    poses = {}
+    for robot in robots:
+        for _ in range(PLACEMENT_TRIES):
+            xy = rng.uniform(-half, half)
+            away = np.hypot(*(xy - center))
+            if away > clear and away >= distance and all(np.hypot(*(xy - q)) >= width + START_GAP for q in placed):
+                break
+        else:
+            where = f"{2 * half[0]:g} x {2 * half[1]:g} m landmark rectangle"
+            if distance > clear:
+                raise ScenarioError(
+                    f"transport.swarm_distance: {len(robots)} robots do not fit apart in the {where} at least "
+                    f"{distance:g} m from the object at ({center[0]:.2f}, {center[1]:.2f})")
+            raise ScenarioError(f"robots.count: {len(robots)} robots do not fit apart in the {where} "
+                                "(transport.landmarks.extent)")
+        placed.append(xy)
+        poses[robot] = Pose2D(float(xy[0]), float(xy[1]), float(rng.uniform(-math.pi, math.pi)))
+    return poses
+
+
 class CagingSense(NamedTuple):
     """What a robot of the transport task senses besides odometry and scan."""
 
@@ -89,7 +116,9 @@ class TransportTask:
         rng = np.random.default_rng(seeds[0])
         half = np.array(TransportConfig.of(s).landmarks.extent, dtype=float) / 2
         center = rng.uniform(-half, half)
-        world.place_robots(self._starts(rng, half, center))
+        clear = self.radius + self._w / 2 + self._proximity.range + RAY_START_OFFSET
+        world.place_robots(starts(rng, half, center, world.robots, self._w, clear,
+                                  TransportConfig.of(s).swarm_distance))
         shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=self.radius, height=s.robots.height,
                                        physicsClientId=self._cid)
         self.body = p.createMultiBody(self.mass, shape, -1, [center[0], center[1], self._z0],
@@ -104,26 +133,6 @@ class TransportTask:
         angles = np.radians(np.asarray(self._proximity.angles, dtype=float))
         self._sensor_angles = angles
         self._read_object()
-
-    def _starts(self, rng: np.random.Generator, half: np.ndarray, center: np.ndarray) -> dict[str, Pose2D]:
-        """p_i^0: uniform in the landmark rectangle, apart and out of the object's sight."""
-        w = self._w
-        clear = self.radius + w / 2 + self._proximity.range + RAY_START_OFFSET
-        placed: list[np.ndarray] = []
-        poses = {}
-        for robot in self._world.robots:
-            for _ in range(PLACEMENT_TRIES):
-                xy = rng.uniform(-half, half)
-                if np.hypot(*(xy - center)) > clear and all(np.hypot(*(xy - q)) >= w + START_GAP for q in placed):
-                    break
-            else:
-                raise ScenarioError(
-                    f"robots.count: {len(self._world.robots)} robots do not fit apart in the "
-                    f"{2 * half[0]:g} x {2 * half[1]:g} m landmark rectangle (transport.landmarks.extent)"
-                )
-            placed.append(xy)
-            poses[robot] = Pose2D(float(xy[0]), float(xy[1]), float(rng.uniform(-math.pi, math.pi)))
-        return poses
 
     # ------------------------------------------------------------------ physics
 
