@@ -15,7 +15,8 @@ relay of what robots send each other (`peer_relay`) and what it shows besides th
 itself: its observation publishers, its intake of commands and acks, and its command line.
 
 Observations (and the task's state topics, e.g. the caging object's pose) are encoded straight
-to CDR bytes, published raw and written to the bag as the same bytes.
+to CDR bytes, published raw and written to the bag as the same bytes; with ``--publish-shards K``
+K processes of their own publish the observations from shared memory (`publish_shard`).
 
 What it hears is untrusted (`swarm_sim.inbound`): commands, acks (which must carry the run's tag,
 `swarm_msgs_py.auth`) and robots' messages pass its guard, and what it refuses is recorded on the
