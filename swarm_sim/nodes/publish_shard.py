@@ -89,6 +89,8 @@ class ShardDied(Exception):
 
 @dataclass(frozen=True)
 class Region:
+    """Where a shard's ticks are written: `size` bytes from `offset` in block `name`."""
+
     name: str
     """The shared-memory block's name."""
     buf: memoryview
@@ -230,10 +232,9 @@ def _environment() -> dict[str, str]:
 class PublishShards:
     """The world's K shard processes and their shared memory (`ShardWriter` each)."""
 
-    def __init__(self, robots: Sequence[str], count: int, say: Callable[[str], None],
-                 region_bytes: int | None = None) -> None:
+    def __init__(self, robots: Sequence[str], count: int, say: Callable[[str], None]) -> None:
         self.robots = shard_robots(robots, count)
-        size = region_bytes or REGION_BYTES_PER_ROBOT * len(self.robots[0])
+        size = REGION_BYTES_PER_ROBOT * len(self.robots[0])
         self._blocks = [SharedMemory(create=True, size=size * count)]
         first = self._blocks[0]
         env = _environment()
