@@ -113,8 +113,9 @@ def scenario_sets(robots: int, arena: float | None) -> list[str]:
 
 
 def tree(root: int) -> dict[int, str]:
-    """pid -> role (launcher, world, controllers, server, other) of `root` and its descendants; the
-process that forks the robot processes counts as the launcher's."""
+    """pid -> role (launcher, world, shards, controllers, server, other) of `root` and its descendants;
+the process that forks the robot processes counts as the launcher's; shards: the world's publishing
+shards (``--run-arg=--publish-shards --run-arg=K``)."""
     children: dict[int, list[int]] = defaultdict(list)
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -132,7 +133,8 @@ process that forks the robot processes counts as the launcher's."""
         except OSError:
             continue
         forking = "controller_node" in cmd and " --fork" in cmd and parent == root  # runs no robot itself
-        role = ("world" if "world_node" in cmd else "launcher" if pid == root or forking
+        role = ("world" if "world_node" in cmd else "shards" if "publish_shard" in cmd
+                else "launcher" if pid == root or forking
                 else "controllers" if "controller_node" in cmd else "server" if "server_node" in cmd else "other")
         out[pid] = role
     return out
@@ -330,7 +332,7 @@ def report(result: dict) -> None:
     print(f"window: {ticks} ticks in {result['window_wall_s']:.1f} s wall "
           f"({ticks * TICK / result['window_wall_s']:.2f}x)")
     cpu = result["cpu_ms_per_tick"]
-    roles = [r for r in ("world", "controllers", "server", "launcher", "other") if any(c.startswith(r + "|") for c in cpu)]
+    roles = [r for r in ("world", "shards", "controllers", "server", "launcher", "other") if any(c.startswith(r + "|") for c in cpu)]
     groups = sorted({c.split("|")[1] for c in cpu})
     print("CPU ms per tick | " + " | ".join(roles))
     for g in groups:

@@ -57,6 +57,7 @@ from swarm_sim.analysis.text import summary_lines
 from swarm_sim.cli import add_scenario_arguments, first_paragraph, number, scenario_fields, stop_on_signals
 from swarm_sim.nodes.lifetime import die_with_parent
 from swarm_sim.nodes.live_view import DEFAULT_PORT, LOOPBACK
+from swarm_sim.nodes.publish_shard import SHARD_ENV, shard_environment
 from swarm_sim.nodes.run_watch import WORLD_TIMEOUT
 from swarm_sim.nodes.ws_proxy import check_port
 from swarm_sim.recording import repair_bag
@@ -218,6 +219,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="DDS data between the run's processes through shared memory (/dev/shm), UDP 127.0.0.1 "
                              "for discovery and anyone else (default: UDP 127.0.0.1 only); less CPU with a few "
                              "controller processes, more with one per robot (README, Benchmarks)")
+    parser.add_argument("--publish-shards", type=number(int, 0), default=0, metavar="K",
+                        help="the world's observations published by K processes of their own, fed by shared memory "
+                             "(default 0: by the world; pays with many robots: docs/benchmarks.md, The graph)")
     parser.add_argument("--foxglove", type=number(int, 0, 65535), nargs="?", const=DEFAULT_PORT, metavar="PORT",
                         help=f"serve the run live to Foxglove over WebSocket (default port {DEFAULT_PORT}; 0: any free)")
     parser.add_argument("--foxglove-host", default=LOOPBACK,
@@ -265,7 +269,7 @@ class Plan:
     """`local` dealt over the controller processes."""
     servers: tuple[registry.ServerSpec, ...]
     processes: int
-    """DDS processes of the run here: controllers, servers, the world."""
+    """DDS processes of the run here: controllers, servers, the world and its publishing shards."""
     parameter_services: bool
     """Whether the controller nodes serve ``ros2 param`` (`PARAMETER_SERVICES_UP_TO`)."""
 
@@ -302,11 +306,14 @@ def plan_run(args: argparse.Namespace) -> Plan:
     local = [r for r in scenario.robot_names if r not in {r for robots in remote.values() for r in robots}]
     groups = split_robots(local, args.controller_processes) if local else []
     servers = registry.of(scenario).servers
-    processes = len(groups) + len(servers) + 1
+    if args.publish_shards > scenario.robots.count:
+        raise Refused(f"--publish-shards {args.publish_shards}: more shards than the run's {scenario.robots.count} robots")
+    processes = len(groups) + len(servers) + 1 + args.publish_shards
     if processes > PROFILE_MAX_PROCESSES:
         raise Refused(f"{scenario.robots.count} robots in {len(groups)} controller processes make {processes} DDS "
-                      f"processes; the loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use "
-                      "--controller-processes K with fewer processes)")
+                      f"processes{f' with {args.publish_shards} publishing shards' if args.publish_shards else ''}; the "
+                      f"loopback profile discovers at most {PROFILE_MAX_PROCESSES} (use --controller-processes K "
+                      "with fewer processes)")
     services = args.parameter_services
     if services is None:
         services = scenario.robots.count <= PARAMETER_SERVICES_UP_TO
@@ -349,6 +356,8 @@ def dds_environments(args: argparse.Namespace, plan: Plan, domain: int) -> Envir
                                              profiles / "discovery_server.xml")
         # Controllers do not read the ROS graph announcements (`robot_profile`): N, not N x N, pairs.
         robots_env = profile_env(env, "robots.xml", robot_profile())
+    if args.publish_shards:  # a shard is a client of the world's discovery and reads no graph, as a controller
+        world_env = {**world_env, SHARD_ENV: shard_environment(world_env, robots_env)}
     return Environments(world_env, robots_env, env, profiles, port)
 
 
@@ -357,7 +366,8 @@ def announce(args: argparse.Namespace, plan: Plan, domain: int, port: int | None
     scenario = plan.scenario
     print(
         f"[swarm-run] {scenario.name}: {scenario.robots.count} robots, {scenario.sim.duration:.0f} s, "
-        f"seed {scenario.seed}, {args.mode}, {len(plan.groups)} controller process(es), domain {domain}\n"
+        f"seed {scenario.seed}, {args.mode}, {len(plan.groups)} controller process(es)"
+        f"{f', {args.publish_shards} publishing shards' if args.publish_shards else ''}, domain {domain}\n"
         f"[swarm-run] recording to {bag}",
         flush=True,
     )
@@ -402,6 +412,8 @@ def commands(args: argparse.Namespace, plan: Plan, bag: Path, common: list[str],
                  "--real-time-factor", str(args.real_time_factor or 1.0)]
     if plan.pace:
         world_cmd += ["--pace", str(plan.pace)]
+    if args.publish_shards:
+        world_cmd += ["--publish-shards", str(args.publish_shards)]
     if args.foxglove is not None:
         world_cmd += ["--foxglove", str(args.foxglove), "--foxglove-host", args.foxglove_host]
     options = [] if plan.parameter_services else ["--no-parameter-services"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from graph_helpers import SMALL_ARENA, overrides, run_graph
+from graph_helpers import SMALL_ARENA, launch, overrides, run_graph  # noqa: F401 - launch: a fixture
 
 from swarm_sim.analysis.metrics import summarize
 from swarm_sim.analysis.replay import load_odometry
@@ -52,3 +52,27 @@ def test_graph_with_a_process_per_robot_equals_batch_at_112_robots(tmp_path):
     for key in COMPARED:
         assert graph[key] == expected[key], key
     assert graph["stale_ticks"] == 0 and graph["dead_nodes"] == []
+
+
+def test_graph_with_publishing_shards_equals_batch(launch):
+    """``--publish-shards 2``: the observations go out through two shard processes fed by shared
+    memory, and the bag's trajectories are still the batch run's; the shards are the run's own
+    publishers (not tainted, exit 0), named, and gone with the run."""
+    robots, duration, seed = 5, 8.0, 7
+    run = launch("--robots", str(robots), "--duration", str(duration), "--seed", str(seed), "--publish-shards", "2",
+                 *overrides(SMALL_ARENA))
+    named = lambda: sorted(t.split()[0] for t in run.children().values() if "swarm_sim.nodes.publish_shard" in t)  # noqa: E731
+    run.wait_until(lambda: named() == ["shard0", "shard1"], what="the world's two shard processes, named")
+    code, graph, err = run.finish()
+    assert code == 0, err[-3000:]
+    assert "Traceback" not in err and graph["foreign_publishers"] == []
+    assert run.alive() == []
+    scenario = load_scenario("cpfa", SMALL_ARENA, robots__count=robots, sim__duration=duration, seed=seed)
+    batch = run_batch(scenario, record_poses=True)
+    odom = load_odometry(run.bag)
+    assert len(odom) == robots
+    for i, (robot, rows) in enumerate(odom.items()):
+        np.testing.assert_array_equal(rows[:, 1:], batch.poses[:, i, :], err_msg=robot)
+    expected = summarize(batch.trace)
+    for key in COMPARED:
+        assert graph[key] == expected[key], key

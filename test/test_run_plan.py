@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from launch_py.run import PARAMETER_SERVICES_UP_TO, build_parser, commands, plan_run, scenario_args
+from launch_py.run import PARAMETER_SERVICES_UP_TO, Refused, build_parser, commands, plan_run, scenario_args
 
 
 def _controller_commands(argv: list[str]) -> list[list[str]]:
@@ -36,3 +36,19 @@ def test_asking_for_and_against_parameter_services_at_once_is_refused(capsys):
         build_parser().parse_args(["--parameter-services", "--no-parameter-services"])
     assert exit_.value.code == 2
     assert "not allowed with argument" in capsys.readouterr().err
+
+
+def test_publishing_shards_go_to_the_world_count_as_processes_and_no_more_than_the_robots(capsys):
+    args = build_parser().parse_args(["--robots", "8", "--controller-processes", "2", "--publish-shards", "3"])
+    plan = plan_run(args)
+    assert plan.processes == 2 + 1 + 3  # controllers, the world, its shards
+    world = commands(args, plan, Path("bag"), [], []).world
+    assert world[world.index("--publish-shards") + 1] == "3"
+    plain = build_parser().parse_args(["--robots", "8"])
+    assert "--publish-shards" not in commands(plain, plan_run(plain), Path("bag"), [], []).world  # today's world
+    with pytest.raises(Refused, match="--publish-shards 9: more shards than the run's 8 robots"):
+        plan_run(build_parser().parse_args(["--robots", "8", "--publish-shards", "9"]))
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args(["--publish-shards", "-1"])
+    assert exit_.value.code == 2
+    assert "--publish-shards: -1 is outside [0, inf]" in capsys.readouterr().err

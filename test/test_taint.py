@@ -42,10 +42,10 @@ class Graph:
         return list(topics.items())
 
 
-def run_graph(robots: int) -> tuple[Graph, ForeignWatch]:
+def run_graph(robots: int, shards: int = 0) -> tuple[Graph, ForeignWatch]:
     scenario = load_scenario("cpfa", robots__count=robots)
     graph = Graph()
-    watch = ForeignWatch(scenario, graph.info, graph.count, graph.nodes, graph.of_node)
+    watch = ForeignWatch(scenario, graph.info, graph.count, graph.nodes, graph.of_node, shards)
     for topic, spec in watch.topics.items():
         for namespace, name in spec.publishers:
             graph.add(namespace, name, topic)
@@ -59,6 +59,17 @@ def test_a_foreign_node_is_found_at_the_next_check_whatever_the_budget():
     found = watch.check(budget=0.0)
     assert [(f.topic, f.node, f.tainting) for f in found] == [("/robot_3/odom", "/hostile", True)]
     assert watch.check(budget=0.0) == []  # reported once
+
+
+def test_publishing_shards_are_the_run_s_own_on_their_robots_observations_only():
+    graph, watch = run_graph(16, shards=3)
+    assert watch.topics["/robot_4/odom"].publishers == {("/", "publish_shard_1")}  # robots k::K
+    assert watch.check(budget=math.inf) == []  # every shard publishing its robots' observations
+    graph.add("/", "world", "/robot_4/scan")  # the world no longer publishes them
+    graph.add("/", "publish_shard_0", "/robot_4/sense")  # nor another shard
+    found = watch.check(budget=math.inf)
+    assert sorted((f.topic, f.node) for f in found) == [("/robot_4/scan", "/world"),
+                                                         ("/robot_4/sense", "/publish_shard_0")]
 
 
 def test_a_second_publisher_under_a_run_name_is_found_within_a_rotation():

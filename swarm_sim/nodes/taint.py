@@ -1,7 +1,9 @@
 """Who may publish on a run's topics, and the world's watch for anyone else (a foreign publisher).
 
 A run knows its own nodes from the start: the world, one controller per robot (node
-``controller`` in the robot's namespace), one node per registered server (`ServerSpec.node_name`).
+``controller`` in the robot's namespace), one node per registered server (`ServerSpec.node_name`),
+and with ``--publish-shards K`` the K shards that publish the observations in the world's stead
+(`swarm_sim.nodes.publish_shard.shard_node_name`, robots k::K).
 `run_topics` lists every topic of the run with its type (from our own types, whatever else a
 foreign publisher announces) and the nodes that publish it.
 
@@ -32,6 +34,7 @@ from dataclasses import dataclass, field
 from swarm_msgs_py import auth, topics
 from swarm_msgs_py.topics import CLOCK
 from swarm_sim import registry
+from swarm_sim.nodes.publish_shard import shard_node_name
 from swarm_sim.outputs import MARKER_ARRAY, outputs_of
 from swarm_sim.scenario import Scenario
 
@@ -53,8 +56,9 @@ class RunTopic:
         return self.type_name in auth.SIGNED_TYPES
 
 
-def run_topics(scenario: Scenario) -> dict[str, RunTopic]:
-    """Every topic of a run: its type and the run's nodes that publish it."""
+def run_topics(scenario: Scenario, shards: int = 0) -> dict[str, RunTopic]:
+    """Every topic of a run: its type and the run's nodes that publish it (the observations: the
+    world, or with `shards` robot i's shard, i mod `shards`)."""
     out: dict[str, RunTopic] = {}
 
     def add(topic: str, type_name: str, node: tuple[str, str]) -> None:
@@ -68,10 +72,11 @@ def run_topics(scenario: Scenario) -> dict[str, RunTopic]:
     for st in registry.resolve(task.state) if task.state else ():
         add(st.topic, st.type_name, WORLD)
     inbound, outbound = registry.robot_topics(algorithm)
-    for robot in scenario.robot_names:
+    for i, robot in enumerate(scenario.robot_names):
         controller = (f"/{robot}", CONTROLLER)
+        observer = ("/", shard_node_name(i % shards)) if shards else WORLD
         for name in topics.OBSERVATIONS:
-            add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], WORLD)
+            add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], observer)
         for name in (topics.CMD_VEL, topics.STATUS):
             add(topics.robot_topic(robot, name), topics.ROBOT_TOPIC_TYPES[name], controller)
         add(topics.DIAGNOSTICS, topics.type_string(topics.DIAGNOSTICS), controller)
@@ -133,10 +138,12 @@ class ForeignWatch:
 
     def __init__(self, scenario: Scenario, publishers_info: Callable[[str], list],
                  count_publishers: Callable[[str], int], node_names: Callable[[], list] = lambda: [],
-                 publishers_of_node: Callable[[str, str], list] = lambda name, namespace: []) -> None:
+                 publishers_of_node: Callable[[str, str], list] = lambda name, namespace: [],
+                 shards: int = 0) -> None:
         """`node_names()`: (name, namespace) of every node in the graph; `publishers_of_node(name,
-        namespace)`: that node's (topic, types) (rclpy's names for both)."""
-        self.topics = run_topics(scenario)
+        namespace)`: that node's (topic, types) (rclpy's names for both); `shards`: the run's
+        publishing shards (`run_topics`)."""
+        self.topics = run_topics(scenario, shards)
         self._info = publishers_info
         self._count = count_publishers
         self._node_names = node_names

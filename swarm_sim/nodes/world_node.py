@@ -15,7 +15,8 @@ relay of what robots send each other (`peer_relay`) and what it shows besides th
 itself: its observation publishers, its intake of commands and acks, and its command line.
 
 Observations (and the task's state topics, e.g. the caging object's pose) are encoded straight
-to CDR bytes, published raw and written to the bag as the same bytes.
+to CDR bytes, published raw and written to the bag as the same bytes; with ``--publish-shards K``
+K processes of their own publish the observations from shared memory (`publish_shard`).
 
 What it hears is untrusted (`swarm_sim.inbound`): commands, acks (which must carry the run's tag,
 `swarm_msgs_py.auth`) and robots' messages pass its guard, and what it refuses is recorded on the
@@ -52,6 +53,7 @@ from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.endpoint import ack_wait
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.peer_relay import PeerRelay
+from swarm_sim.nodes.publish_shard import PublishShards, ShardDied
 from swarm_sim.nodes.qos import SENSOR_LOCKSTEP
 from swarm_sim.nodes.run_watch import END_ACK_WAIT, END_ACK_WAIT_HERE, RunBeacon
 from swarm_sim.nodes.status_watch import StatusWatch
@@ -112,6 +114,9 @@ class WorldNodeConfig:
     """Realtime: robots whose commands come as plain ``geometry_msgs/Twist`` (a robot's own
     computer on wall-clock time, TurtleBot-style: no stamp); a command's time is the tick it
     arrived at."""
+    publish_shards: int = 0
+    """Observations published by this many processes of their own (`swarm_sim.nodes.publish_shard`;
+    0: by the world itself)."""
 
 
 class WorldNode(Node):
@@ -127,8 +132,11 @@ class WorldNode(Node):
         self.robots: tuple[RobotId, ...] = self.world.robots
         if unknown := set(cfg.plain_twist) - set(self.robots):
             raise ValueError(f"plain_twist: no robot {sorted(unknown)[0]!r} in this run")
+        if not 0 <= cfg.publish_shards <= len(self.robots):
+            raise ValueError(f"publish_shards: expected 0-{len(self.robots)} (the run's robots), got {cfg.publish_shards}")
         self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers,
-                                  self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node)
+                                  self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node,
+                                  cfg.publish_shards)
         """The graph's publishers on the run's topics: foreign ones are reported (`check_foreign`)."""
         self.foreign: list[str] = []
         """The foreign publishers found whose messages may have reached a core: the run is tainted."""
@@ -152,19 +160,30 @@ class WorldNode(Node):
         """The task's world-level state topics (`swarm_msgs_py.sensing.StateTopic`), every tick."""
         self._state_pubs = [self.recording.publisher(st.topic, SENSOR_LOCKSTEP, st.type_name)
                             for st in self.state_topics]
-        self._obs_pubs = {
-            r: {
-                name: self.recording.publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP)
-                for name in topics.OBSERVATIONS
+        self.shards: PublishShards | None = None
+        """The processes that publish the observations (``publish_shards``); None: the world does."""
+        self._obs_pubs = {}
+        if cfg.publish_shards:
+            for r in self.robots:
+                for name in topics.OBSERVATIONS:
+                    topic = topics.robot_topic(r, name)
+                    self.recording.add(topic, topics.type_string(topic))
+            self.shards = PublishShards(self.robots, cfg.publish_shards, self.get_logger().warning)
+        else:
+            self._obs_pubs = {
+                r: {
+                    name: self.recording.publisher(topics.robot_topic(r, name), SENSOR_LOCKSTEP)
+                    for name in topics.OBSERVATIONS
+                }
+                for r in self.robots
             }
-            for r in self.robots
-        }
         # rclpy's `Publisher.publish` around the raw publish (a handle context, two type checks) was
         # half of a raw publish's Python, 336 times a tick with 112 robots: the tick calls the
-        # publisher's own `publish_raw`.
-        self._obs_targets = {r: {name: (pub.handle.publish_raw, topics.robot_topic(r, name))
-                                 for name, pub in pubs.items()}
-                             for r, pubs in self._obs_pubs.items()}
+        # publisher's own `publish_raw` (with shards: None, the shard publishes).
+        self._obs_targets = {r: {name: (None if self.shards else self._obs_pubs[r][name].handle.publish_raw,
+                                        topics.robot_topic(r, name))
+                                 for name in topics.OBSERVATIONS}
+                             for r in self.robots}
         """Robot -> observation name -> (raw publish, topic)."""
         self._commands: dict[RobotId, Command] = {}
         realtime = cfg.mode == "realtime"
@@ -408,11 +427,12 @@ class WorldNode(Node):
         """Robots (of `among`, default all) whose controller is not matched on every topic yet,
         and the servers if any has no ack publisher yet."""
         robots = self.robots if among is None else [r for r in among if r in self._cmd_subs]
-        missing = [
-            r for r in robots
-            if self._cmd_subs[r].get_publisher_count() == 0
-            or any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())
-        ]
+        if self.shards is not None:  # each shard says which of its robots' publishers have matched
+            matched = self.shards.ready()
+            unmatched = lambda r: r not in matched  # noqa: E731
+        else:
+            unmatched = lambda r: any(p.get_subscription_count() == 0 for p in self._obs_pubs[r].values())  # noqa: E731
+        missing = [r for r in robots if self._cmd_subs[r].get_publisher_count() == 0 or unmatched(r)]
         if self.servers:  # by their nodes' names: a foreign ack publisher must not stand in for one
             ready = self.watch.ready(topics.LOCKSTEP_ACK)
             waiting = [spec.node_name for spec in registry.of(self.scenario).servers if spec.node_name not in ready]
@@ -448,7 +468,9 @@ class WorldNode(Node):
             }
             out += [(*targets[name], data) for name, data in encoded.items()]
             self._sent[r] = encoded
-        self.recording.publish_all(out, send=send)
+        self.recording.publish_all(out, send=send and self.shards is None)
+        if send and self.shards is not None:
+            self.shards.publish(t_ns, self._sent, lambda: self.stop_requested)
         if self.state_topics:
             values = self.world.task.state()
             for st, pub in zip(self.state_topics, self._state_pubs):
@@ -459,10 +481,12 @@ class WorldNode(Node):
         for r in waiting:
             if r in self._sent:
                 self.command_watch.resent[r] += 1
-                for name, data in self._sent[r].items():
+                for name, data in self._sent[r].items() if self.shards is None else ():  # shards: below
                     self._obs_pubs[r][name].publish(data)
             else:  # a server: it answers a repeated /clock with its ack
                 self._clock_pub.publish(clock_codec.encode_clock(stamp))
+        if self.shards is not None:  # the same tick from its region again (the world writes none before)
+            self.shards.again([r for r in waiting if r in self._sent])
 
     def publish_world_state(self, final: bool = False) -> None:
         """After a step: events, stats, markers, diagnostics (`swarm_sim.nodes.world_outputs`)."""
@@ -470,6 +494,8 @@ class WorldNode(Node):
         self.outputs.publish(self.world, events, final=final)
 
     def close(self) -> None:
+        if self.shards is not None:
+            self.shards.close()
         self.recording.close(
             {f.topic for f in self.watch.found},
             wall_seconds=f"{time.monotonic() - (self.loop.wall_start or time.monotonic()):.3f}",
@@ -511,12 +537,15 @@ def parse_args(argv: list[str]) -> tuple[WorldNodeConfig, list[str]]:
     parser.add_argument("--plain-twist", nargs="+", default=[], metavar="ROBOT",
                         help="realtime: these robots' commands come as plain geometry_msgs/Twist (a robot's own "
                              "computer on wall-clock time); each counts from the tick it arrives at")
+    parser.add_argument("--publish-shards", type=number(int, 0), default=0, metavar="K",
+                        help="the observations published by K processes of their own, fed by shared memory "
+                             "(default 0: by the world itself; docs/benchmarks.md)")
     args, ros_args = parser.parse_known_args(argv)
     config = WorldNodeConfig(
         scenario=args.scenario, overrides=tuple(args.overrides), seed=args.seed, mode=args.mode,
         tick_timeout=args.tick_timeout, real_time_factor=args.real_time_factor, bag=args.bag,
         foxglove_port=args.foxglove, foxglove_host=args.foxglove_host, pace=args.pace or 0.0,
-        resend_period=args.resend_period, plain_twist=tuple(args.plain_twist),
+        resend_period=args.resend_period, plain_twist=tuple(args.plain_twist), publish_shards=args.publish_shards,
     )
     return config, ros_args
 
@@ -530,6 +559,7 @@ def main(argv: list[str] | None = None) -> int:
     auth.load_from_environment()  # the run's key, when the launcher handed one down
     rclpy.init(args=["swarm-world", *ros_args], signal_handler_options=SignalHandlerOptions.NO)
     node = None
+    code = 0
     failed = True  # until the run ends as it should (a crash: the others hear "world failed")
     signal.signal(signal.SIGINT, signal.default_int_handler)  # until the node exists
     try:
@@ -550,6 +580,9 @@ def main(argv: list[str] | None = None) -> int:
         failed = False
         if node.stop_requested:
             raise Interrupted
+    except ShardDied as exc:  # its robots can no longer be sent a tick: the run ends here
+        print(f"swarm-world: {exc}: the run ends here", file=sys.stderr, flush=True)
+        code = 1
     except (KeyboardInterrupt, ExternalShutdownException, Interrupted):
         failed = False
         print("[world] interrupted: closing the bag", flush=True)
@@ -561,7 +594,7 @@ def main(argv: list[str] | None = None) -> int:
             node.close()
             # until the end reached every reader: the participant goes with the process (`leave`)
             node.beacon.wait_acknowledged(END_ACK_WAIT if ack_wait() > 0 else END_ACK_WAIT_HERE)
-    leave(0)  # no teardown of the node, its executor or the discovery server (`lifetime.leave`)
+    leave(code)  # no teardown of the node, its executor or the discovery server (`lifetime.leave`)
 
 
 if __name__ == "__main__":
