@@ -222,7 +222,10 @@ def boxplot_figure(
     ncol = min(len(legend), 3 * len(panels))
     rows = -(-len(legend) // max(ncol, 1))
     if legend:
-        fig.legend(handles=list(legend.values()), fontsize="small", loc="lower center", ncol=ncol, frameon=False)
+        # Anchored in figure coordinates: anchored to the figure's box, a tight save (`save_figure`
+        # with a caption) would move it down onto the caption.
+        fig.legend(handles=list(legend.values()), fontsize="small", loc="lower center", ncol=ncol, frameon=False,
+                   bbox_to_anchor=(0.5, 0.0), bbox_transform=fig.transFigure)
     fig.tight_layout(rect=(0, 0.07 * rows, 1, 1))
     save_figure(fig, path, dpi=110)
     plt.close(fig)
@@ -247,7 +250,11 @@ def save_figure(fig: Any, path: Path, dpi: int = 100) -> None:
     printed box plot says which robot made it."""
     text = _CAPTION.get()
     if text:
-        fig.text(0.005, 0.0, text, fontsize=7, color="0.3", ha="left", va="top")
+        from matplotlib.transforms import offset_copy
+
+        # Just below the figure (a legend under the panels reaches down to its bottom edge).
+        fig.text(0.005, 0.0, text, fontsize=7, color="0.3", ha="left", va="top",
+                 transform=offset_copy(fig.transFigure, fig=fig, y=-4, units="points"))
     fig.savefig(path, dpi=dpi, bbox_inches="tight" if text else None, pad_inches=0.08)
 
 
