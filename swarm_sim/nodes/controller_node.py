@@ -21,7 +21,7 @@ discovery (benchmarks/README.md); the discovery server only tells each process o
 its own topics. ``--no-parameter-services`` leaves them out: more than half of a controller's
 endpoints, and with 1000 robots half of the start-up's CPU (Fast DDS pairs every endpoint it
 learns of with every local one: the world, as discovery server, learns of them all); ``swarm-run``
-leaves them out by default above `launch_py.run.PARAMETER_SERVICES_UP_TO` robots. Its parameters
+leaves them out by default above `launch_py.run.PARAMETER_SERVICES_UP_TO` robots. The node's parameters
 are read-only (it reads them once, when it is made: a later value would change nothing), so it
 never has a parameter event to send, and it has no ``/parameter_events`` writer
 (`NoParameterEvents`): one endpoint fewer per robot, which no one in a run reads.
