@@ -166,3 +166,14 @@ def test_a_scenario_the_world_cannot_build_is_one_line_and_no_bag(tmp_path):
     assert_one_line(result, 2, "swarm-world: resources.clusters: cannot place 5 non-overlapping groups")
     assert "before recording anything" in result.stderr and "could not read the bag" not in result.stderr
     assert not any((tmp_path / "bags").glob("*/metadata.yaml"))
+
+
+@pytest.mark.parametrize("args, needle", [
+    (("--set", "robots.count=2", "--publish-shards", "5"), "swarm-world: publish_shards: expected 0-2"),
+    (("--plain-twist", "robot_0"), "swarm-world: plain_twist: a plain Twist carries no tick"),
+], ids=["more_shards_than_robots", "plain_twist_in_lockstep"])
+def test_a_hand_started_world_refuses_options_that_cannot_run_in_one_line(tmp_path, args, needle):
+    """swarm-world started by hand (swarm-run refuses these before starting anything): one line
+    naming the option, exit 2, no traceback."""
+    result = run("swarm_sim.nodes.world_node", *args, cwd=tmp_path)
+    assert_one_line(result, 2, needle)

@@ -7,11 +7,14 @@ from __future__ import annotations
 import json
 from multiprocessing import Pipe
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from swarm_sim.nodes.publish_shard import (
+    SHARD_ENV,
     Region,
+    ShardEnvironmentError,
     ShardReader,
     ShardWriter,
     frame,
@@ -110,3 +113,24 @@ def test_robots_are_dealt_round_robin_and_the_environment_turns_the_world_s_into
     assert shard_robots([f"r{i}" for i in range(5)], 2) == [["r0", "r2", "r4"], ["r1", "r3"]]
     spec = json.loads(shard_environment({"A": "1", "B": "server", "C": "x"}, {"A": "1", "B": "client", "D": "y"}))
     assert spec == {"set": {"B": "client", "D": "y"}, "unset": ["C"]}
+
+
+def test_the_shards_environment_is_refused_in_one_line_when_it_cannot_be_made(tmp_path):
+    """A hand-started world that is the discovery server, with no SHARD_ENV to make its shards
+    clients, and a SHARD_ENV that is not the launcher's JSON: refused by name (the world prints the
+    line and exits 2), not started with a server's environment or a traceback."""
+    from swarm_sim.nodes.publish_shard import _environment
+
+    server = tmp_path / "server.xml"
+    server.write_text("<dds><discoveryProtocol>SERVER</discoveryProtocol></dds>")
+    with pytest.raises(ShardEnvironmentError, match="discovery server"):
+        _environment({"FASTRTPS_DEFAULT_PROFILES_FILE": str(server)})
+    for bad in ("not json", '{"set": {}}', '{"set": {"A": 1}, "unset": []}', '[1, 2]'):
+        with pytest.raises(ShardEnvironmentError, match=SHARD_ENV):
+            _environment({SHARD_ENV: bad})
+    client = tmp_path / "client.xml"
+    client.write_text("<dds><discoveryProtocol>SIMPLE</discoveryProtocol></dds>")
+    assert _environment({"FASTRTPS_DEFAULT_PROFILES_FILE": str(client), "X": "1"}) == {
+        "FASTRTPS_DEFAULT_PROFILES_FILE": str(client), "X": "1"}
+    spec = shard_environment({"A": "1", "B": "server"}, {"A": "1", "B": "client"})
+    assert _environment({SHARD_ENV: spec, "A": "1", "B": "server"}) == {"A": "1", "B": "client"}

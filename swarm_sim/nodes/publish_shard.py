@@ -221,23 +221,49 @@ def shard_environment(world: Mapping[str, str], shard: Mapping[str, str]) -> str
                        "unset": sorted(set(world) - set(shard))})
 
 
-def _environment() -> dict[str, str]:
-    env = dict(os.environ)
-    spec = json.loads(env.pop(SHARD_ENV, "") or '{"set": {}, "unset": []}')
-    for key in spec["unset"]:
+class ShardEnvironmentError(ValueError):
+    """The shards' DDS environment cannot be made from this process's (one line: the world refuses)."""
+
+
+def _environment(environ: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The shards' environment: this process's as `SHARD_ENV` turns it into a client's. Without
+    `SHARD_ENV` the shards take this process's own, which must then not be a discovery server's
+    (a hand-started ``swarm-world --publish-shards`` whose profile makes it the server: its shards
+    would try to be servers too)."""
+    env = dict(os.environ if environ is None else environ)
+    text = env.pop(SHARD_ENV, "")
+    if not text:
+        profile = env.get("FASTRTPS_DEFAULT_PROFILES_FILE") or env.get("FASTDDS_DEFAULT_PROFILES_FILE") or ""
+        try:
+            server = "<discoveryProtocol>SERVER</discoveryProtocol>" in open(profile).read() if profile else False
+        except OSError:
+            server = False
+        if server:
+            raise ShardEnvironmentError(f"--publish-shards: this world is a discovery server ({profile}) and "
+                                        f"{SHARD_ENV} does not say how its shards join it (swarm-run sets it)")
+        return env
+    try:
+        spec = json.loads(text)
+        unset, assigned = list(spec["unset"]), dict(spec["set"])
+        if not all(isinstance(k, str) for k in unset) or not all(isinstance(v, str) for v in assigned.values()):
+            raise TypeError
+    except (ValueError, KeyError, TypeError):
+        raise ShardEnvironmentError(f'{SHARD_ENV}: expected JSON {{"set": {{NAME: VALUE}}, "unset": [NAME]}}, '
+                                    f"got {text[:60]!r}") from None
+    for key in unset:
         env.pop(key, None)
-    return {**env, **spec["set"]}
+    return {**env, **assigned}
 
 
 class PublishShards:
     """The world's K shard processes and their shared memory (`ShardWriter` each)."""
 
     def __init__(self, robots: Sequence[str], count: int, say: Callable[[str], None]) -> None:
+        env = _environment()  # first: a refusal leaves no block behind
         self.robots = shard_robots(robots, count)
         size = REGION_BYTES_PER_ROBOT * len(self.robots[0])
         self._blocks = [SharedMemory(create=True, size=size * count)]
         first = self._blocks[0]
-        env = _environment()
         self.writers: list[ShardWriter] = []
         self.procs: list[subprocess.Popen] = []
         for k, mine in enumerate(self.robots):

@@ -53,7 +53,7 @@ from swarm_sim.nodes.lockstep import LockstepBarrier
 from swarm_sim.nodes.endpoint import ack_wait
 from swarm_sim.nodes.params import declare_config
 from swarm_sim.nodes.peer_relay import PeerRelay
-from swarm_sim.nodes.publish_shard import PublishShards, ShardDied
+from swarm_sim.nodes.publish_shard import PublishShards, ShardDied, ShardEnvironmentError
 from swarm_sim.nodes.qos import SENSOR_LOCKSTEP
 from swarm_sim.nodes.run_watch import END_ACK_WAIT, END_ACK_WAIT_HERE, RunBeacon
 from swarm_sim.nodes.status_watch import StatusWatch
@@ -119,21 +119,25 @@ class WorldNodeConfig:
     0: by the world itself)."""
 
 
+class WorldConfigError(ValueError):
+    """A world node configuration that cannot run (one line, exit 2: `main`)."""
+
+
 class WorldNode(Node):
     def __init__(self, config: WorldNodeConfig | None = None, **kwargs) -> None:
         super().__init__("world", **kwargs)
         self.config = cfg = declare_config(self, WorldNodeConfig, config)
         if cfg.mode not in ("lockstep", "realtime"):
-            raise ValueError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
+            raise WorldConfigError(f"mode: expected 'lockstep' or 'realtime', got {cfg.mode!r}")
         if cfg.plain_twist and cfg.mode != "realtime":
-            raise ValueError("plain_twist: a plain Twist carries no tick, so only a realtime run can take it")
+            raise WorldConfigError("plain_twist: a plain Twist carries no tick, so only a realtime run can take it")
         self.scenario: Scenario = load_scenario(cfg.scenario, cfg.overrides, seed=cfg.seed)
         self.world = World(self.scenario, registry.task_factory(self.scenario), cfg.seed)
         self.robots: tuple[RobotId, ...] = self.world.robots
         if unknown := set(cfg.plain_twist) - set(self.robots):
-            raise ValueError(f"plain_twist: no robot {sorted(unknown)[0]!r} in this run")
+            raise WorldConfigError(f"plain_twist: no robot {sorted(unknown)[0]!r} in this run")
         if not 0 <= cfg.publish_shards <= len(self.robots):
-            raise ValueError(f"publish_shards: expected 0-{len(self.robots)} (the run's robots), got {cfg.publish_shards}")
+            raise WorldConfigError(f"publish_shards: expected 0-{len(self.robots)} (the run's robots), got {cfg.publish_shards}")
         self.watch = ForeignWatch(self.scenario, self.get_publishers_info_by_topic, self._count_publishers,
                                   self.get_node_names_and_namespaces, self.get_publisher_names_and_types_by_node,
                                   cfg.publish_shards)
@@ -565,7 +569,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         try:
             node = WorldNode(config)
-        except ScenarioError as exc:  # a scenario that loads but cannot be built (resources that do not fit)
+        except (ScenarioError, WorldConfigError, ShardEnvironmentError) as exc:
+            # a scenario that loads but cannot be built (resources that do not fit), options that
+            # contradict it or each other, shards without a client's environment
             print(f"swarm-world: {exc}", file=sys.stderr, flush=True)
             return 2
 
