@@ -34,7 +34,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-CLK = os.sysconf("SC_CLK_TCK")
+from profile_graph import process_cpu_s  # noqa: E402
+
 NAMES = ("odom", "scan", "sense")
 STAMP = struct.Struct("<iI")  # CDR: 4 bytes of encapsulation, then std_msgs/Header's stamp
 RESEND_S = 0.5
@@ -66,14 +67,15 @@ def stamped(data: bytes, tick: int) -> bytes:
     return data[:4] + STAMP.pack(tick, 0) + data[12:]
 
 
+BASE_ENV = dict(os.environ)
+"""The environment this benchmark started with: each process's DDS environment is made from it."""
+
+
 def _env(domain: int, processes: int) -> None:
     from launch_py.dds import loopback_env
 
     os.environ.clear()
     os.environ.update(loopback_env(domain, processes, base=BASE_ENV))
-
-
-BASE_ENV = dict(os.environ)
 
 
 def _types():
@@ -150,11 +152,7 @@ def shard_main(domain: int, processes: int, robots: list[int], shm_name: str, of
 
 
 def _cpu_s(pids: list[int]) -> float:
-    total = 0.0
-    for pid in pids:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-        total += (int(fields[11]) + int(fields[12])) / CLK
-    return total
+    return sum(process_cpu_s(pid) for pid in pids)
 
 
 def one_run(robots: int, controller_processes: int, shards: int, ticks: int, warmup: int, domain: int) -> dict:

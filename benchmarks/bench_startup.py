@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from profile_batch import scaled_fields
-from profile_graph import CLK, tree
+from profile_graph import process_cpu_s, tree
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,11 +31,7 @@ def cpu_seconds(root: int) -> dict[str, float]:
     out = {"world": 0.0, "controllers": 0.0}
     for pid, role in tree(root).items():
         if role in out:
-            try:
-                fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-            except OSError:
-                continue
-            out[role] += (int(fields[11]) + int(fields[12])) / CLK
+            out[role] += process_cpu_s(pid)
     return out
 
 

@@ -112,6 +112,15 @@ def scenario_sets(robots: int, arena: float | None) -> list[str]:
     return out
 
 
+def process_cpu_s(pid: int) -> float:
+    """CPU seconds (user + system) process `pid` has used so far; 0 once it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / CLK
+
+
 def tree(root: int) -> dict[int, str]:
     """pid -> role (launcher, world, shards, controllers, server, other) of `root` and its descendants;
 the process that forks the robot processes counts as the launcher's; shards: the world's publishing

@@ -19,7 +19,8 @@ class ReferenceError(Exception):
     """A run or an input that cannot be used; the message names it."""
 
 
-def _children_cpu_s() -> float:
+def children_cpu_s() -> float:
+    """CPU seconds (user + system) of this process's waited-for children so far."""
     used = resource.getrusage(resource.RUSAGE_CHILDREN)
     return used.ru_utime + used.ru_stime
 
@@ -31,10 +32,10 @@ def run_argos(command: list[str], tree: Path, xml: str, name: str, label: str, t
     temp = tree / name
     temp.write_text(xml)
     try:
-        start, cpu = time.perf_counter(), _children_cpu_s()
+        start, cpu = time.perf_counter(), children_cpu_s()
         done = subprocess.run([*command, "-c", temp.name], cwd=tree, capture_output=True, text=True,
                               timeout=timeout_s, stdin=subprocess.DEVNULL, env=env)
-        wall, cpu = time.perf_counter() - start, _children_cpu_s() - cpu
+        wall, cpu = time.perf_counter() - start, children_cpu_s() - cpu
     except subprocess.TimeoutExpired:
         raise ReferenceError(f"{label}: argos3 ran past {timeout_s:.0f} s") from None
     finally:

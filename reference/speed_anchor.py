@@ -15,14 +15,13 @@ from __future__ import annotations
 import argparse
 import math
 import re
-import resource
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
-from argos_run import ReferenceError, run_argos  # noqa: E402
+from argos_run import ReferenceError, children_cpu_s, run_argos  # noqa: E402
 from queue_argos import EXPERIMENT, experiment_xml  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,14 +65,12 @@ def _ours(robots: int, arena: float, duration: float, resources: int, clusters: 
     cmd = [sys.executable, "-m", "swarm_sim.batch", "--scenario", "queue_qse", "--robots", str(robots),
            "--duration", f"{duration:g}", "--seed", str(seed), "--set", f"arena.size={arena:g}",
            "--set", f"resources.count={resources}", "--set", f"resources.clusters={clusters}"]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), children_cpu_s()
     done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    wall, cpu = time.perf_counter() - start, children_cpu_s() - cpu
     if done.returncode != 0:
         raise ReferenceError(f"swarm-batch exited {done.returncode}: {(done.stderr or done.stdout).strip()[-300:]}")
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
 
 
 def main(argv: list[str] | None = None) -> int:

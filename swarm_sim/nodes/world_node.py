@@ -482,15 +482,16 @@ class WorldNode(Node):
 
     def resend(self, waiting: list[str], stamp: int) -> None:
         """Tick `stamp` again to those of `waiting` (robots: their observations; servers: the clock)."""
-        for r in waiting:
-            if r in self._sent:
-                self.command_watch.resent[r] += 1
-                for name, data in self._sent[r].items() if self.shards is None else ():  # shards: below
+        robots = [r for r in waiting if r in self._sent]
+        for r in robots:
+            self.command_watch.resent[r] += 1
+            if self.shards is None:
+                for name, data in self._sent[r].items():
                     self._obs_pubs[r][name].publish(data)
-            else:  # a server: it answers a repeated /clock with its ack
-                self._clock_pub.publish(clock_codec.encode_clock(stamp))
         if self.shards is not None:  # the same tick from its region again (the world writes none before)
-            self.shards.again([r for r in waiting if r in self._sent])
+            self.shards.again(robots)
+        for _ in range(len(waiting) - len(robots)):  # a server each: it answers a repeated /clock with its ack
+            self._clock_pub.publish(clock_codec.encode_clock(stamp))
 
     def publish_world_state(self, final: bool = False) -> None:
         """After a step: events, stats, markers, diagnostics (`swarm_sim.nodes.world_outputs`)."""
