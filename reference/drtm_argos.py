@@ -18,7 +18,7 @@ nothing here builds it: reference/README.md), compiles our loop functions
 (``reference/drtm_arena/``: the paper's arena, which the example's own loop functions cannot
 give: their nest is the strip x < -1), writes an experiment file with the example's controller
 parameters, the scenario's arena and a seed, runs ``argos3``, and turns the per-tick log into a
-row of ``results/reference/drtm/results.jsonl``. The energy ledger (F(t), V_f, E_e) is computed
+row of ``results/reference/drtm_example/results.jsonl``. The energy ledger (F(t), V_f, E_e) is computed
 from that log by our own `NestLedger`, so both columns use one formula.
 """
 from __future__ import annotations
@@ -209,12 +209,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--tree", required=True, type=Path, help="a built checkout of ilpincy/argos3-examples")
     p.add_argument("--commit", required=True, help="the checkout's commit (40 hex digits)")
     p.add_argument("--argos-commit", required=True, help="ARGoS 3's commit it was built from")
-    p.add_argument("--scenario", default="drtm", help="our scenario whose arena, swarm and ledger to use")
+    p.add_argument("--scenario", default="drtm_example",
+                   help="our scenario whose arena, swarm and ledger to use (the example's rule on our side)")
     p.add_argument("--seeds", type=int, default=20, help="seeds 1..N (ARGoS takes 0 as 'from the clock')")
     p.add_argument("--no-occlusions", action="store_true",
                    help="robots do not block range-and-bearing messages (our nest relays every announcement)")
     p.add_argument("--timeout", type=float, default=600.0, help="wall seconds one run may take")
-    p.add_argument("--out", type=Path, default=Path("results/reference/drtm/results.jsonl"))
+    p.add_argument("--out", type=Path, default=Path("results/reference/drtm_example/results.jsonl"))
     a = p.parse_args(argv)
     try:
         if not re.fullmatch(r"[0-9a-f]{40}", a.commit) or not re.fullmatch(r"[0-9a-f]{40}", a.argos_commit):
