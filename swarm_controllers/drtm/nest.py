@@ -13,9 +13,10 @@ ledger charges only moving foragers.
 Each tick (stamp t_k) the server applies the reports stamped before t_k, in order, then charges
 the tick just ended [t_{k-1}, t_k): `step_energy` per robot in S_S or S_R, C_rate dt / 60 tokens
 for the nest. A robot that reported LEFT at t_{k-1} is charged for that tick; one that reported
-DEPOSITED at t_{k-1} is not (it was waiting when the tick began). Then it answers every robot
-with `NestState` (F(t_k), N_W, M_T2, total OAEs); robots see it at t_{k+1}. The run trace's
-nest series are read off these states (`swarm_controllers.drtm.codec.OUTPUTS`).
+DEPOSITED or RETURNED_EMPTY (back without a token: the ARGoS foraging example's rule) at t_{k-1}
+is not (it was waiting when the tick began). Then it answers every robot with `NestState`
+(F(t_k), N_W, M_T2, total OAEs); robots see it at t_{k+1}. The run trace's nest series are read
+off these states (`swarm_controllers.drtm.codec.OUTPUTS`).
 """
 
 from __future__ import annotations
@@ -129,6 +130,9 @@ class NestServer:
             self.active.discard(m.robot)
             self.returning.discard(m.robot)
             self.ledger.deliver()
+        elif m.event is NestEvent.RETURNED_EMPTY:
+            self.active.discard(m.robot)
+            self.returning.discard(m.robot)
         elif m.event is NestEvent.AVOIDED:
             self.ledger.avoid()
             if self._window_all or m.robot in self.returning:

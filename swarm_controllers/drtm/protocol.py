@@ -30,6 +30,9 @@ class NestEvent(Enum):
     """S_R -> S_W: the robot delivered its token to the nest and stopped consuming energy."""
     AVOIDED = "avoided"
     """One obstacle-avoidance event (costs E_a)."""
+    RETURNED_EMPTY = "returned_empty"
+    """The robot came back to rest without a token (the ARGoS foraging example's unsuccessful
+    exploration): it stops consuming energy, nothing is delivered."""
 
 
 @dataclass(frozen=True, slots=True)
