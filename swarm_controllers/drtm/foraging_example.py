@@ -18,9 +18,9 @@ Each robot keeps RestToExploreProb and ExploreToRestProb, always clipped to [0, 
   has explored more than ``minimum_unsuccessful_explore_time`` ticks without a find draws each
   tick: with ExploreToRestProb it returns home empty, else ExploreToRestProb rises and
   RestToExploreProb falls by the food-rule deltas. Otherwise it walks: its TimeExploring-
-  Unsuccessfully grows, and every tick the diffusion vector reports a collision,
-  ExploreToRestProb rises and RestToExploreProb falls by ``collision_rule_explore_to_rest_delta_prob``
-  (every tick of it, as the example does). Its heading vector is ``max_speed`` x the diffusion
+  Unsuccessfully grows, and on every tick the diffusion vector reports a collision (every tick
+  of it, as the example does) ExploreToRestProb rises and RestToExploreProb falls by
+  ``collision_rule_explore_to_rest_delta_prob``. Its heading vector is ``max_speed`` x the diffusion
   vector, minus ``max_speed`` / 4 x the unit vector to the light while in the nest
   (anti-phototaxis). On the tick it turns home it sets no wheels (they keep the last tick's
   speeds, as ARGoS's actuator does).
@@ -42,9 +42,9 @@ example's loop functions, every robot not resting as walking: LEFT when it stops
 on each pick-up, AVOIDED once per collision episode (the tick the diffusion vector's collision
 flag rises, exploring or returning). When it rests it reports DEPOSITED once per token the world
 dropped in the nest during the trip (the world drops the token as its centre enters the nest, so
-the ledger credits it up to ~6 s late, when the robot rests), or RETURNED_EMPTY after a trip that
-delivered nothing (an unsuccessful exploration). A token dropped while resting (the world's drop
-came late) is reported DEPOSITED at once.
+the ledger credits it a little over 5 s late: the 51 ticks the robot looks for a place in the
+nest), or RETURNED_EMPTY after a trip that delivered nothing (an unsuccessful exploration). A
+token dropped while resting (the world's drop came late) is reported DEPOSITED at once.
 """
 
 from __future__ import annotations

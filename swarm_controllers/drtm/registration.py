@@ -66,7 +66,7 @@ register(Algorithm(
           "run's rule, not the paper's",
     behaviour="swarm_controllers.drtm.foraging_example:ForagingExampleBehaviour",
     task="nest",
-    config=(*_SECTIONS, ("example", "swarm_controllers.drtm.config:ExampleRuleConfig")),
+    config=(_SECTIONS[0], ("example", "swarm_controllers.drtm.config:ExampleRuleConfig")),
     checks=("swarm_controllers.drtm.config:check_nest", "swarm_controllers.drtm.config:check_example"),
     servers=(_SERVER,),
     metrics=_METRICS,

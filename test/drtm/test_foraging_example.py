@@ -110,7 +110,8 @@ def test_an_unsuccessful_exploration_gives_up_after_the_minimum_time_and_rests_e
     assert robot.state is ExampleState.EXPLORING and robot.explore_to_rest == 0.0
     for n in range(1, 4):  # each draw that keeps exploring: the food rule the other way
         clock.step()
-        assert robot.explore_to_rest == pytest.approx(0.01 * n) and robot.rest_to_explore == pytest.approx(0.1 - 0.01 * n)
+        assert robot.explore_to_rest == pytest.approx(0.01 * n)
+        assert robot.rest_to_explore == pytest.approx(0.1 - 0.01 * n)
     while robot.state is ExampleState.EXPLORING:
         clock.step()
     assert clock.k < 601 + 50  # ExploreToRestProb grows until a draw sends it home
@@ -178,7 +179,8 @@ def test_the_ledger_follows_the_robot_whatever_the_world_does(stretches, r2e, e2
     steps = [(carrying, inside, blocked) for carrying, inside, blocked, n in stretches for _ in range(n)]
     scenario = _scenario(f"controller.example.initial_rest_to_explore_prob={r2e}",
                          f"controller.example.initial_explore_to_rest_prob={e2r}",
-                         "controller.example.minimum_resting_time=2", "controller.example.minimum_unsuccessful_explore_time=5",
+                         "controller.example.minimum_resting_time=2",
+                         "controller.example.minimum_unsuccessful_explore_time=5",
                          "controller.example.minimum_search_for_place_in_nest_time=2",
                          "controller.example.collision_rule_explore_to_rest_delta_prob=0.3")
     robot = ForagingExampleBehaviour(scenario, "robot_0", np.random.default_rng(seed))
