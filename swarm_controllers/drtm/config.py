@@ -107,9 +107,7 @@ class ThresholdConfig(Section):
 class ExampleRuleConfig(Section):
     """The ARGoS foraging example's ``<state>`` parameters (ilpincy/argos3-examples,
     ``CFootBotForaging::SStateData::Init`` in ``controllers/footbot_foraging/footbot_foraging.cpp``;
-    values of ``experiments/foraging.argos``), named as in its XML; times in control ticks. Its
-    two ``social_rule_*`` deltas are left out: the social rule is not ported (the reference run
-    sets both to 0, see `swarm_controllers.drtm.foraging_example`)."""
+    values of ``experiments/foraging.argos``), named as in its XML; times in control ticks."""
 
     initial_rest_to_explore_prob: float = 0.1
     """RestToExploreProb at the start: a resting robot leaves with it once it has rested enough."""
@@ -121,6 +119,11 @@ class ExampleRuleConfig(Section):
     """RestToExploreProb rises by it on a find and falls by it on each draw that keeps exploring."""
     collision_rule_explore_to_rest_delta_prob: float = 0.01
     """Each exploring tick with a collision raises ExploreToRestProb and lowers RestToExploreProb by it."""
+    social_rule_rest_to_explore_delta_prob: float = 0.01
+    """A resting robot told of another's successful exploration raises RestToExploreProb by it
+    (and lowers it by it for an unsuccessful one)."""
+    social_rule_explore_to_rest_delta_prob: float = 0.01
+    """... and lowers ExploreToRestProb by it (raises it by it for an unsuccessful one)."""
     minimum_resting_time: int = 50
     """A resting robot draws only once it has rested more than this many ticks."""
     minimum_unsuccessful_explore_time: int = 600
@@ -132,7 +135,8 @@ class ExampleRuleConfig(Section):
 
     PROBABILITIES: ClassVar[tuple[str, ...]] = (
         "initial_rest_to_explore_prob", "initial_explore_to_rest_prob", "food_rule_explore_to_rest_delta_prob",
-        "food_rule_rest_to_explore_delta_prob", "collision_rule_explore_to_rest_delta_prob")
+        "food_rule_rest_to_explore_delta_prob", "collision_rule_explore_to_rest_delta_prob",
+        "social_rule_rest_to_explore_delta_prob", "social_rule_explore_to_rest_delta_prob")
     TIMES: ClassVar[tuple[str, ...]] = (
         "minimum_resting_time", "minimum_unsuccessful_explore_time", "minimum_search_for_place_in_nest_time")
 

@@ -33,9 +33,15 @@ nest's grey. ARGoS puts those at (-6.3, -1.16) and (6.3, -1.16) cm (the right-ha
 example's comment calls them the back pair); here both points, from the robot's pose and
 `swarm_sim.robots.footbot.MOTOR_GROUND_SENSORS`, lie in the depot disc (the nest).
 
-Not ported: the example's social rule (resting robots hearing the others' last exploration result
-over range-and-bearing and moving their probabilities by ``social_rule_*`` deltas): the reference
-run sets both deltas to 0, so neither side has it.
+* **The social rule** (``Rest()``): a robot that comes to rest tells the others whether its last
+  exploration found food (the example broadcasts it over range-and-bearing for one tick: TOLD_SUCCESSFUL
+  or TOLD_UNSUCCESSFUL to the nest here, which relays the counts in its next `NestState`). A
+  resting robot that does not leave on the tick it hears them moves its probabilities by the
+  ``social_rule_*`` deltas once per robot told: a success raises RestToExploreProb and lowers
+  ExploreToRestProb, a failure the reverse. Its own telling is not counted. Every resting robot
+  hears every telling, a tick later than in ARGoS (robot -> nest -> robot); in ARGoS a robot
+  within range-and-bearing's 3 m (the whole nest) hears it unless other robots block the line of
+  sight, which the reference run measures both ways (``--no-occlusions``).
 
 Reporting to the nest's ledger (`swarm_controllers.drtm.nest`), whose energy counts, like the
 example's loop functions, every robot not resting as walking: LEFT when it stops resting, FOUND
@@ -55,7 +61,7 @@ from enum import Enum
 import numpy as np
 
 from swarm_controllers.drtm.config import ExampleRuleConfig
-from swarm_controllers.drtm.protocol import NestEvent, NestReport
+from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_controllers.robots.wheel_turning import WheelTurning
 from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId
 from swarm_sim.robots.footbot import MOTOR_GROUND_SENSORS
@@ -103,6 +109,12 @@ class ForagingExampleBehaviour:
         self._carrying = False
         self._delivered = 0
         """Tokens dropped in the nest since the robot last rested."""
+        self._result: NestEvent | None = None
+        """The last exploration's result, told when the robot comes to rest (TOLD_*)."""
+        self._told_ns: int | None = None
+        """When it last told: the first nest state stamped after it counts its own telling."""
+        self._heard_ns = -1
+        """The stamp of the last nest state heard."""
         self._events = 0
         self._trips = 0
         self._stamp = 0
@@ -123,9 +135,13 @@ class ForagingExampleBehaviour:
             self._delivered += 1
             self._trips += 1
         self._carrying = carrying
+        news = None
+        for m in obs.messages:
+            if type(m) is NestState and m.stamp_ns > self._heard_ns:
+                news, self._heard_ns = m, m.stamp_ns
         colliding = False
         if self._state is ExampleState.RESTING:
-            self._rest(reports)
+            self._rest(reports, news)
         elif self._state is ExampleState.EXPLORING:
             colliding = self._explore(obs, reports)
         else:
@@ -145,8 +161,8 @@ class ForagingExampleBehaviour:
 
     # ------------------------------------------------------------------ states
 
-    def _rest(self, reports: list[NestEvent]) -> None:
-        """``Rest()``: the wheels stay stopped."""
+    def _rest(self, reports: list[NestEvent], news: NestState | None) -> None:
+        """``Rest()``: the wheels stay stopped; `news`, a nest state first heard this tick."""
         if self._delivered:  # the world dropped the token after the robot had come to rest
             reports.extend([NestEvent.DEPOSITED] * self._delivered)
             self._delivered = 0
@@ -156,16 +172,35 @@ class ForagingExampleBehaviour:
             reports.append(NestEvent.LEFT)
         else:
             self.time_rested += 1
+            if news is not None:
+                self._hear(news)
+
+    def _hear(self, news: NestState) -> None:
+        """The social rule: the deltas once per other robot told (see the module docstring)."""
+        good, bad = news.told_successful, news.told_unsuccessful
+        if self._told_ns is not None and news.stamp_ns > self._told_ns:
+            if self._result is NestEvent.TOLD_SUCCESSFUL:
+                good -= 1
+            else:
+                bad -= 1
+            self._told_ns = None
+        c = self.config
+        for _ in range(max(good, 0)):
+            self._shift(-c.social_rule_explore_to_rest_delta_prob, c.social_rule_rest_to_explore_delta_prob)
+        for _ in range(max(bad, 0)):
+            self._shift(c.social_rule_explore_to_rest_delta_prob, -c.social_rule_rest_to_explore_delta_prob)
 
     def _explore(self, obs: Observation, reports: list[NestEvent]) -> bool:
         """``Explore()``; True if the diffusion vector reported a collision."""
         c = self.config
         if self._carrying:  # success: the food rule
             self._shift(-c.food_rule_explore_to_rest_delta_prob, c.food_rule_rest_to_explore_delta_prob)
-            home = True
+            home, self._result = True, NestEvent.TOLD_SUCCESSFUL
         elif self.time_exploring_unsuccessfully > c.minimum_unsuccessful_explore_time:
             home = self._uniform() < self.explore_to_rest
-            if not home:
+            if home:
+                self._result = NestEvent.TOLD_UNSUCCESSFUL
+            else:
                 self._shift(c.food_rule_explore_to_rest_delta_prob, -c.food_rule_rest_to_explore_delta_prob)
         else:
             home = False
@@ -197,6 +232,8 @@ class ForagingExampleBehaviour:
                 self.time_searching_for_place_in_nest = 0
                 reports.extend([NestEvent.DEPOSITED] * self._delivered if self._delivered
                                else [NestEvent.RETURNED_EMPTY])
+                reports.append(self._result)
+                self._told_ns = obs.stamp_ns
                 self._delivered = 0
                 return False
             self.time_searching_for_place_in_nest += 1

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from swarm_controllers.drtm.foraging_example import ExampleState, ForagingExampleBehaviour
 from swarm_controllers.drtm.nest import NestServer
-from swarm_controllers.drtm.protocol import NestEvent, NestReport
+from swarm_controllers.drtm.protocol import NestEvent, NestReport, NestState
 from swarm_controllers.drtm.task import NestSense
 from swarm_msgs_py.types import Observation, Pose2D
 from swarm_sim import registry
@@ -37,8 +37,14 @@ BLOCKED = FREE.copy()
 BLOCKED[12] = 0.1  # ray 12 of the foot-bot's scan is the sensor at +7.5 deg: outside the +-5 deg window
 
 
-def _obs(k: int, pose=OUT, *, carrying=False, light=(0.5, 0.0), ranges=FREE) -> Observation:
-    return Observation("robot_0", k * DT_NS, Pose2D(*pose), 0.0, 0.0, ranges, NestSense((), carrying, light))
+def _obs(k: int, pose=OUT, *, carrying=False, light=(0.5, 0.0), ranges=FREE, messages=()) -> Observation:
+    return Observation("robot_0", k * DT_NS, Pose2D(*pose), 0.0, 0.0, ranges, NestSense((), carrying, light),
+                       messages)
+
+
+def _told(k: int, good: int, bad: int) -> NestState:
+    """The nest's state at tick k, relaying `good` successful and `bad` unsuccessful tellings."""
+    return NestState(k * DT_NS, 5.0, 2, 0, 0, good, bad)
 
 
 def _events(command) -> list[NestEvent]:
@@ -80,7 +86,7 @@ def test_a_robot_that_came_back_rests_more_than_the_minimum_resting_time(minimum
         clock.step(IN)
         assert robot.state is ExampleState.RETURNING
     c = clock.step(IN)
-    assert robot.state is ExampleState.RESTING and _events(c) == [NestEvent.DEPOSITED]
+    assert robot.state is ExampleState.RESTING and _events(c) == [NestEvent.DEPOSITED, NestEvent.TOLD_SUCCESSFUL]
     resting = [clock.step(IN) for _ in range(minimum + 1)]  # TimeRested 0 .. minimum: no draw
     assert robot.state is ExampleState.RESTING
     assert all((c.linear, c.angular, c.messages) == (0.0, 0.0, ()) for c in resting)
@@ -117,7 +123,7 @@ def test_an_unsuccessful_exploration_gives_up_after_the_minimum_time_and_rests_e
     assert clock.k < 601 + 50  # ExploreToRestProb grows until a draw sends it home
     assert _events(clock.step(IN)) == []  # TimeSearchingForPlaceInNest 0: not more than 0
     c = clock.step(IN)
-    assert robot.state is ExampleState.RESTING and _events(c) == [NestEvent.RETURNED_EMPTY]
+    assert robot.state is ExampleState.RESTING and _events(c) == [NestEvent.RETURNED_EMPTY, NestEvent.TOLD_UNSUCCESSFUL]
     assert robot.status().trips == 0
 
 
@@ -157,6 +163,50 @@ def test_the_nest_is_where_ground_sensors_2_and_3_both_are():
     assert robot.time_searching_for_place_in_nest == 3
     clock.step((0.74, 0.0, math.pi / 2))  # centre inside, the sensors out: not in the nest
     assert robot.time_searching_for_place_in_nest == 0
+
+
+def test_a_resting_robot_moves_its_probabilities_once_per_robot_told():
+    """The social rule: +-social delta per telling, each state heard once."""
+    robot = _robot("controller.example.minimum_resting_time=100")  # it does not leave meanwhile
+    robot.step(_obs(0, IN, messages=(_told(0, 2, 1),)))
+    assert robot.rest_to_explore == pytest.approx(0.1 + 0.02 - 0.01)
+    assert robot.explore_to_rest == pytest.approx(0.1 - 0.02 + 0.01)
+    robot.step(_obs(1, IN, messages=(_told(0, 2, 1),)))  # the same state again: nothing new
+    robot.step(_obs(2, IN, messages=(_told(1, 0, 3),)))
+    assert robot.rest_to_explore == pytest.approx(0.11 - 0.03)
+    assert robot.explore_to_rest == pytest.approx(0.09 + 0.03)
+
+
+def test_robots_not_resting_or_leaving_on_the_tick_do_not_hear():
+    robot = _robot("controller.example.initial_rest_to_explore_prob=1.0")
+    robot.step(_obs(0, IN, messages=(_told(0, 0, 0),)))
+    robot.step(_obs(1, IN, messages=(_told(1, 5, 0),)))  # it leaves on this tick (Rest()'s first branch)
+    assert robot.state is ExampleState.EXPLORING and robot.rest_to_explore == 1.0
+    assert robot.explore_to_rest == pytest.approx(0.1)
+    robot.step(_obs(2, OUT, messages=(_told(2, 0, 5),)))  # exploring: tellings are not for it
+    assert robot.explore_to_rest == pytest.approx(0.1) and robot.rest_to_explore == 1.0
+
+
+def test_a_robot_does_not_count_its_own_telling_and_the_nest_relays_the_others():
+    """Two robots through the nest: robot_0 comes back with food and tells; robot_1, resting, hears
+    it one tick after the nest applied it; robot_0 itself does not count it."""
+    scenario = _scenario("controller.example.minimum_resting_time=1000",
+                         "controller.example.minimum_search_for_place_in_nest_time=0")
+    teller = ForagingExampleBehaviour(scenario, "robot_0", np.random.default_rng(1))
+    listener = ForagingExampleBehaviour(scenario, "robot_1", np.random.default_rng(2))
+    teller._state = ExampleState.EXPLORING
+    nest = NestServer(scenario)
+    state = nest.step(0, [])[0]
+    sequence = [(OUT, True), (IN, False), (IN, False), (IN, False), (IN, False)]
+    for k, (pose, carrying) in enumerate(sequence, 1):
+        a = teller.step(_obs(k, pose, carrying=carrying, messages=(state,)))
+        b = listener.step(_obs(k, IN, messages=(state,)))
+        state = nest.step((k + 1) * DT_NS, [*a.messages, *b.messages])[0]
+        if NestEvent.TOLD_SUCCESSFUL in _events(a):
+            assert teller.state is ExampleState.RESTING and (state.told_successful, state.told_unsuccessful) == (1, 0)
+    assert listener.rest_to_explore == pytest.approx(0.11) and listener.explore_to_rest == pytest.approx(0.09)
+    assert teller.rest_to_explore == pytest.approx(0.11)  # the food rule's 0.01 only, not its own telling
+    assert state.told_successful == 0  # the nest relays a telling once
 
 
 def test_the_section_is_checked_naming_the_key():
