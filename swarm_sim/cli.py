@@ -65,19 +65,20 @@ def _first_sentence(text: str, width: int = 72) -> str:
     return sentence if len(sentence) <= width else sentence[: width - 3].rstrip() + "..."
 
 
-def scenario_table() -> list[str]:
-    """One line per shipped scenario: its name, its algorithm, robots, sim seconds and the first
-    sentence of the comment it opens with."""
-    lines = []
+def scenario_table(width: int = 120) -> list[str]:
+    """One line per shipped scenario, at most `width` characters: its name, its algorithm, robots,
+    sim seconds and the first sentence of the comment it opens with (cut to fit: an algorithm
+    name longer than its column shortens that line's sentence)."""
+    lines = [f"{'scenario':16s} {'algorithm':9s} {'robots':>5s} {'sim s':>7s}  about"]
     for name, path in scenario_files().items():
         text = path.read_text()
         data = yaml.safe_load(text) or {}
-        about = _first_sentence(text)
         controller = data.get("controller") or {}
         robots = (data.get("robots") or {}).get("count", "")
         duration = (data.get("sim") or {}).get("duration", "")
-        lines.append(f"{name:16s} {controller.get('behaviour', ''):9s} {robots!s:>5s} {duration!s:>7s}  {about}")
-    return [f"{'scenario':16s} {'algorithm':9s} {'robots':>5s} {'sim s':>7s}  about", *lines]
+        row = f"{name:16s} {controller.get('behaviour', ''):9s} {robots!s:>5s} {duration!s:>7s}  "
+        lines.append(row + _first_sentence(text, min(72, width - len(row))))
+    return lines
 
 
 class _ListScenarios(argparse.Action):

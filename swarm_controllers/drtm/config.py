@@ -1,10 +1,12 @@
-"""The DRTM paper's scenario sections (``controller.nest``, ``controller.threshold``).
+"""The DRTM paper's scenario sections (``controller.nest``, ``controller.threshold``,
+``controller.example``).
 
 Pang et al. 2023 (drtm_task_allocation.md): `NestConfig` is the nest's energy model of Sec. 3.1
 (the ledger the nest server keeps, eqs. (8)-(9)); `ThresholdConfig` the response-threshold
 foragers of Secs. 2.1-2.2 and 3.1, DRTM (eqs. (2)-(7)) and ARTM (Castello et al.) alike. Both
 algorithms declare both sections, so a DRTM and an ARTM run of one scenario file differ only in
-``controller.behaviour``.
+``controller.behaviour``. `ExampleRuleConfig` is the rule of the ARGoS foraging example, the
+DRTM reference run's (``foraging_example``, `swarm_controllers.drtm.foraging_example`).
 """
 
 from __future__ import annotations
@@ -99,6 +101,55 @@ class ThresholdConfig(Section):
     example's robots search for a place in the nest for 50 ticks."""
 
     SECTION: ClassVar[str] = "threshold"
+
+
+@dataclass(frozen=True)
+class ExampleRuleConfig(Section):
+    """The ARGoS foraging example's ``<state>`` parameters (ilpincy/argos3-examples,
+    ``CFootBotForaging::SStateData::Init`` in ``controllers/footbot_foraging/footbot_foraging.cpp``;
+    values of ``experiments/foraging.argos``), named as in its XML; times in control ticks."""
+
+    initial_rest_to_explore_prob: float = 0.1
+    """RestToExploreProb at the start: a resting robot leaves with it once it has rested enough."""
+    initial_explore_to_rest_prob: float = 0.1
+    """ExploreToRestProb at the start: an explorer that found nothing for long gives up with it."""
+    food_rule_explore_to_rest_delta_prob: float = 0.01
+    """ExploreToRestProb falls by it on a find and rises by it on each draw that keeps exploring."""
+    food_rule_rest_to_explore_delta_prob: float = 0.01
+    """RestToExploreProb rises by it on a find and falls by it on each draw that keeps exploring."""
+    collision_rule_explore_to_rest_delta_prob: float = 0.01
+    """Each exploring tick with a collision raises ExploreToRestProb and lowers RestToExploreProb by it."""
+    social_rule_rest_to_explore_delta_prob: float = 0.01
+    """A resting robot told of another's successful exploration raises RestToExploreProb by it
+    (and lowers it by it for an unsuccessful one)."""
+    social_rule_explore_to_rest_delta_prob: float = 0.01
+    """... and lowers ExploreToRestProb by it (raises it by it for an unsuccessful one)."""
+    minimum_resting_time: int = 50
+    """A resting robot draws only once it has rested more than this many ticks."""
+    minimum_unsuccessful_explore_time: int = 600
+    """An explorer draws to give up only after more than this many ticks without a find."""
+    minimum_search_for_place_in_nest_time: int = 50
+    """A returning robot rests after more than this many consecutive ticks in the nest."""
+
+    SECTION: ClassVar[str] = "example"
+
+    PROBABILITIES: ClassVar[tuple[str, ...]] = (
+        "initial_rest_to_explore_prob", "initial_explore_to_rest_prob", "food_rule_explore_to_rest_delta_prob",
+        "food_rule_rest_to_explore_delta_prob", "collision_rule_explore_to_rest_delta_prob",
+        "social_rule_rest_to_explore_delta_prob", "social_rule_explore_to_rest_delta_prob")
+    TIMES: ClassVar[tuple[str, ...]] = (
+        "minimum_resting_time", "minimum_unsuccessful_explore_time", "minimum_search_for_place_in_nest_time")
+
+
+def check_example(scenario: Scenario) -> None:
+    """Refuse settings the example's rule cannot use (ValueError naming the key)."""
+    example = ExampleRuleConfig.of(scenario)
+    for key in ExampleRuleConfig.PROBABILITIES:
+        if not 0.0 <= getattr(example, key) <= 1.0:
+            raise ValueError(f"controller.example.{key}: must be a probability in [0, 1]")
+    for key in ExampleRuleConfig.TIMES:
+        if getattr(example, key) < 0:
+            raise ValueError(f"controller.example.{key}: must not be negative [ticks]")
 
 
 def check_nest(scenario: Scenario) -> None:

@@ -13,9 +13,11 @@ ledger charges only moving foragers.
 Each tick (stamp t_k) the server applies the reports stamped before t_k, in order, then charges
 the tick just ended [t_{k-1}, t_k): `step_energy` per robot in S_S or S_R, C_rate dt / 60 tokens
 for the nest. A robot that reported LEFT at t_{k-1} is charged for that tick; one that reported
-DEPOSITED at t_{k-1} is not (it was waiting when the tick began). Then it answers every robot
-with `NestState` (F(t_k), N_W, M_T2, total OAEs); robots see it at t_{k+1}. The run trace's
-nest series are read off these states (`swarm_controllers.drtm.codec.OUTPUTS`).
+DEPOSITED or RETURNED_EMPTY (back without a token: the ARGoS foraging example's rule) at t_{k-1}
+is not (it was waiting when the tick began). Then it answers every robot with `NestState`
+(F(t_k), N_W, M_T2, total OAEs, and the TOLD_* reports it applied: the foraging example's social
+rule, relayed); robots see it at t_{k+1}. The run trace's nest series are read
+off these states (`swarm_controllers.drtm.codec.OUTPUTS`).
 """
 
 from __future__ import annotations
@@ -93,6 +95,9 @@ class NestServer:
         """Reports that could not be applied, by reason."""
         self.lost: set[str] = set()
         """Robots the world declared dead."""
+        self._told = [0, 0]
+        """TOLD_SUCCESSFUL and TOLD_UNSUCCESSFUL reports applied at this step: the nest relays them
+        to every robot (in ARGoS every resting robot within range-and-bearing's reach hears them)."""
 
     def robot_lost(self, robot: str, stamp_ns: int) -> None:
         """`robot` was declared dead: it no longer forages, its later reports are refused."""
@@ -101,6 +106,7 @@ class NestServer:
         self.returning.discard(robot)
 
     def step(self, stamp_ns: int, messages: Sequence[object]) -> tuple[NestState, ...]:
+        self._told = [0, 0]
         for m in messages:
             if isinstance(m, NestReport):
                 self._apply(m, stamp_ns)
@@ -111,7 +117,7 @@ class NestServer:
         while recent and recent[0] <= stamp_ns - self._window_ns:
             recent.popleft()
         state = NestState(stamp_ns, self.ledger.food, len(self.robots) - len(self.active), len(recent),
-                          self.ledger.avoidances)
+                          self.ledger.avoidances, *self._told)
         return (state,)
 
     def _apply(self, m: NestReport, stamp_ns: int) -> None:
@@ -129,6 +135,13 @@ class NestServer:
             self.active.discard(m.robot)
             self.returning.discard(m.robot)
             self.ledger.deliver()
+        elif m.event is NestEvent.RETURNED_EMPTY:
+            self.active.discard(m.robot)
+            self.returning.discard(m.robot)
+        elif m.event is NestEvent.TOLD_SUCCESSFUL:
+            self._told[0] += 1
+        elif m.event is NestEvent.TOLD_UNSUCCESSFUL:
+            self._told[1] += 1
         elif m.event is NestEvent.AVOIDED:
             self.ledger.avoid()
             if self._window_all or m.robot in self.returning:

@@ -30,6 +30,14 @@ class NestEvent(Enum):
     """S_R -> S_W: the robot delivered its token to the nest and stopped consuming energy."""
     AVOIDED = "avoided"
     """One obstacle-avoidance event (costs E_a)."""
+    RETURNED_EMPTY = "returned_empty"
+    """The robot came back to rest without a token (the ARGoS foraging example's unsuccessful
+    exploration): it stops consuming energy, nothing is delivered."""
+    TOLD_SUCCESSFUL = "told_successful"
+    """The robot came to rest and tells the resting robots its last exploration found food (the
+    ARGoS foraging example's social rule, which it broadcasts over range-and-bearing)."""
+    TOLD_UNSUCCESSFUL = "told_unsuccessful"
+    """As TOLD_SUCCESSFUL, for an exploration given up without a find."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -56,3 +64,7 @@ class NestState:
     """M_T2: OAEs reported within the last T_2 seconds."""
     total_oaes: int
     """OAEs reported since the start."""
+    told_successful: int = 0
+    """TOLD_SUCCESSFUL reports applied at this tick (the robots that came to rest in the last)."""
+    told_unsuccessful: int = 0
+    """TOLD_UNSUCCESSFUL reports applied at this tick."""

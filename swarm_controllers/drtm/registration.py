@@ -1,5 +1,6 @@
 """The DRTM paper's registry records (drtm_task_allocation.md, Pang et al. 2023): its nest task,
-DRTM and the ARTM baseline, both served by the nest."""
+DRTM and the ARTM baseline, both served by the nest, and the ARGoS foraging example's rule
+(``foraging_example``), the rule of the DRTM reference run, on the same nest."""
 
 from swarm_sim.registry import Algorithm, Measure, Metric, Panel, ServerSpec, TaskSpec, register, register_task
 
@@ -56,3 +57,21 @@ for _name, _class, _what in (("drtm", "DrtmBehaviour", "DRTM, eqs. (2)-(7)"),
         states=("waiting", "searching", "returning"),
         trace_status=True,
     ))
+
+register(Algorithm(
+    name="foraging_example",
+    authors_robot="footbot_foraging",
+    paper="drtm_task_allocation.md (Pang et al. 2023) sec. 3.1's set-up with the ARGoS foraging example's rule "
+          "(ilpincy/argos3-examples, controllers/footbot_foraging; social rule not ported): the DRTM reference "
+          "run's rule, not the paper's",
+    behaviour="swarm_controllers.drtm.foraging_example:ForagingExampleBehaviour",
+    task="nest",
+    config=(_SECTIONS[0], ("example", "swarm_controllers.drtm.config:ExampleRuleConfig")),
+    checks=("swarm_controllers.drtm.config:check_nest", "swarm_controllers.drtm.config:check_example"),
+    servers=(_SERVER,),
+    metrics=_METRICS,
+    headline=_HEADLINE,
+    panels=_PANELS,
+    states=("resting", "exploring", "returning"),
+    trace_status=True,
+))

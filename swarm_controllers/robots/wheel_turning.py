@@ -109,10 +109,10 @@ class WheelTurning:
     def update(self, ranges: np.ndarray) -> Command | None:
         if not self._looked:
             self._looked = True
-            x, y = self._ring.vector(ranges)
-            length = hypot(x, y)
-            if abs(atan2(y, x)) <= self._straight and length < self._delta:
+            near = self.diffusion(ranges)
+            if near is None:
                 return None
+            x, y, length = near
             self.active = True
             if not self._collided:
                 self.events += 1
@@ -121,6 +121,16 @@ class WheelTurning:
         return self._override
 
     turn_only = update
+
+    def diffusion(self, ranges: np.ndarray) -> tuple[float, float, float] | None:
+        """``DiffusionVector``: None when the robot may go straight (no collision), else the sum of
+        the proximity readings (x, y) [body frame] and its length; the robot heads away from it.
+        Pure: it neither counts nor steers."""
+        x, y = self._ring.vector(ranges)
+        length = hypot(x, y)
+        if abs(atan2(y, x)) <= self._straight and length < self._delta:
+            return None
+        return x, y, length
 
     def reset(self) -> None:
         self._next = (self._next[0], False)

@@ -15,7 +15,9 @@ Every value from ilpincy/argos3 (``src/plugins/robots/foot-bot/simulator/``):
   at any distance (its reading falls with distance, but the foraging example only uses the
   direction of the sum: ``CFootBotForaging::CalculateVectorToLight``).
 - motor ground sensors: four, at (+-0.063, +-0.0116) m in the body frame (``footbot_entity.cpp``,
-  the grayscale ground sensors), 0.0641 m from the centre.
+  the grayscale ground sensors), 0.0641 m from the centre; readings 0-3 at (0.063, 0.0116),
+  (-0.063, 0.0116), (-0.063, -0.0116), (0.063, -0.0116) m
+  (``control_interface/ci_footbot_motor_ground_sensor.cpp``).
 
 Here the ring is the scan: 24 rays over 345 deg (a scan that is not a full circle puts its rays on
 both edges, ``fov / (rays - 1)`` = 15 deg apart from -172.5 deg), i.e. the foot-bot's sensor
@@ -41,7 +43,9 @@ RING_RANGE = 0.1
 """[m] beyond the body, along each sensor's ray."""
 RING_FOV = math.radians(345.0)
 """The scan's field of view that puts its 24 rays on the foot-bot's sensor directions [rad]."""
-GROUND_SENSOR_OFFSET = math.hypot(0.063, 0.0116)
+MOTOR_GROUND_SENSORS = ((0.063, 0.0116), (-0.063, 0.0116), (-0.063, -0.0116), (0.063, -0.0116))
+"""[m, body frame, x ahead, y left] the motor ground sensors, in the order of their readings."""
+GROUND_SENSOR_OFFSET = math.hypot(*MOTOR_GROUND_SENSORS[0])
 """[m] from the centre to each motor ground sensor."""
 _NEAR = 0.009889556
 _A = 0.0100527

@@ -71,6 +71,25 @@ def test_the_ledger_step_by_step_on_a_scripted_history():
     assert [s.total_oaes for s in states] == [0, 0, 1, 3, 3, 3, 3]
 
 
+def test_a_robot_back_empty_stops_being_charged_and_delivers_nothing():
+    """The ARGoS foraging example's unsuccessful exploration (RETURNED_EMPTY): charged from LEFT
+    to its return like a forager, nothing delivered, waiting again."""
+    nest = NestServer(_scenario())
+    script = {1: [_report(0, 0, NestEvent.LEFT)], 4: [_report(3, 0, NestEvent.RETURNED_EMPTY)]}
+    states = [nest.step(k * DT_NS, script.get(k, []))[0] for k in range(7)]
+    # ticks 1-3 charge robot_0 (1 unit each), every tick charges the nest 5 units
+    assert [s.food * 1500.0 for s in states] == pytest.approx([7500.0, 7494.0, 7488.0, 7482.0, 7477.0, 7472.0, 7467.0])
+    assert [s.waiting for s in states] == [3, 2, 2, 2, 3, 3, 3]
+    assert nest.ledger.deliveries == 0 and not nest.active
+
+
+def test_every_nest_event_crosses_the_graph():
+    reports = tuple(NestReport(7 * DT_NS, "robot_1", e) for e in NestEvent)
+    (data,) = NEST.encode(7 * DT_NS, reports)
+    assert NEST.decode(data) == reports
+    assert NestReport(7 * DT_NS, "robot_1", NestEvent.RETURNED_EMPTY) in NEST.decode(data)
+
+
 def test_recent_oaes_and_waiting_robots_from_a_hand_made_history():
     nest = NestServer(_scenario("controller.nest.oae_window=0.5"))  # T_2 = 5 ticks
     oae_ticks = [0, 1, 1, 4, 9]
@@ -125,7 +144,7 @@ def test_food_changes_only_by_deliveries_consumption_and_the_nest_rate(events, p
         for m in batch:
             if m.event is NestEvent.LEFT:
                 active.add(m.robot)
-            elif m.event is NestEvent.DEPOSITED:
+            elif m.event in (NestEvent.DEPOSITED, NestEvent.RETURNED_EMPTY):
                 active.discard(m.robot)
         state = nest.step(k * DT_NS, batch)[0]
         deliveries = sum(m.event is NestEvent.DEPOSITED for m in batch)
