@@ -15,7 +15,7 @@
  *    randomly");
  *  - it logs, every tick, what swarmforage's nest ledger needs: robots not resting (the
  *    example's "walking" robots, charged one unit a tick), tokens dropped in the nest (F_t),
- *    deliveries booked when a successful robot comes to rest (the ledger's DEPOSITED), and
+ *    deliveries booked when the robot that dropped them comes to rest (the ledger's DEPOSITED), and
  *    obstacle-avoidance events (OAEs): one per episode, an episode being the ticks in which the
  *    controller's diffusion (its DiffusionVector) turns away from an obstacle, read from the
  *    same proximity readings with the same two thresholds. The energy ledger itself is computed
@@ -125,7 +125,7 @@ public:
          SRobot& sR = m_vecRobots[i++];
          size_t unTotal = cCtrl.GetFoodData().TotalFoodItems;
          if(cCtrl.IsResting()) {
-            if(!sR.Resting && unTotal > sR.TotalAtLeave) ++m_unDeliveries;
+            if(!sR.Resting) m_unDeliveries += unTotal - sR.TotalAtLeave;
             sR.Resting = true;
             sR.Avoiding = false;
             continue;
