@@ -1,0 +1,88 @@
+"""Our ``drtm_example`` runs against the ARGoS foraging example run here (``drtm_argos.py``): the
+same rule on both sides, so what differs is the robot, the world and our port.
+
+Prints a markdown table (CAUSES.md, DRTM): each of the DRTM paper's measures plus the robots
+foraging, ARGoS's runs (each range-and-bearing setting) beside ours, judged on REPORT's scale for
+a level against the authors' code (`swarm_sim.compare.reference.against_reference`: our mean within
+±25 % of theirs, Welch's two one-sided tests, Holm over the table's cells).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # our package
+from swarm_sim.compare.reference import against_reference  # noqa: E402
+from swarm_sim.compare.verdicts import ALPHA, CONTRADICTS, HOLDS, LEVEL, NOT_SHOWN, Claim, holm  # noqa: E402
+
+MEASURES = (("food_collected", "F_t [tokens]", 1.0), ("oae_total", "M_T [events]", 1.0),
+            ("oae_per_robot", "M_v [events/robot]", 1.0), ("food_deviation", "V_f [tokens]", 1.0),
+            ("energy_efficiency", "E_e [%]", 100.0), ("nest_food_final", "F(T) [tokens]", 1.0),
+            ("robots_foraging", "robots foraging (mean over t)", 1.0))
+
+
+def value(row: dict, measure: str, scale: float) -> float:
+    """A row's measure; robots foraging is the mean of its 5-s series (both sides sample it alike)."""
+    if measure == "robots_foraging":
+        series = row["active_robots_series"]
+        return sum(v for _, v in series) / len(series)
+    return float(row[measure]) * scale
+
+
+def table(ours: list[dict], reference: dict[str, list[dict]]) -> list[str]:
+    """The markdown lines: one row per measure, a column per reference setting, ours, and ours
+    against the setting named last."""
+    names = list(reference)
+    judged = names[-1]
+    cells = []
+    for measure, label, scale in MEASURES:
+        mine = [value(r, measure, scale) for r in ours]
+        theirs = [value(r, measure, scale) for r in reference[judged]]
+        claim = Claim(f"drtm_example.{measure}", LEVEL, label, "reference", measure, "foraging_example", value=0.0)
+        cells.append((label, measure, scale, mine, against_reference(claim, mine, theirs, 0)))
+    adjusted = holm([cv.p for *_, cv in cells])
+    out = [f"| measure | {' | '.join(f'ARGoS, {n} ({len(reference[n])} runs)' for n in names)} | "
+           f"ours ({len(ours)} runs) | ours vs ARGoS, {judged} [95 % CI] | verdict |",
+           "|---|" + "---|" * (len(names) + 3)]
+    for (label, measure, scale, mine, cv), p in zip(cells, adjusted):
+        refs = [_fmt([value(r, measure, scale) for r in reference[n]]) for n in names]
+        verdict = (HOLDS if cv.reason == "inside" else CONTRADICTS) if p < ALPHA else NOT_SHOWN
+        ci = f"[{cv.ci[0]:+.0f}, {cv.ci[1]:+.0f}]" if all(map(math.isfinite, cv.ci)) else ""
+        out.append(f"| {label} | {' | '.join(refs)} | {_fmt(mine)} | {cv.effect:+.1f} % {ci}, p = {p:.2g} | "
+                   f"{verdict} |")
+    return out
+
+
+def _fmt(xs: list[float]) -> str:
+    mean = sum(xs) / len(xs)
+    sd = math.sqrt(sum((x - mean) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else 0.0
+    return f"{mean:.3g} ± {sd:.2g}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--ours", type=Path, default=Path("results/authors/drtm_example/results.jsonl"))
+    p.add_argument("--reference", type=Path, default=Path("results/reference/drtm_example/results.jsonl"))
+    a = p.parse_args(argv)
+    try:
+        ours = [json.loads(line) for line in a.ours.read_text().splitlines() if line.strip()]
+        reference: dict[str, list[dict]] = {}
+        for line in a.reference.read_text().splitlines():
+            if line.strip():
+                r = json.loads(line)
+                occluded = json.loads(r["settings"])["rab_occlusions"]
+                reference.setdefault("occlusions on" if occluded else "occlusions off", []).append(r)
+        if not ours or not reference:
+            raise ValueError("no runs to compare")
+        print("\n".join(table(ours, dict(sorted(reference.items(), reverse=True)))))
+    except (OSError, ValueError, KeyError) as e:
+        print(f"drtm_versus: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
