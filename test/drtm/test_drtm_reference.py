@@ -63,3 +63,22 @@ def test_the_experiment_carries_the_scenario_and_the_examples_parameters(tmp_pat
 def test_seed_zero_is_refused_as_argos_would_take_the_clock(tmp_path):
     with pytest.raises(da.ReferenceError, match="seed 0"):
         da.experiment_xml(TEN_TICKS, 0, tmp_path, tmp_path / "log.tsv", occlusions=True)
+
+
+_vs_spec = importlib.util.spec_from_file_location("drtm_versus", _PATH.parent / "drtm_versus.py")
+dv = importlib.util.module_from_spec(_vs_spec)
+_vs_spec.loader.exec_module(dv)
+
+
+def _row(scale, k):
+    """A run whose every measure is `scale` x a base value, with some spread over k."""
+    x = scale * (1.0 + 0.02 * (k % 5 - 2))
+    return {"food_collected": 100 * x, "oae_total": 1000 * x, "oae_per_robot": 50 * x, "food_deviation": 5 * x,
+            "energy_efficiency": 0.2 * x, "nest_food_final": 20 * x, "active_robots_series": [[0.0, 10 * x]]}
+
+
+@pytest.mark.parametrize("scale, verdict", [(1.0, "holds"), (2.0, "contradicts")])
+def test_ours_is_judged_against_the_reference_on_the_level_scale(scale, verdict):
+    lines = dv.table([_row(scale, k) for k in range(20)], {"occlusions off": [_row(1.0, k) for k in range(20)]})
+    assert len(lines) == 2 + len(dv.MEASURES)
+    assert all(line.endswith(f"| {verdict} |") for line in lines[2:])
