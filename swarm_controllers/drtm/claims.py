@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from swarm_sim.compare.verdicts import LEVEL, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
+from swarm_sim.compare.verdicts import LEVEL, MEASURED, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
 
 DRTM_STRATEGIES: tuple[str, ...] = ("drtm", "artm")
 DRTM_LABELS: dict[str, str] = {"drtm": "DRTM", "artm": "ARTM"}
@@ -86,19 +86,56 @@ PAPER_TTESTS: dict[str, dict[str, tuple[float, float]]] = {
 """THE PAPER'S Tables 2 and 4: (t, two-tailed p) of DRTM vs ARTM, 50 runs each (98 d.o.f.), all
 reported significant; the paper gives no sign convention and every t is positive."""
 
-_BODY = Cause(PARTIAL, "the foot-bot's 0.17 m body: with the e-puck's 0.07 m body DRTM's OAEs fall below ARTM's "
-                       "at 3.1 and DRTM keeps F closer to F_d at 4.3-4.4 (factor `body_0.07`, drtm31 / drtm43, "
-                       "2 seeds)", "body_0.07", 2)
+RELATION_STEPS: dict[tuple[str, str], tuple[tuple[float, float], ...]] = {
+    ("oae_total", "body_0.07"): ((25.6, -6.4), (30.2, 1.2), (11.2, 0.3), (14.7, 7.6), (6.7, 87.5)),
+    ("food_deviation", "body_0.07"): ((-13.6, -28.9), (-25.6, -32.4), (-8.7, -25.2), (54.4, -37.7),
+                                      (121.7, -14.7)),
+    ("energy_efficiency", "mt2_returning"): ((-21.9, -0.2), (-23.3, -4.6), (-11.9, 11.9), (-40.1, -17.0),
+                                             (-29.7, -16.3)),
+}
+"""Issue 37's one-factor steps on the authors' robot, condition by condition (cells 0-4): DRTM
+against ARTM [% of ARTM] in our main sweep (20 seeds) and with the factor alone switched (groups
+``drtm31``, ``drtm41``, ``drtm43``: seeds 0-9; FACTORS.md)."""
+
+_GROUPS = {0: "drtm31", 1: "drtm41", 2: "drtm41", 3: "drtm43", 4: "drtm43"}
+_FACTOR_WORDS = {"body_0.07": "the foot-bot's 0.17 m body (the e-puck's 0.07 m on the foot-bot's motion and sensors)",
+                 "mt2_returning": "our reading of M_T2 (every forager's OAEs; Sec. 2.2's other reading, the "
+                                  "returning robots' only, lowers DRTM's OAE term beta M_A)"}
+
+
+def _step_cause(measure: str, factor: str, cells: tuple[int, ...], paper: dict[int, float]) -> Cause:
+    """The factor as the cause of a relation's gap: measured where switching it alone closes at
+    least half the gap (in points of the DRTM-vs-ARTM size) in every cell the claim covers,
+    partial where it does in some, open where in none."""
+    steps = RELATION_STEPS[(measure, factor)]
+    closes = [abs(steps[c][1] - paper[c]) <= abs(steps[c][0] - paper[c]) / 2 for c in cells]
+    grade = MEASURED if all(closes) else PARTIAL if any(closes) else OPEN
+    detail = "; ".join(f"{DRTM_CONDITIONS[c].section}: {steps[c][0]:+g} -> {steps[c][1]:+g} % (paper "
+                       f"{paper[c]:+g})" for c in cells)
+    kept = [DRTM_CONDITIONS[c].section for c, ok in zip(cells, closes) if ok]
+    verdict = ("it closes at least half the gap in every condition" if grade == MEASURED
+               else f"it closes at least half the gap in {', '.join(kept)} only" if kept
+               else "it closes half the gap in no condition: not this factor")
+    groups = ",".join(dict.fromkeys(_GROUPS[c] for c in cells))
+    return Cause(grade, f"{_FACTOR_WORDS[factor]}: DRTM against ARTM, ours -> with the factor alone switched "
+                        f"(10 seeds): {detail}; {verdict} (groups {groups}, FACTORS.md, CAUSES.md)",
+                 f"{groups}/{factor}", 10)
+
+
 _LEVEL = Cause(OPEN, "not measured: the paper's numbers come from ARGoS runs whose OAE rule and sensing the paper "
-                     "does not give in full, and the authors published no code (CAUSES.md, DRTM)")
-_OAE = Cause(OPEN, "how ARGoS counted an OAE is not stated and the authors published no code: our counts are "
-                   "1-5x the paper's; not measured")
-_EE = Cause(PARTIAL, "E_e = F(T) / F_t: the food DRTM keeps in the nest carries 62-96 % of the gap (the split in "
-                     "each table.md, 20 seeds); F settles where S = F_d - F meets a threshold whose OAE term "
-                     "is our OAE count (`mt2_returning`, `body_0.07`: 2 seeds)", "mt2_returning", 2)
+                     "does not give in full, and the authors published no code. Not our robot or world: with the "
+                     "ARGoS foraging example's rule in the paper's arena ours is within 25 % of ARGoS's on F_t, "
+                     "M_T, E_e, F(T) and the robots foraging (reference/drtm_versus.py, 20 seeds each; CAUSES.md)")
+_OAE = Cause(OPEN, "how the paper counted an OAE is not stated and the authors published no code: our counts are "
+                   "1-5x the paper's. Not our robot or world: with the ARGoS foraging example's rule in the paper's "
+                   "arena, counting as we do (one per episode of its diffusion), ours makes 12 % fewer OAEs than "
+                   "ARGoS's foot-bots (3604 against 4071, 20 seeds each; CAUSES.md)")
 _FT_TEST = Cause(OPEN, "not measured: our DRTM and ARTM collect within a few per cent of each other; what would "
                        "separate them as Tables 2 and 4 do is not known")
-_FT = Cause(OPEN, "F_t is 30-40 % below the paper's on both robots; not measured")
+_FT = Cause(OPEN, "F_t is 30-40 % below the paper's on both robots. Not our robot's foraging: with the ARGoS "
+                  "foraging example's rule ours collects 2 % more than ARGoS's foot-bots (277 against 272, 20 "
+                  "seeds each), and our DRTM sends out 7.4 robots on average where the example's rule sends 16; "
+                  "how many DRTM sends goes back to its OAE term (CAUSES.md); not measured")
 
 
 def _section(cell: int) -> str:
@@ -123,21 +160,31 @@ def _pct(metric: str, cell: int) -> float:
     return round(100.0 * (p["drtm"][metric] - p["artm"][metric]) / p["artm"][metric], 1)
 
 
+def _sizes(metric: str) -> dict[int, float]:
+    """The paper's DRTM against ARTM [% of ARTM], condition by condition."""
+    return {c: _pct(metric, c) for c in range(len(DRTM_CONDITIONS))}
+
+
 def _relations() -> list[Claim]:
     every = tuple(range(len(DRTM_CONDITIONS)))
     vf = tuple(c for c in every if c != 1)
     out = [
         Claim("DRTM<ARTM.V_f", RELATION, "DRTM keeps the food closer to F_d (V_f lower than ARTM's)",
               "Secs. 3.1, 4.2-4.4", "food_deviation", "artm", vf, b="drtm", sign=-1,
-              sizes=tuple((c, _pct("food_deviation", c)) for c in vf), causes=(("authors", _BODY),)),
+              sizes=tuple((c, _pct("food_deviation", c)) for c in vf),
+              causes=(("authors", _step_cause("food_deviation", "body_0.07", vf, _sizes("food_deviation"))),)),
         Claim("DRTM=ARTM.V_f.4.1", RELATION, "both keep the food near F_d with N_f = 25 (V_f 2.90 / 2.92)",
-              "Sec. 4.1", "food_deviation", "artm", (1,), b="drtm", sign=0, causes=(("authors", _BODY),)),
+              "Sec. 4.1", "food_deviation", "artm", (1,), b="drtm", sign=0,
+              causes=(("authors", _step_cause("food_deviation", "body_0.07", (1,), _sizes("food_deviation"))),)),
         Claim("DRTM<ARTM.M_T", RELATION, "DRTM has fewer obstacle-avoidance events (M_T)",
               "Secs. 3.1, 4.1-4.4; Tables 2, 4", "oae_total", "artm", every, b="drtm", sign=-1,
-              sizes=tuple((c, _pct("oae_total", c)) for c in every), causes=(("authors", _BODY),)),
+              sizes=tuple((c, _pct("oae_total", c)) for c in every),
+              causes=(("authors", _step_cause("oae_total", "body_0.07", every, _sizes("oae_total"))),)),
         Claim("DRTM>ARTM.E_e", RELATION, "DRTM is more energy-efficient (E_e higher)", "Secs. 3.1, 4.1-4.4",
               "energy_efficiency", "artm", every, b="drtm", sign=1, scale=100.0,
-              sizes=tuple((c, _pct("energy_efficiency", c)) for c in every), causes=(("authors", _EE),)),
+              sizes=tuple((c, _pct("energy_efficiency", c)) for c in every),
+              causes=(("authors", _step_cause("energy_efficiency", "mt2_returning", every,
+                                              _sizes("energy_efficiency"))),)),
     ]
     for cell in every:
         size = _pct("food_collected", cell)

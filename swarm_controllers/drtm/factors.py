@@ -1,5 +1,5 @@
 """The DRTM paper's factor groups (`swarm_sim.factor_sweeps`, run by ``scripts/factors``): Sec. 3.1,
-and Secs. 4.3 and 4.4, the authors' robot against one factor changed at a time.
+Secs. 4.1 and 4.2, and Secs. 4.3 and 4.4, the authors' robot against one factor changed at a time.
 
 footbot_foraging against the generic (e-puck-sized) robot of drtm.yaml: body 0.17 vs 0.07 m, turn
 rate 1.43 vs 3.8 rad/s, ring 0.1 m vs 0.1 m beyond the body (24 rays each), light everywhere vs
@@ -33,6 +33,13 @@ GROUPS = (
         Factor("mt2_returning", "DRTM's rule reading: M_T2 counts the OAEs of robots in S_R only (Sec. 2.2: \"the "
                "number of OAEs due to robots within state S_R can well reflect the traffic conditions\") instead of "
                "every forager's", _MT2),
+    )),
+    # Secs. 4.1 and 4.2 (25 tokens; E_a = 20): the two factors that carry the relations elsewhere, so that
+    # every condition has them at 10 seeds (issue 37).
+    FactorGroup("drtm41", ("drtm", "--conditions", "4.1", "4.2"), "drtm/results.jsonl", "1,2", (
+        BASELINE, BODY,
+        Factor("mt2_returning", "DRTM's rule reading: M_T2 counts the OAEs of robots in S_R only instead of every "
+               "forager's", _MT2),
     )),
     # Secs. 4.3 and 4.4 (30 robots; the 3 m arena), where V_f fails on foot-bots: the same factors.
     FactorGroup("drtm43", ("drtm", "--conditions", "4.3", "4.4"), "drtm/results.jsonl", "3,4", (
