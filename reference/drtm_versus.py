@@ -56,6 +56,42 @@ def table(ours: list[dict], reference: dict[str, list[dict]]) -> list[str]:
     return out
 
 
+PANELS = (("active_robots_series", "robots foraging"), ("nest_food_series", "F(t) [tokens]"),
+          ("oae_series", "OAEs so far [events]"))
+
+
+def figure(ours: list[dict], reference: dict[str, list[dict]], path: Path) -> None:
+    """Time series, mean and one standard deviation over runs (each series every 5 s): robots
+    foraging, F(t) and OAEs so far; ARGoS's settings beside ours."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig, axes = plt.subplots(1, len(PANELS), figsize=(15, 4.2))
+    runs = [*(f"ARGoS, {n}" for n in reference), "ours"]
+    styles = {"ARGoS, occlusions on": ("0.55", "--"), "ARGoS, occlusions off": ("tab:blue", "-"),
+              "ours": ("tab:orange", "-")}
+    for ax, (key, label) in zip(axes, PANELS):
+        for name, rows in zip(runs, [*reference.values(), ours]):
+            n = min(len(r[key]) for r in rows)
+            t = np.array([p[0] for p in rows[0][key][:n]])
+            y = np.array([[p[1] for p in r[key][:n]] for r in rows], dtype=float)
+            colour, line = styles.get(name, ("k", ":"))
+            ax.plot(t, y.mean(axis=0), color=colour, linestyle=line, label=f"{name} ({len(rows)} runs)")
+            ax.fill_between(t, y.mean(axis=0) - y.std(axis=0), y.mean(axis=0) + y.std(axis=0), color=colour,
+                            alpha=0.15, linewidth=0)
+        ax.set(xlabel="t [s]", ylabel=label, xlim=(0, None))
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="lower right", fontsize=8)
+    fig.suptitle("The ARGoS foraging example's rule in the DRTM paper's arena (Sec. 3.1): ARGoS against ours "
+                 "(mean ± sd)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
 def _fmt(xs: list[float]) -> str:
     mean = sum(xs) / len(xs)
     sd = math.sqrt(sum((x - mean) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else 0.0
@@ -66,6 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--ours", type=Path, default=Path("results/authors/drtm_example/results.jsonl"))
     p.add_argument("--reference", type=Path, default=Path("results/reference/drtm_example/results.jsonl"))
+    p.add_argument("--figure", type=Path, help="also draw the time series to this PNG")
     a = p.parse_args(argv)
     try:
         ours = [json.loads(line) for line in a.ours.read_text().splitlines() if line.strip()]
@@ -77,7 +114,10 @@ def main(argv: list[str] | None = None) -> int:
                 reference.setdefault("occlusions on" if occluded else "occlusions off", []).append(r)
         if not ours or not reference:
             raise ValueError("no runs to compare")
-        print("\n".join(table(ours, dict(sorted(reference.items(), reverse=True)))))
+        reference = dict(sorted(reference.items(), reverse=True))
+        print("\n".join(table(ours, reference)))
+        if a.figure:
+            figure(ours, reference, a.figure)
     except (OSError, ValueError, KeyError) as e:
         print(f"drtm_versus: {e}", file=sys.stderr)
         return 2
