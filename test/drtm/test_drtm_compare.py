@@ -104,3 +104,15 @@ def test_every_number_of_the_paper_is_a_level_and_drtm_against_artm_is_judged_pe
     assert found["DRTM=ARTM.V_f.4.1"].cells[0].cell == 1
     assert all(c.effect < 0 for c in vf.cells) and vf.verdict != CONTRADICTS
     assert found["F_t.3.1"].claim.sign == -1 and found["F_t.4.1"].claim.sign == 1  # the paper's means
+
+
+def test_a_relations_cause_is_graded_by_how_much_of_the_gap_its_factor_closes(monkeypatch):
+    """Measured: half the gap closed in every condition; partial: in some; open: in none."""
+    from swarm_controllers.drtm import claims
+
+    paper = {0: -20.0, 1: -20.0}
+    for steps, grade in ((((20.0, -10.0), (30.0, -5.0)), "measured"), (((20.0, -10.0), (30.0, 20.0)), "partial"),
+                         (((20.0, 10.0), (30.0, 40.0)), "open")):
+        monkeypatch.setitem(claims.RELATION_STEPS, ("oae_total", "body_0.07"), steps)
+        cause = claims._step_cause("oae_total", "body_0.07", (0, 1), paper)
+        assert cause.grade == grade and cause.seeds == 10 and "drtm31,drtm41/body_0.07" == cause.factor
