@@ -95,7 +95,7 @@ def figure(ours: list[dict], reference: dict[str, list[dict]], path: Path) -> No
 def _fmt(xs: list[float]) -> str:
     mean = sum(xs) / len(xs)
     sd = math.sqrt(sum((x - mean) ** 2 for x in xs) / (len(xs) - 1)) if len(xs) > 1 else 0.0
-    return f"{mean:.3g} ± {sd:.2g}"
+    return f"{mean:.0f} ± {sd:.0f}" if abs(mean) >= 100 else f"{mean:.3g} ± {sd:.2g}"
 
 
 def main(argv: list[str] | None = None) -> int:
