@@ -51,6 +51,13 @@ class SpiralConfig(Section):
     still ask within the center's range (the authors' robots read the assignment from shared
     memory anywhere)."""
 
+    lane_yield: bool = True
+    """A searcher on its lane yields (stops) to what is in its own lane ahead and swerves only
+    after `ddsa.LANE_YIELD_TIMEOUT` (`ddsa.LaneAvoidance`: this project's rule since issue 4, for
+    adjacent lanes one gap apart). False: every state avoids by the robot model's avoidance alone,
+    as the authors' controllers do (``BaseController::CollisionDetection`` in ``Move``, no
+    yielding: MARSLab-UTRGV DDSA and MDBSA, luki-dev, ``source/Base/BaseController.cpp``)."""
+
     SECTION: ClassVar[str] = "spiral"
 
 

@@ -139,6 +139,8 @@ class LaneAvoidance:
         reach the outer lanes (``arena_margin`` = 0.2 m from the walls) head on."""
         self.half_width = SpiralConfig.of(scenario).gap / 2.0
         self.yield_timeout = float(yield_timeout)
+        self.lane_yield = SpiralConfig.of(scenario).lane_yield
+        """False: the lane rule is off and the general avoidance applies on the lane too."""
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
         self._rays = [(i, math.cos(a), abs(math.sin(a)))
                       for i, a in enumerate(ray_angles(scenario.sensors.scan))
@@ -172,7 +174,7 @@ class LaneAvoidance:
     def update(self, ranges: np.ndarray | Sequence[float], t: float, *,
                on_lane: bool) -> Command | None:
         """The command overriding the behaviour this tick, or None. t: sim time [s]."""
-        if self._general_on or not on_lane:
+        if self._general_on or not on_lane or not self.lane_yield:
             self._yield_since = None
             return self._general(ranges)
         if not self.lane_blocked(ranges):

@@ -21,7 +21,7 @@ from swarm_sim.analysis.metrics import resources_delivered
 from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
-from swarm_sim.scenario import ScenarioError
+from swarm_sim.scenario import ScenarioError, load_scenario
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("ddsa", robots__count=4)
@@ -249,6 +249,17 @@ def test_lane_avoidance_ignores_what_is_behind_or_far_and_lets_the_behaviour_ste
     assert la.events == 0 and not la.yielding
     # Off the lane the same neighbour is an obstacle for the general avoidance.
     assert la.update(circle_ranges(0.12, 0.12), 0.1, on_lane=False) is not None
+
+
+def test_without_the_lane_rule_the_general_avoidance_acts_on_the_lane_too():
+    """``controller.spiral.lane_yield=false`` (the authors' controllers): a robot in the lane ahead
+    is no yield but the robot model's avoidance, as off the lane."""
+    ahead = circle_ranges(0.2, 0.0)
+    on = lane()
+    assert on.update(ahead, 0.0, on_lane=True) == STOP and on.yielding
+    off = LaneAvoidance(load_scenario("ddsa", ["controller.spiral.lane_yield=false"]))
+    command = off.update(ahead, 0.0, on_lane=True)
+    assert command is not None and command != STOP and not off.yielding and off.events == 1
 
 
 def test_batch_run_delivers_and_searchers_keep_to_their_own_lanes(monkeypatch):
