@@ -100,10 +100,12 @@ def experiment_xml(scenario: Scenario, seed: int, tree: Path, log: Path, occlusi
     if (cx, cy) != (0.0, 0.0):
         raise ReferenceError(f"{s.name}: our loop functions put the nest at the arena's centre, not at {cx}, {cy}")
     ticks = round(1.0 / s.sim.dt)
+    long_, out = 2 * half + 0.2, half + 0.05  # 0.1 m thick, inner faces at +-L/2, closing the corners
     walls = "\n".join(
-        f'<box id="wall_{i}" size="{sx},{sy},0.5" movable="false"><body position="{px},{py},0" orientation="0,0,0"/></box>'
-        for i, (sx, sy, px, py) in enumerate(((2 * half + 0.2, 0.1, 0, half + 0.05), (2 * half + 0.2, 0.1, 0, -half - 0.05),
-                                              (0.1, 2 * half + 0.2, half + 0.05, 0), (0.1, 2 * half + 0.2, -half - 0.05, 0))))
+        f'<box id="wall_{i}" size="{sx},{sy},0.5" movable="false">'
+        f'<body position="{px},{py},0" orientation="0,0,0"/></box>'
+        for i, (sx, sy, px, py) in enumerate(((long_, 0.1, 0, out), (long_, 0.1, 0, -out),
+                                              (0.1, long_, out, 0), (0.1, long_, -out, 0))))
     state = " ".join(f'{k}="{v}"' for k, v in STATE.items())
     return f"""<?xml version="1.0" ?>
 <argos-configuration>

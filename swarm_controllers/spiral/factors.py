@@ -29,6 +29,12 @@ DDSA_TURN = Factor("ddsa_turn_away", "DDSA's collision turn: away from the readi
 START = Factor("start_0.2", "start grid: 0.2 m apart (the authors' ARGoS distribute grids, luki-dev "
                "experiments/*.xml) instead of 0.4 m; the authors' rules (run after the 2026-11-27 defaults)",
                (*AUTHORS, "--set", "robots.start_spacing=0.2"))
+# Issue 37's bisection of our DDSA against the authors' run here (it collects 13-64 % more at 8-32 robots):
+# our lane rule (yield to a robot in the lane ahead, issue 4) off, so every robot avoids by the model's
+# avoidance alone, as the authors' BaseController does.
+LANE_YIELD = Factor("lane_yield_off", "the lane rule off: every state avoids by the robot model's avoidance alone "
+                    "(the authors' BaseController::CollisionDetection, no yielding) instead of yielding to a robot "
+                    "in the lane ahead; today's other rules", (*AUTHORS, "--set", "controller.spiral.lane_yield=false"))
 # The MDBSA rules adopted on 2026-11-27 (afternoon), each switched off alone on today's defaults
 # (5 seeds): compare with the main sweep's MDBSA runs, not with this group's older baseline.
 MDBSA_RULES = (
@@ -54,5 +60,6 @@ GROUPS = (
     ), baseline="baseline/exp1"),
     # Experiment 2 (8-32 robots, 16 regions), where MDBSA-C is to collect about 44 % less than DDSA.
     FactorGroup("spiral2", ("spiral", "--experiment", "2"), "spiral/exp2/results.jsonl", "all",
-                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES), baseline="baseline/exp2"),
+                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD),
+                baseline="baseline/exp2"),
 )
