@@ -62,8 +62,8 @@ register(Algorithm(
     name="foraging_example",
     authors_robot="footbot_foraging",
     paper="drtm_task_allocation.md (Pang et al. 2023) sec. 3.1's set-up with the ARGoS foraging example's rule "
-          "(ilpincy/argos3-examples, controllers/footbot_foraging; social rule not ported): the DRTM reference "
-          "run's rule, not the paper's",
+          "(ilpincy/argos3-examples, controllers/footbot_foraging; its social rule relayed by the nest): the DRTM "
+          "reference run's rule, not the paper's",
     behaviour="swarm_controllers.drtm.foraging_example:ForagingExampleBehaviour",
     task="nest",
     config=(_SECTIONS[0], ("example", "swarm_controllers.drtm.config:ExampleRuleConfig")),
