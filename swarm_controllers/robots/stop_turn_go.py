@@ -180,6 +180,20 @@ class StopTurnGo:
     def reset(self) -> None:
         self.active = False
 
+    def collide(self, angle: float) -> None:
+        """A collision this tick at `angle` [deg, body frame], as if the summed readings pointed
+        there: for a behaviour whose own rule finds the way blocked where they miss the cone
+        (`swarm_controllers.spiral.ddsa.LaneAvoidance` with ``controller.spiral.lane_unjam``).
+        No-op if the ring already saw a collision this tick; `update` then starts its turn."""
+        if self._looked and self._hit is not None:
+            return
+        self._looked = True
+        self._hit = angle
+        self._delay_draw = float(self._rng.uniform(*COLLISION_DELAY))
+        self.active = True
+        if not self._collided:
+            self.events += 1
+
     # ------------------------------------------------------------------ the tick
 
     def _detect(self, ranges: np.ndarray) -> None:

@@ -140,11 +140,13 @@ class LaneAvoidance:
         self.half_width = SpiralConfig.of(scenario).gap / 2.0
         self.yield_timeout = float(yield_timeout)
         self.lane_yield = SpiralConfig.of(scenario).lane_yield
+        self.lane_unjam = SpiralConfig.of(scenario).lane_unjam
         """False: the lane rule is off and the general avoidance applies on the lane too."""
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
         self._rays = [(i, math.cos(a), abs(math.sin(a)))
                       for i, a in enumerate(ray_angles(scenario.sensors.scan))
                       if abs(a) <= half_front]
+        self._angles = [math.degrees(a) for a in ray_angles(scenario.sensors.scan) if abs(a) <= half_front]
         self._yield_since: float | None = None
         self._yields = 0
         self._general_on = False
@@ -187,7 +189,20 @@ class LaneAvoidance:
             return STOP
         self._yield_since = None
         command = self._general(ranges)
+        collide = getattr(self.general, "collide", None)
+        if command is None and self.lane_unjam and collide is not None:
+            collide(self._lane_bearing(ranges))
+            command = self._general(ranges)
         return STOP if command is None else command
+
+    def _lane_bearing(self, ranges: np.ndarray | Sequence[float]) -> float:
+        """The bearing [deg, body frame] of the nearest hit in the lane ahead."""
+        best, bearing = math.inf, 0.0
+        for (i, c, s), a in zip(self._rays, self._angles):
+            v = float(ranges[i])
+            if v < best and 0.0 < v * c <= self.lookahead and v * s < self.half_width:
+                best, bearing = v, a
+        return bearing
 
     def parked(self, ranges: np.ndarray | Sequence[float]) -> Command:
         """The command of a robot that stands still (path finished, waiting at or idle away

@@ -262,6 +262,42 @@ def test_without_the_lane_rule_the_general_avoidance_acts_on_the_lane_too():
     assert command is not None and command != STOP and not off.yielding and off.events == 1
 
 
+def _scan(scenario, discs) -> np.ndarray:
+    """The scan of a robot seeing foot-bot-sized discs at body-frame centres `discs`."""
+    radius, out = scenario.robots.diameter / 2, []
+    for a in ray_angles(scenario.sensors.scan):
+        ux, uy, best = math.cos(a), math.sin(a), math.inf
+        for cx, cy in discs:
+            along = cx * ux + cy * uy
+            disc = along**2 - (cx * cx + cy * cy) + radius**2
+            t = along - math.sqrt(disc) if disc >= 0 else math.inf
+            best = min(best, t if t > 0 else math.inf)
+        out.append(best)
+    return np.asarray(out, dtype=np.float32)
+
+
+@pytest.mark.parametrize("unjam", [False, True])
+def test_a_foot_bot_in_a_yielding_chain_turns_after_the_timeout_only_with_lane_unjam(unjam):
+    """A foot-bot with robots just ahead and just behind in its lane: the summed readings miss its
+    -37.5..37.5 deg cone, so after the yield timeout the shipped rule yields again (the chain
+    stands for good); ``lane_unjam`` starts the model's avoidance turn at the lane hit instead."""
+    scenario = load_scenario("ddsa", [f"controller.spiral.lane_unjam={str(unjam).lower()}"])
+    la = LaneAvoidance(scenario)
+    d = scenario.robots.diameter + 0.02
+    ranges = _scan(scenario, [(d, 0.0), (-d, 0.0)])
+    assert la.lane_blocked(ranges) and la.general.update(ranges) is None
+    la = LaneAvoidance(scenario)
+    commands = []
+    for k in range(round(LANE_YIELD_TIMEOUT / 0.1) + 2):
+        la.general.begin(k * 100_000_000)  # the behaviour's tick
+        commands.append(la.update(ranges, 0.1 * k, on_lane=True))
+    assert commands[0] == STOP
+    turned = [c for c in commands if c != STOP]
+    assert bool(turned) == unjam
+    if unjam:
+        assert turned[0].linear == 0.0 and turned[0].angular != 0.0
+
+
 def test_batch_run_delivers_and_searchers_keep_to_their_own_lanes(monkeypatch):
     """The experiment 1 swarm (8 robots) for the first 200 s, seed 0: deliveries happen and a
     searcher stays on its own line. Before `LaneAvoidance` and the lane target (issue 4) the
