@@ -27,8 +27,9 @@ _DDSA_SURPLUS = Cause(
              "92, 129 -> 107 resources; theirs 97, 102) but not at 20-32 (134 -> 129, 122 -> 112, 104 -> 90; theirs "
              "89, 76, 64), and 3 of its 50 DDSA runs jam at the start (our lane rule: every robot yielding to a "
              "neighbour in its lane). Our lane rule off (`lane_yield_off`, the authors' avoidance alone) raises DDSA "
-             "further (137 and 134 at 26 and 32 robots). Factors `start_0.2`, `lane_yield_off` (spiral2, 10 seeds); "
-             "the rest is not measured (CAUSES.md)", "spiral2/start_0.2", 10)
+             "further (137 and 134 at 26 and 32 robots), and so does the fix of its jams (`lane_unjam`: 98 -> 128 at "
+             "32 robots). Factors `start_0.2`, `lane_yield_off`, `lane_unjam` (spiral2, 10 seeds); the rest is not "
+             "measured (CAUSES.md)", "spiral2/start_0.2", 10)
 _CONE = Cause(PARTIAL, "MDBSA's -80..80 deg collision cone at the 0.18 m nest (factor `cone_80`, 2 seeds, on our "
                        "earlier rules: 9.9 -> 8.5 resources at 4 regions)", "cone_80", 2)
 _RADIO = Cause(PARTIAL, "how the two walkers of a region end (factor `mdbsa_no_radio`, 3 seeds: without the "
