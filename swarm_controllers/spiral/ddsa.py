@@ -140,7 +140,10 @@ class LaneAvoidance:
         self.half_width = SpiralConfig.of(scenario).gap / 2.0
         self.yield_timeout = float(yield_timeout)
         self.lane_yield = SpiralConfig.of(scenario).lane_yield
-        self.lane_unjam = SpiralConfig.of(scenario).lane_unjam
+        self._collide = getattr(self.general, "collide", None) if SpiralConfig.of(scenario).lane_unjam else None
+        """``controller.spiral.lane_unjam``: start the general avoidance's turn at a lane hit it missed.
+        Only the foot-bot's `StopTurnGo` can miss one (its cone on the summed readings); the other
+        avoidances detect a lane hit themselves and have no such method."""
         """False: the lane rule is off and the general avoidance applies on the lane too."""
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
         self._rays = [(i, math.cos(a), abs(math.sin(a)))
@@ -189,9 +192,8 @@ class LaneAvoidance:
             return STOP
         self._yield_since = None
         command = self._general(ranges)
-        collide = getattr(self.general, "collide", None)
-        if command is None and self.lane_unjam and collide is not None:
-            collide(self._lane_bearing(ranges))
+        if command is None and self._collide is not None:
+            self._collide(self._lane_bearing(ranges))
             command = self._general(ranges)
         return STOP if command is None else command
 
