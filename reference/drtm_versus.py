@@ -41,6 +41,7 @@ def table(ours: list[dict], reference: dict[str, list[dict]]) -> list[str]:
     for measure, label, scale in MEASURES:
         mine = [value(r, measure, scale) for r in ours]
         theirs = [value(r, measure, scale) for r in reference[judged]]
+        # against_reference reads a claim only for its bootstrap's seed (its id); value is unused
         claim = Claim(f"drtm_example.{measure}", LEVEL, label, "reference", measure, "foraging_example", value=0.0)
         cells.append((label, measure, scale, mine, against_reference(claim, mine, theirs, 0)))
     adjusted = holm([cv.p for *_, cv in cells])
