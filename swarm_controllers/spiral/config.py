@@ -58,12 +58,12 @@ class SpiralConfig(Section):
     as the authors' controllers do (``BaseController::CollisionDetection`` in ``Move``, no
     yielding: MARSLab-UTRGV DDSA and MDBSA, luki-dev, ``source/Base/BaseController.cpp``)."""
 
-    lane_unjam: bool = False
+    lane_unjam: bool = True
     """With the lane rule: a lane still blocked after the yield timeout starts the robot model's
     avoidance turn at the blocking hit's bearing even when the model's own detection misses it (the
-    foot-bot's cone on the summed readings misses a robot ahead when another is behind). False, as
-    shipped: the robot yields again, and a chain of robots each yielding to the next can stand for
-    good (issue 37: 3 of 20 DDSA runs at 32 robots; CAUSES.md)."""
+    foot-bot's cone on the summed readings misses a robot ahead when another is behind). False: the
+    robot yields again, and a chain of robots each yielding to the next can stand for good (issue
+    37: 3 of 20 DDSA runs at 32 robots before this became the default; CAUSES.md)."""
 
     SECTION: ClassVar[str] = "spiral"
 
