@@ -35,10 +35,12 @@ START = Factor("start_0.2", "start grid: 0.2 m apart (the authors' ARGoS distrib
 LANE_YIELD = Factor("lane_yield_off", "the lane rule off: every state avoids by the robot model's avoidance alone "
                     "(the authors' BaseController::CollisionDetection, no yielding) instead of yielding to a robot "
                     "in the lane ahead; today's other rules", (*AUTHORS, "--set", "controller.spiral.lane_yield=false"))
-# The lane rule's yielding chains (issue 37: 3 of 20 DDSA runs at 32 robots stand for good): broken.
-LANE_UNJAM = Factor("lane_unjam", "the lane rule's timeout starts the model's avoidance turn at the lane hit even "
-                    "when the model's detection misses it, instead of yielding again; today's other rules",
-                    ("--strategies", "ddsa", "mdbsa_c", *AUTHORS, "--set", "controller.spiral.lane_unjam=true"))
+# The lane rule's yielding chains (issue 37: 3 of 20 DDSA runs at 32 robots stood for good) are broken by
+# controller.spiral.lane_unjam, the default since 2026-11-29; this factor is the rule before it.
+LANE_UNJAM_OFF = Factor("lane_unjam_off", "the lane rule's timeout yields again (as shipped before 2026-11-29), "
+                        "instead of starting the model's avoidance turn at the lane hit the model's detection "
+                        "missed; today's other rules",
+                        ("--strategies", "ddsa", "mdbsa_c", *AUTHORS, "--set", "controller.spiral.lane_unjam=false"))
 # The MDBSA rules adopted on 2026-11-27 (afternoon), each switched off alone on today's defaults
 # (5 seeds): compare with the main sweep's MDBSA runs, not with this group's older baseline.
 MDBSA_RULES = (
@@ -64,6 +66,6 @@ GROUPS = (
     ), baseline="baseline/exp1"),
     # Experiment 2 (8-32 robots, 16 regions), where MDBSA-C is to collect about 44 % less than DDSA.
     FactorGroup("spiral2", ("spiral", "--experiment", "2"), "spiral/exp2/results.jsonl", "all",
-                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD, LANE_UNJAM),
+                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD, LANE_UNJAM_OFF),
                 baseline="baseline/exp2"),
 )
