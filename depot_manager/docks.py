@@ -73,11 +73,17 @@ def dock_zones(scenario: Scenario) -> tuple[DropZoneConfig, ...]:
 def check_docks(scenario: Scenario) -> None:
     """A scenario delivering at the docks needs its docks side by side around the depot and its
     perimeter around the depot and inside the arena (ValueError naming the key)."""
-    d, k, half = scenario.depot, DockingConfig.of(scenario), scenario.arena.size / 2
+    d, k = scenario.depot, DockingConfig.of(scenario)
     diameter = scenario.robots.diameter
     stop = d.radius + diameter / 2 if k.dock_distance is None else k.dock_distance
     if k.docks > 1 and 2 * stop * math.sin(math.pi / k.docks) < diameter:
         raise ValueError(f"docking.docks: {k.docks} docks do not fit side by side {stop} m from the depot centre")
+    check_perimeter(scenario)
+
+
+def check_perimeter(scenario: Scenario) -> None:
+    """The perimeter round the depot and inside the arena (ValueError naming the key)."""
+    d, k, half = scenario.depot, DockingConfig.of(scenario), scenario.arena.size / 2
     if k.perimeter_radius <= d.radius:
         raise ValueError("docking.perimeter_radius: must exceed depot.radius")
     if not (abs(d.center[0]) + k.perimeter_radius <= half and abs(d.center[1]) + k.perimeter_radius <= half):

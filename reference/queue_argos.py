@@ -2,7 +2,10 @@
 
 The reference for the queue paper's levels: Tameem786/Collision_Free_CPFA (branch ``main``: the
 single queue with entry-point joining, the paper's Q_SE; branch ``CPFA-2.0``: tail joining, Q_ST),
-run on an ARGoS 3 built on this machine. Nothing of theirs is committed and nothing here builds
+run on an ARGoS 3 built on this machine. For the CPFA baseline, the CPFA their code grew from
+(Artglz/Collision_Free_CPFA ``main``, "add existing files": the same ``BaseController`` and CPFA
+without the queue) in their queue experiment's arena; it takes one nest, so ``NestPosition`` is
+the centre (``queue_cpfa``'s four docks 0.3 m out are the queue authors' own set-up). Nothing of theirs is committed and nothing here builds
 it (reference/README.md says why and what a checkout must hold): this script takes a checkout
 that is already built, writes their experiment file with a swarm size and a seed set, runs
 ``argos3`` on it and turns the one line their ``CPFA_loop_functions::PostExperiment`` prints into
@@ -11,6 +14,9 @@ a row of ``results/reference/queue/results.jsonl``.
 Their experiment (``experiments/Clustered_CPFA_r64_tag512_16by16.xml``) places the robots in
 four ``<distribute>`` groups of equal ``quantity`` (28 each = 112); a swarm of N robots is four
 groups of N / 4, as their logs' sizes 48-112 are. Seeds are their ``run.sh`` list.
+
+The CPFA it grew from ends a run at ``MaxSimTimeInSeconds`` (theirs: at 18 minutes by the clock)
+and prints ``score, seconds, seed``; its collision count (detections, not time) is not kept.
 """
 from __future__ import annotations
 
@@ -21,7 +27,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # run as a script or loaded by path
-from argos_run import done_keys, ReferenceError, run_argos  # noqa: E402
+from argos_run import ANSI, done_keys, ReferenceError, run_argos  # noqa: E402
 
 AUTHORS_SEEDS = (123456, 789012, 345678, 901234, 567890, 135791, 246802, 864209, 751936, 428573,
                  613579, 982034, 704321, 319864, 580246, 162738, 947120, 830591, 204869, 678345)
@@ -37,10 +43,23 @@ LINE = re.compile(
     r"Random Seed: (?P<seed>\d+)")
 """The line ``PostExperiment`` prints (collision in minutes, all robots; circle in minutes per
 delivery: their ``(TimeInsideRedCircle / 60) / score``)."""
+CPFA_LINE = re.compile(r"^(?P<score>\d+(?:\.\d+)?), (?P<seconds>\d+(?:\.\d+)?), (?P<seed>\d+)$", re.MULTILINE)
+"""The line the CPFA they grew from prints in ``PostExperiment`` (``printf("%f, %f, %lu\\n", ...)``)."""
+CPFA = "queue_cpfa"
+DURATION_S = 1080
+"""The paper's 18 minutes (Table I)."""
 
 
-def experiment_xml(text: str, robots: int, seed: int) -> str:
-    """Their experiment file with ``robots`` split over the four groups and ``seed`` set."""
+def _set_one(text: str, attribute: str, value: str) -> str:
+    text, n = re.subn(rf'{attribute}="[^"]*"', f'{attribute}="{value}"', text)
+    if n != 1:
+        raise ReferenceError(f"{EXPERIMENT}: expected one {attribute} attribute, found {n}")
+    return text
+
+
+def experiment_xml(text: str, robots: int, seed: int, strategy: str = "queue_qse") -> str:
+    """Their experiment file with ``robots`` split over the four groups and ``seed`` set; for the
+    CPFA baseline one nest at the centre and the run's end at 18 minutes."""
     if robots % 4:
         raise ReferenceError(f"--robots {robots}: their experiment has four equal start groups, "
                              "so the swarm size must be a multiple of 4")
@@ -48,14 +67,20 @@ def experiment_xml(text: str, robots: int, seed: int) -> str:
     if len(groups) != 4:
         raise ReferenceError(f"{EXPERIMENT}: expected 4 robot groups, found {len(groups)}")
     text = re.sub(r'(<entity max_trials="\d+" quantity=")\d+(">)', rf"\g<1>{robots // 4}\g<2>", text)
-    text, n = re.subn(r'random_seed="\d+"', f'random_seed="{seed}"', text)
-    if n != 1:
-        raise ReferenceError(f"{EXPERIMENT}: expected one random_seed attribute, found {n}")
+    text = _set_one(text, "random_seed", str(seed))
+    if strategy == CPFA:
+        text = _set_one(_set_one(text, "NestPosition", "0,0"), "MaxSimTimeInSeconds", str(DURATION_S))
     return text
 
 
-def parse_line(output: str) -> dict:
-    """The numbers of the one ``Resource Collected`` line in a run's output."""
+def parse_line(output: str, strategy: str = "queue_qse") -> dict:
+    """The numbers of the one result line in a run's output."""
+    if strategy == CPFA:
+        found = CPFA_LINE.findall(ANSI.sub("", output))
+        if len(found) != 1:
+            raise ReferenceError(f"argos3 printed {len(found)} 'score, seconds, seed' lines, expected 1")
+        score, seconds, seed = (float(v) for v in found[0])
+        return {"score": score, "minutes": seconds / 60.0, "seed": seed, "collision": None, "circle": None}
     found = LINE.findall(output)
     if len(found) != 1:
         raise ReferenceError(f"argos3 printed {len(found)} 'Resource Collected' lines, expected 1")
@@ -80,18 +105,20 @@ def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, pro
         "resources_collected_pct": round(100.0 * score / TOTAL_RESOURCES, 6),
         "resources_per_robot": round(score / robots, 6),
         "authors_collision_time_total_min": printed["collision"],
-        "authors_collision_time_per_robot_s": round(60.0 * printed["collision"] / robots, 6),
+        "authors_collision_time_per_robot_s": (None if printed["collision"] is None
+                                               else round(60.0 * printed["collision"] / robots, 6)),
         "authors_time_in_circle_per_delivery_min": printed["circle"],
         **provenance,
     }
 
 
-def run_one(argos: str, tree: Path, robots: int, seed: int, timeout_s: float) -> tuple[dict, float, float]:
+def run_one(argos: str, tree: Path, experiment: str, strategy: str, robots: int, seed: int,
+            timeout_s: float) -> tuple[dict, float, float]:
     """The printed numbers, the wall seconds and the CPU seconds (user + system) of one run."""
-    xml = experiment_xml((tree / EXPERIMENT).read_text(), robots, seed)
+    xml = experiment_xml(experiment, robots, seed, strategy)
     output, wall, cpu = run_argos([argos], tree, xml, f".swarmforage_r{robots}_s{seed}.xml",
                                   f"robots {robots} seed {seed}", timeout_s)
-    return parse_line(output), wall, cpu
+    return parse_line(output, strategy), wall, cpu
 
 
 def _done(out: Path) -> set[tuple[str, int, int, str]]:
@@ -103,8 +130,13 @@ def main(argv: list[str] | None = None) -> int:
                                 epilog="Appends one row per run to --out; runs already there are skipped.")
     p.add_argument("--argos", required=True, help="the argos3 executable built here")
     p.add_argument("--tree", required=True, type=Path, help="a built checkout of the authors' repository")
-    p.add_argument("--strategy", required=True, choices=("queue_qse", "queue_qst"),
-                   help="what the checkout's branch is (main: queue_qse, CPFA-2.0: queue_qst)")
+    p.add_argument("--strategy", required=True, choices=("queue_qse", "queue_qst", CPFA),
+                   help="what the checkout's branch is (main: queue_qse, CPFA-2.0: queue_qst; "
+                        "Artglz/Collision_Free_CPFA main: queue_cpfa)")
+    p.add_argument("--experiment", type=Path,
+                   help=f"the queue authors' experiment file (default: the checkout's {EXPERIMENT}; "
+                        "queue_cpfa needs a Tameem786/Collision_Free_CPFA checkout's)")
+    p.add_argument("--experiment-commit", help="the commit --experiment was taken from (40 hex digits)")
     p.add_argument("--repository", default="Tameem786/Collision_Free_CPFA")
     p.add_argument("--branch", required=True)
     p.add_argument("--commit", required=True, help="the checkout's commit (40 hex digits)")
@@ -120,17 +152,28 @@ def main(argv: list[str] | None = None) -> int:
             raise ReferenceError("--commit and --argos-commit take 40 hex digits")
         if not 1 <= a.seeds <= len(AUTHORS_SEEDS):
             raise ReferenceError(f"--seeds {a.seeds}: the authors' list has {len(AUTHORS_SEEDS)}")
-        if not (a.tree / EXPERIMENT).is_file():
-            raise ReferenceError(f"--tree {a.tree}: no {EXPERIMENT}")
-        provenance = {"repository": a.repository, "branch": a.branch, "commit": a.commit, "xml": EXPERIMENT,
+        experiment = a.experiment or a.tree / EXPERIMENT
+        if a.strategy == CPFA and (a.experiment is None or a.experiment_commit is None):
+            raise ReferenceError("--strategy queue_cpfa takes --experiment and --experiment-commit: the queue "
+                                 "authors' experiment file, which the CPFA's own checkout does not hold")
+        if a.experiment_commit is not None and not re.fullmatch(r"[0-9a-f]{40}", a.experiment_commit):
+            raise ReferenceError("--experiment-commit takes 40 hex digits")
+        if not experiment.is_file():
+            raise ReferenceError(f"no experiment file {experiment}")
+        xml = (EXPERIMENT if a.experiment is None else
+               f"Tameem786/Collision_Free_CPFA {a.experiment_commit}:{EXPERIMENT}")
+        if a.strategy == CPFA:
+            xml += f' (NestPosition="0,0", MaxSimTimeInSeconds="{DURATION_S}")'
+        provenance = {"repository": a.repository, "branch": a.branch, "commit": a.commit, "xml": xml,
                       "argos_commit": a.argos_commit, "build_fixes": a.build_fixes}
+        text = experiment.read_text()
         a.out.parent.mkdir(parents=True, exist_ok=True)
         done = _done(a.out)
         for robots in a.robots:
             for seed in AUTHORS_SEEDS[:a.seeds]:
                 if (a.strategy, robots, seed, a.commit) in done:
                     continue
-                printed, wall, cpu = run_one(a.argos, a.tree, robots, seed, a.timeout)
+                printed, wall, cpu = run_one(a.argos, a.tree, text, a.strategy, robots, seed, a.timeout)
                 r = row(a.strategy, robots, seed, printed, wall, provenance, cpu)
                 with a.out.open("a") as f:
                     f.write(json.dumps(r) + "\n")

@@ -256,7 +256,9 @@ def test_delivery_kinds_are_registered_by_whoever_provides_them():
     assert not registry.delivery_kind("docks").resources_inside
     with pytest.raises(ValueError, match="delivery kind 'docks' is already registered"):
         registry.register_delivery(registry.delivery_kind("docks"))
-    s = load_scenario("queue_cpfa")
+    assert [z.name for z in drop_zones(load_scenario("queue_cpfa"))] == ["depot"]  # the authors' CPFA: one nest
+    assert registry.delivery_kind("perimeter_depot").probes == registry.delivery_kind("docks").probes == ("perimeter",)
+    s = load_scenario("queue_cpfa", ["depot.delivery=docks"])  # the text's reading
     zones = drop_zones(s)
     assert [z.name for z in zones] == [f"dock_{k}" for k in range(4)]
     docking = DockingConfig.of(s)
@@ -268,7 +270,7 @@ def test_delivery_kinds_are_registered_by_whoever_provides_them():
     ("depot.delivery=nowhere", "depot.delivery: unknown delivery kind 'nowhere' (known: depot, docks, "),
     ("depot.delivery=3", "depot.delivery: expected a string, got 3"),
     ("depot.delivery=docks", None),  # the CPFA baseline also delivers at the docks (queue_cpfa)
-    ("depot.delivery=region_centers", "depot.delivery: cpfa delivers to depot or docks, not 'region_centers'"),
+    ("depot.delivery=region_centers", "depot.delivery: cpfa delivers to depot or docks or perimeter_depot, not 'region_centers'"),
 ])
 def test_an_unknown_or_unsuitable_delivery_kind_is_refused_naming_the_key(override, message):
     if message is None:
@@ -282,7 +284,7 @@ def test_an_unknown_or_unsuitable_delivery_kind_is_refused_naming_the_key(overri
 def test_a_delivery_kinds_own_checks_run():
     """The docks kind needs its perimeter inside the arena; the depot kind does not."""
     with pytest.raises(ScenarioError, match="docking.perimeter_radius: a perimeter of 6.5 m does not fit"):
-        load_scenario("queue_cpfa", ["docking.perimeter_radius=6.5"])
+        load_scenario("queue_qse", ["docking.perimeter_radius=6.5"])
     assert DockingConfig.of(load_scenario("cpfa", ["docking.perimeter_radius=6.5"])).perimeter_radius == 6.5
 
 
@@ -297,7 +299,7 @@ def test_a_delivery_kinds_own_checks_run():
 ])
 def test_the_docking_section_is_checked_naming_the_key(override, message):
     with pytest.raises(ScenarioError) as info:
-        load_scenario("queue_cpfa", [override])
+        load_scenario("queue_cpfa", ["depot.delivery=docks", "depot.radius=0.5", override])
     assert str(info.value).startswith(message), str(info.value)
 
 

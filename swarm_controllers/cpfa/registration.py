@@ -22,7 +22,7 @@ register(Algorithm(
     behaviour="swarm_controllers.cpfa.behaviour:CpfaBehaviour",
     config=(SECTION,),
     peers=(PHEROMONES,),
-    deliveries=("depot", "docks"),
+    deliveries=("depot", "docks", "perimeter_depot"),
     comparison="swarm_controllers.queue.comparison:QUEUE_COMPARISON",
     headline=HEADLINE,
     states=STATES,

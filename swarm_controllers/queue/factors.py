@@ -15,13 +15,23 @@ TURN = Factor("turn_2.29", "turn rate: the wheels at RobotForwardSpeed (16 cm/s)
 STEP = Factor("step_0.16", "collision step: SearchStepSize 0.16 m (BaseController's default) instead of the "
               "experiment files' 0.08 m",
               ("--robot-model", "authors", "--set", "robots.stop_turn_go.collision_step=0.16"))
-# Dock distance: the CPFA baseline unloads at the queue authors' NestPosition docks, 0.3 m from the
-# centre (queue_cpfa.yaml); our queue layouts need their docks one body outside the 0.5 m depot
-# (0.585 m: four serpentines do not fit round 0.3 m docks with 0.2 m lanes), so the factor moves the
-# CPFA's docks out to the queue strategies' instead.
-CPFA_DOCKS = Factor("cpfa_docks_0.585", "dock distance: the CPFA baseline's docks 0.585 m from the centre (where "
-                    "our queue strategies' are) instead of the authors' NestPosition 0.3 m",
-                    ("--strategies", "queue_cpfa", "--robot-model", "authors", "--set", "docking.dock_distance=0.585"))
+# The CPFA baseline's nest. Shipped (queue_cpfa.yaml, since 2026-11-29): one nest at the centre, 0.189 m,
+# a delivery on arrival, as the CPFA the queue code grew from (Artglz/Collision_Free_CPFA main). The
+# paper's text has every robot unload at a dock (sec. III): four docks at the queue authors'
+# NestPositions, 0.3 m from the centre, 5 s at each (shipped before). Our queue layouts need their docks
+# one body outside the 0.5 m depot (0.585 m: four serpentines do not fit round 0.3 m docks with 0.2 m
+# lanes), so cpfa_docks_0.585 moves the text's docks out to the queue strategies' (measured against the
+# text's docks, before 2026-11-29).
+CPFA_DOCKS_TEXT = ("depot.delivery=docks", "depot.radius=0.5", "resources.min_depot_clearance=2.0")
+CPFA_DOCKS = Factor("cpfa_docks_0.585", "dock distance: the text's CPFA docks 0.585 m from the centre (where our "
+                    "queue strategies' are) instead of the authors' NestPosition 0.3 m",
+                    ("--strategies", "queue_cpfa", "--robot-model", "authors",
+                     *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv)), "--set", "docking.dock_distance=0.585"))
+CPFA_DOCKS_03 = Factor("cpfa_docks_0.3", "the CPFA's nest: the paper's text, four docks at the queue authors' "
+                       "NestPositions 0.3 m from the centre with a 5 s unload (sec. III), instead of the one 0.189 m "
+                       "nest at the centre of the CPFA their code grew from",
+                       ("--strategies", "queue_cpfa", "--robot-model", "authors",
+                        *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv))))
 # Q_ST's join rule: the paper's text (join behind the last robot) against the authors' code (their
 # Q_ST, Tameem786/Collision_Free_CPFA branch CPFA-2.0, boards the spiral's inner lanes ahead of
 # whoever is queued there: controller.queue.join_order=anywhere).
@@ -66,10 +76,10 @@ QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footb
 
 GROUPS = (
     FactorGroup("queue48", ("queue", "--robots", "48"), "queue/results.jsonl", "48",
-                (BASELINE, MOTION_GENERIC, TURN, STEP, CPFA_DOCKS, QST_JOIN, QST_NO_GIVE_UP)),
+                (BASELINE, MOTION_GENERIC, TURN, STEP, CPFA_DOCKS, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
     # At 112 robots, where the strategies' order is the paper's headline.
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
-                (BASELINE, MOTION_GENERIC, TURN, QST_JOIN, QST_NO_GIVE_UP)),
+                (BASELINE, MOTION_GENERIC, TURN, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
                  QST_QUEUED_CONTINUOUS),

@@ -1,6 +1,7 @@
 """The queue paper's registry records (queue_depot_traffic.md): the perimeter probe, the ``docks``
 delivery kind (its docks in `depot_manager.docks`, its world section ``docking``, its runs
-measured by the perimeter probe) and the queue strategies, the robots' side here, the depot
+measured by the perimeter probe), the ``perimeter_depot`` kind of its CPFA baseline and the queue
+strategies, the robots' side here, the depot
 manager's server in the top-level `depot_manager` package."""
 
 from swarm_controllers.cpfa.registration import HEADLINE, PHEROMONES, STATES
@@ -30,7 +31,15 @@ register_delivery(DeliveryKind(
     zones="depot_manager.docks:dock_zones",
     checks=("depot_manager.docks:check_docks",),
     world=(("docking", "depot_manager.config:DockingConfig"),),
-    probes=("perimeter",),  # the queue strategies and the paper's CPFA baseline deliver here
+    probes=("perimeter",),  # the queue strategies (and the text's reading of the CPFA baseline) deliver here
+))
+
+register_delivery(DeliveryKind(
+    name="perimeter_depot",
+    zones="swarm_sim.sites:depot_zones",
+    checks=("depot_manager.docks:check_perimeter",),
+    world=(("docking", "depot_manager.config:DockingConfig"),),
+    probes=("perimeter",),  # the CPFA baseline (queue_cpfa.yaml): the authors' one nest, the paper's perimeter
 ))
 
 register(Algorithm(

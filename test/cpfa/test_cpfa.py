@@ -31,6 +31,7 @@ from swarm_sim.behaviour import Behaviour, behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import Scenario
+from swarm_sim.sites import drop_zones
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("cpfa")
@@ -596,15 +597,32 @@ def test_pheromone_fields_are_plain_python_numbers():
 # --------------------------------------------------------------------------- the queue paper's set-up
 
 QUEUE_CPFA = generic_scenario("queue_cpfa")
+QUEUE_CPFA_DOCKS = generic_scenario("queue_cpfa", ["depot.delivery=docks", "depot.radius=0.5",
+                                                   "resources.min_depot_clearance=2.0"])
+"""The text's reading of the queue paper's CPFA baseline (queue_cpfa.yaml): four docks 0.3 m out."""
 
 
-def test_queue_cpfa_carrier_heads_for_the_nearest_dock_and_stands_still_there():
-    b = behaviour(QUEUE_CPFA)
+def test_queue_cpfa_carries_to_the_one_nest_at_the_centre_as_the_authors_cpfa_does():
+    """CPFA_controller::IsInTheNest of the CPFA their queue code grew from: inside NestRadius 0.1 x
+    sqrt(log2 12) of the centre, at once (queue_cpfa.yaml)."""
+    (zone,) = drop_zones(QUEUE_CPFA)
+    assert zone.center == (0.0, 0.0) and zone.radius == pytest.approx(0.1 * math.sqrt(math.log2(12.0)), abs=1e-5)
+    assert zone.dwell == 0.0
+    for scenario, turns in ((QUEUE_CPFA, False), (QUEUE_CPFA_DOCKS, True)):
+        b = behaviour(scenario)
+        b.step(obs(0, 0.6, 0.6, -0.75 * math.pi))  # facing the centre; the nearest docks lie 18 deg aside
+        b.step(obs(1, 0.6, 0.6, -0.75 * math.pi, carrying=True))
+        cmd = b.step(obs(2, 0.6, 0.6, -0.75 * math.pi, carrying=True))
+        assert (abs(cmd.angular) > 0.1) == turns, (scenario.depot, cmd)
+
+
+def test_queue_cpfa_docks_carrier_heads_for_the_nearest_dock_and_stands_still_there():
+    b = behaviour(QUEUE_CPFA_DOCKS)
     b.step(obs(0, 3.0, 0.1, math.pi))
     b.step(obs(1, 3.0, 0.1, math.pi, carrying=True))  # picked up: returning
     cmd = b.step(obs(2, 3.0, 0.1, math.pi, carrying=True))
     assert cmd.linear > 0 and abs(cmd.angular) < 0.5  # toward the dock at (0.3, 0), nearly ahead
-    wall = np.full(QUEUE_CPFA.sensors.scan.rays, 0.1, dtype=np.float32)  # crowded all round
+    wall = np.full(QUEUE_CPFA_DOCKS.sensors.scan.rays, 0.1, dtype=np.float32)  # crowded all round
     events = b.obstacle_avoidance_events
     cmd = b.step(obs(3, 0.32, 0.02, math.pi, carrying=True, ranges=wall))
     assert (cmd.linear, cmd.angular) == (0.0, 0.0)  # unloading: no avoidance, no motion

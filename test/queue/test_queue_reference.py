@@ -25,6 +25,38 @@ def test_the_swarm_is_split_over_the_four_groups_and_the_seed_set():
     assert 'random_seed="42"' in out and "513568" not in out
 
 
+def test_the_cpfa_baseline_gets_one_nest_at_the_centre_and_the_papers_18_minutes():
+    xml = XML.replace("<arena>", '<loop_functions><settings MaxSimTimeInSeconds="3000" '
+                      'NestPosition="0,0.3;0.3,0;0,-0.3;-0.3,0" NestRadius="0.1"/></loop_functions><arena>')
+    out = qa.experiment_xml(xml, 48, 42, "queue_cpfa")
+    assert 'NestPosition="0,0"' in out and 'MaxSimTimeInSeconds="1080"' in out and 'NestRadius="0.1"' in out
+    assert qa.experiment_xml(xml, 48, 42) == qa.experiment_xml(xml, 48, 42, "queue_qst")
+    assert 'NestPosition="0,0.3;' in qa.experiment_xml(xml, 48, 42)
+    with pytest.raises(qa.ReferenceError, match="one NestPosition attribute, found 0"):
+        qa.experiment_xml(XML, 48, 42, "queue_cpfa")
+
+
+def test_the_cpfa_line_becomes_a_row_without_a_collision_time():
+    printed = qa.parse_line("\x1b[1;32mNestRadius=\x1b[0m0.18934\n39.000000, 1080.000000, 123456\n\x1b[0m",
+                            "queue_cpfa")
+    row = qa.row("queue_cpfa", 48, 123456, printed, 60.0, {})
+    assert row["resources_delivered"] == 39 and row["sim_seconds"] == 1080.0
+    assert row["authors_collision_time_total_min"] is None and row["authors_collision_time_per_robot_s"] is None
+    with pytest.raises(qa.ReferenceError, match="printed 0 'score, seconds, seed' lines"):
+        qa.parse_line(PRINTED, "queue_cpfa")
+
+
+def test_the_cpfa_baseline_needs_the_queue_authors_experiment(tmp_path, capsys):
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    base = ["--argos", "/bin/false", "--tree", str(tree), "--strategy", "queue_cpfa", "--branch", "main",
+            "--commit", "b" * 40, "--argos-commit", "a" * 40]
+    assert qa.main(base) == 2
+    assert "takes --experiment and --experiment-commit" in capsys.readouterr().err
+    assert qa.main(base + ["--experiment", str(tmp_path / "x.xml"), "--experiment-commit", "c" * 40]) == 2
+    assert "no experiment file" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("robots", [50, 3])
 def test_a_size_the_four_groups_cannot_hold_equally_is_refused(robots):
     with pytest.raises(qa.ReferenceError, match="multiple of 4"):
