@@ -2,12 +2,12 @@
 
 The reference for the queue paper's levels: Tameem786/Collision_Free_CPFA (branch ``main``: the
 single queue with entry-point joining, the paper's Q_SE; branch ``CPFA-2.0``: tail joining, Q_ST),
-run on an ARGoS 3 built on this machine. For the CPFA baseline, the CPFA their code grew from
-(Artglz/Collision_Free_CPFA ``main``, "add existing files": the same ``BaseController`` and CPFA
-without the queue) in their queue experiment's arena; it takes one nest, so ``NestPosition`` is
-the centre (``queue_cpfa``'s four docks 0.3 m out are the queue authors' own set-up). Nothing of theirs is committed and nothing here builds
-it (reference/README.md says why and what a checkout must hold): this script takes a checkout
-that is already built, writes their experiment file with a swarm size and a seed set, runs
+run on an ARGoS 3 built on this machine; for the CPFA baseline, the plain CPFA in their
+repositories (Artglz/Collision_Free_CPFA ``main``, "add existing files": the queue code's
+``BaseController`` without the queues' additions) in their queue experiment's arena, with its one
+nest at the centre (it takes one ``NestPosition``). Nothing of theirs is committed and nothing
+here builds it (reference/README.md says why and what a checkout must hold): this script takes a
+checkout that is already built, writes their experiment file with a swarm size and a seed set, runs
 ``argos3`` on it and turns the one line their ``CPFA_loop_functions::PostExperiment`` prints into
 a row of ``results/reference/queue/results.jsonl``.
 
@@ -15,7 +15,7 @@ Their experiment (``experiments/Clustered_CPFA_r64_tag512_16by16.xml``) places t
 four ``<distribute>`` groups of equal ``quantity`` (28 each = 112); a swarm of N robots is four
 groups of N / 4, as their logs' sizes 48-112 are. Seeds are their ``run.sh`` list.
 
-The CPFA it grew from ends a run at ``MaxSimTimeInSeconds`` (theirs: at 18 minutes by the clock)
+That CPFA ends a run at ``MaxSimTimeInSeconds`` (theirs: at 18 minutes by the clock)
 and prints ``score, seconds, seed``; its collision count (detections, not time) is not kept.
 """
 from __future__ import annotations
@@ -44,7 +44,7 @@ LINE = re.compile(
 """The line ``PostExperiment`` prints (collision in minutes, all robots; circle in minutes per
 delivery: their ``(TimeInsideRedCircle / 60) / score``)."""
 CPFA_LINE = re.compile(r"^(?P<score>\d+(?:\.\d+)?), (?P<seconds>\d+(?:\.\d+)?), (?P<seed>\d+)$", re.MULTILINE)
-"""The line the CPFA they grew from prints in ``PostExperiment`` (``printf("%f, %f, %lu\\n", ...)``)."""
+"""The line that CPFA prints in ``PostExperiment`` (``printf("%f, %f, %lu\\n", ...)``)."""
 CPFA = "queue_cpfa"
 DURATION_S = 1080
 """The paper's 18 minutes (Table I)."""

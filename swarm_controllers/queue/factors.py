@@ -16,7 +16,7 @@ STEP = Factor("step_0.16", "collision step: SearchStepSize 0.16 m (BaseControlle
               "experiment files' 0.08 m",
               ("--robot-model", "authors", "--set", "robots.stop_turn_go.collision_step=0.16"))
 # The CPFA baseline's nest. Shipped (queue_cpfa.yaml, since 2026-11-29): one nest at the centre, 0.189 m,
-# a delivery on arrival, as the CPFA the queue code grew from (Artglz/Collision_Free_CPFA main). The
+# a delivery on arrival, as the plain CPFA in the authors' repositories (Artglz/Collision_Free_CPFA main). The
 # paper's text has every robot unload at a dock (sec. III): four docks at the queue authors'
 # NestPositions, 0.3 m from the centre, 5 s at each (shipped before). Our queue layouts need their docks
 # one body outside the 0.5 m depot (0.585 m: four serpentines do not fit round 0.3 m docks with 0.2 m
@@ -29,7 +29,7 @@ CPFA_DOCKS = Factor("cpfa_docks_0.585", "dock distance: the text's CPFA docks 0.
                      *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv)), "--set", "docking.dock_distance=0.585"))
 CPFA_DOCKS_03 = Factor("cpfa_docks_0.3", "the CPFA's nest: the paper's text, four docks at the queue authors' "
                        "NestPositions 0.3 m from the centre with a 5 s unload (sec. III), instead of the one 0.189 m "
-                       "nest at the centre of the CPFA their code grew from",
+                       "nest at the centre of the plain CPFA in their repositories",
                        ("--strategies", "queue_cpfa", "--robot-model", "authors",
                         *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv))))
 # Q_ST's join rule: the paper's text (join behind the last robot) against the authors' code (their

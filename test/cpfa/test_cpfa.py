@@ -603,7 +603,7 @@ QUEUE_CPFA_DOCKS = generic_scenario("queue_cpfa", ["depot.delivery=docks", "depo
 
 
 def test_queue_cpfa_carries_to_the_one_nest_at_the_centre_as_the_authors_cpfa_does():
-    """CPFA_controller::IsInTheNest of the CPFA their queue code grew from: inside NestRadius 0.1 x
+    """CPFA_controller::IsInTheNest of the plain CPFA in the queue authors' repositories: inside NestRadius 0.1 x
     sqrt(log2 12) of the centre, at once (queue_cpfa.yaml)."""
     (zone,) = drop_zones(QUEUE_CPFA)
     assert zone.center == (0.0, 0.0) and zone.radius == pytest.approx(0.1 * math.sqrt(math.log2(12.0)), abs=1e-5)
