@@ -80,7 +80,7 @@ _CPFA_REF = Cause(PARTIAL, "ours is within the band of the authors' CPFA run her
                            "64 / 112 robots, 20 runs each; that code itself collects 13-16 % less than Table II "
                            "there (12.7 / 11.6 / 9.6 %), so the rest of the gap lies between the paper and the authors' "
                            "code as run here, whose Table II set-up for the CPFA is not published. With the text's "
-                           "four docks instead (factor `cpfa_docks_0.3`, queue48, 10 seeds) ours collects 35.9 % at 48 robots (11.8 % on the same seeds)")
+                           "four docks instead (factor `cpfa_docks_0.3`, queue48 / queue112, 10 seeds) ours collects 35.9 / 14.3 % at 48 / 112 robots (11.8 / 8.9 % on the same seeds)")
 _CPFA_GENERIC = Cause(OPEN, "generic robot: its CPFA jams harder at the 0.19 m nest as robots are added (17.5 % at 48 "
                             "robots, 5.0 % at 112: -71 %, where the foot-bot's falls by 24 % and the authors' code's by "
                             "24 %); what in its continuous steering and avoidance does it is not measured")
