@@ -111,12 +111,11 @@ def _levels() -> list[Claim]:
     out = []
     for s in QUEUE_STRATEGIES:
         for n in QUEUE_SIZES:
-            cause = (None if s == "queue_cpfa" else _QST48_MOTION if (s, n) == ("queue_qst", 48)
-                     else _LINE_MOTION.get((s, n), _MOTION))
+            causes = (_CPFA_CAUSES if s == "queue_cpfa" else
+                      _on(_QST48_MOTION if (s, n) == ("queue_qst", 48) else _LINE_MOTION.get((s, n), _MOTION)))
             out.append(Claim(f"T2.{QUEUE_LABELS[s]}.{n}", LEVEL, f"{QUEUE_LABELS[s]} collects {PAPER_TABLE_II[s][n]} % "
                              f"with {n} robots", "Table II", PCT, s, (n,), value=PAPER_TABLE_II[s][n], unit="%",
-                             note=TEXT_COUNTS.get((s, n), ""),
-                             causes=_CPFA_CAUSES if cause is None else _on(cause)))
+                             note=TEXT_COUNTS.get((s, n), ""), causes=causes))
     return out
 
 

@@ -22,16 +22,16 @@ STEP = Factor("step_0.16", "collision step: SearchStepSize 0.16 m (BaseControlle
 # one body outside the 0.5 m depot (0.585 m: four serpentines do not fit round 0.3 m docks with 0.2 m
 # lanes), so cpfa_docks_0.585 moves the text's docks out to the queue strategies' (measured against the
 # text's docks, before 2026-11-29).
-CPFA_DOCKS_TEXT = ("depot.delivery=docks", "depot.radius=0.5", "resources.min_depot_clearance=2.0")
+CPFA_DOCKS_TEXT = ("--set", "depot.delivery=docks", "--set", "depot.radius=0.5",
+                   "--set", "resources.min_depot_clearance=2.0")
 CPFA_DOCKS = Factor("cpfa_docks_0.585", "dock distance: the text's CPFA docks 0.585 m from the centre (where our "
                     "queue strategies' are) instead of the authors' NestPosition 0.3 m",
                     ("--strategies", "queue_cpfa", "--robot-model", "authors",
-                     *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv)), "--set", "docking.dock_distance=0.585"))
+                     *CPFA_DOCKS_TEXT, "--set", "docking.dock_distance=0.585"))
 CPFA_DOCKS_03 = Factor("cpfa_docks_0.3", "the CPFA's nest: the paper's text, four docks at the queue authors' "
                        "NestPositions 0.3 m from the centre with a 5 s unload (sec. III), instead of the one 0.189 m "
                        "nest at the centre of the plain CPFA in their repositories",
-                       ("--strategies", "queue_cpfa", "--robot-model", "authors",
-                        *(a for kv in CPFA_DOCKS_TEXT for a in ("--set", kv))))
+                       ("--strategies", "queue_cpfa", "--robot-model", "authors", *CPFA_DOCKS_TEXT))
 # Q_ST's join rule: the paper's text (join behind the last robot) against the authors' code (their
 # Q_ST, Tameem786/Collision_Free_CPFA branch CPFA-2.0, boards the spiral's inner lanes ahead of
 # whoever is queued there: controller.queue.join_order=anywhere).

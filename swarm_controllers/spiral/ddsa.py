@@ -140,16 +140,15 @@ class LaneAvoidance:
         self.half_width = SpiralConfig.of(scenario).gap / 2.0
         self.yield_timeout = float(yield_timeout)
         self.lane_yield = SpiralConfig.of(scenario).lane_yield
+        """False: the lane rule is off and the general avoidance applies on the lane too."""
         self._collide = getattr(self.general, "collide", None) if SpiralConfig.of(scenario).lane_unjam else None
         """``controller.spiral.lane_unjam``: start the general avoidance's turn at a lane hit it missed.
         Only the foot-bot's `StopTurnGo` can miss one (its cone on the summed readings); the other
         avoidances detect a lane hit themselves and have no such method."""
-        """False: the lane rule is off and the general avoidance applies on the lane too."""
         half_front = scenario.controller.avoidance.front_fov / 2.0 + 1e-12
-        self._rays = [(i, math.cos(a), abs(math.sin(a)))
-                      for i, a in enumerate(ray_angles(scenario.sensors.scan))
-                      if abs(a) <= half_front]
-        self._angles = [math.degrees(a) for a in ray_angles(scenario.sensors.scan) if abs(a) <= half_front]
+        front = [(i, a) for i, a in enumerate(ray_angles(scenario.sensors.scan)) if abs(a) <= half_front]
+        self._rays = [(i, math.cos(a), abs(math.sin(a))) for i, a in front]
+        self._angles = [math.degrees(a) for _, a in front]
         self._yield_since: float | None = None
         self._yields = 0
         self._general_on = False

@@ -22,6 +22,7 @@ from swarm_sim.behaviour import behaviour_rng
 from swarm_sim.registry import known as known_behaviours
 from swarm_sim.registry import make_behaviour
 from swarm_sim.scenario import ScenarioError, load_scenario
+from swarm_sim.world.raycast import StaticScene, cast_scan
 from swarm_sim.world.tasks.foraging import ForagingSense
 
 BASE = generic_scenario("ddsa", robots__count=4)
@@ -263,17 +264,12 @@ def test_without_the_lane_rule_the_general_avoidance_acts_on_the_lane_too():
 
 
 def _scan(scenario, discs) -> np.ndarray:
-    """The scan of a robot seeing foot-bot-sized discs at body-frame centres `discs`."""
-    radius, out = scenario.robots.diameter / 2, []
-    for a in ray_angles(scenario.sensors.scan):
-        ux, uy, best = math.cos(a), math.sin(a), math.inf
-        for cx, cy in discs:
-            along = cx * ux + cy * uy
-            disc = along**2 - (cx * cx + cy * cy) + radius**2
-            t = along - math.sqrt(disc) if disc >= 0 else math.inf
-            best = min(best, t if t > 0 else math.inf)
-        out.append(best)
-    return np.asarray(out, dtype=np.float32)
+    """The scan of a robot at the origin, heading along x, with foot-bots at `discs` [m]."""
+    scan = scenario.sensors.scan
+    origins = np.array([(0.0, 0.0), *discs])
+    return cast_scan(origins, np.zeros(len(origins)), scenario.robots.diameter / 2,
+                     StaticScene(scenario.arena.size / 2, np.zeros((0, 3)), np.zeros((0, 5))),
+                     scan.rays, scan.fov, scan.range_max)[0]
 
 
 @pytest.mark.parametrize("unjam", [False, True])
