@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 from pathlib import Path
@@ -41,8 +42,11 @@ LINE = re.compile(
     r"Resource Collected: (?P<score>[-\d.]+), Collision Time: (?P<collision>[-\d.naif]+), "
     r"Time Inside RedCircle: (?P<circle>[-\d.naif]+), Time Took: (?P<minutes>[-\d.]+) minutes, "
     r"Random Seed: (?P<seed>\d+)")
-"""The line ``PostExperiment`` prints (collision in minutes, all robots; circle in minutes per
-delivery: their ``(TimeInsideRedCircle / 60) / score``)."""
+"""The line ``PostExperiment`` prints (collision in minutes, all robots: the ticks their
+``CPFA_controller::CollisionDetection`` fired, one count a tick, divided by 2 x ticks per second,
+so half the time; circle in minutes per delivery: their ``(TimeInsideRedCircle / 60) / score``,
+each carrier's time from boarding (Q_SE) or entering the red circle (Q_ST) to reaching the nest:
+the paper's drop-off time, which ours measures as ``dropoff_time_mean_s``)."""
 CPFA_LINE = re.compile(r"^(?P<score>\d+(?:\.\d+)?), (?P<seconds>\d+(?:\.\d+)?), (?P<seed>\d+)$", re.MULTILINE)
 """The line that CPFA prints in ``PostExperiment`` (``printf("%f, %f, %lu\\n", ...)``)."""
 CPFA = "queue_cpfa"
@@ -88,12 +92,17 @@ def parse_line(output: str, strategy: str = "queue_qse") -> dict:
     return {k: float(v) for k, v in match.groupdict().items()}
 
 
+def _finite(value: float | None) -> float | None:
+    """A printed number, None where their print has none (``nan`` from a run that delivered nothing)."""
+    return value if value is not None and math.isfinite(value) else None
+
+
 def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, provenance: dict,
         cpu_s: float | None = None) -> dict:
     """One reference run in our results schema (the fields our queue rows share) plus provenance."""
     if int(printed["seed"]) != seed:
         raise ReferenceError(f"the run printed seed {int(printed['seed'])}, it was given {seed}")
-    score = printed["score"]
+    score, collision, circle = printed["score"], _finite(printed["collision"]), _finite(printed["circle"])
     sim_s = printed["minutes"] * 60.0
     return {
         "strategy": strategy, "cell": robots, "scenario": strategy, "seed": seed, "robots": robots,
@@ -104,10 +113,12 @@ def row(strategy: str, robots: int, seed: int, printed: dict, wall_s: float, pro
         "total_resources": TOTAL_RESOURCES, "resources_delivered": int(round(score)),
         "resources_collected_pct": round(100.0 * score / TOTAL_RESOURCES, 6),
         "resources_per_robot": round(score / robots, 6),
-        "authors_collision_time_total_min": printed["collision"],
-        "authors_collision_time_per_robot_s": (None if printed["collision"] is None
-                                               else round(60.0 * printed["collision"] / robots, 6)),
-        "authors_time_in_circle_per_delivery_min": printed["circle"],
+        # their print is half the time their rule fired (`LINE`); ours counts the whole of it
+        "authors_collision_time_total_min": None if collision is None else round(2.0 * collision, 6),
+        "authors_collision_time_per_robot_s": (None if collision is None
+                                               else round(2.0 * 60.0 * collision / robots, 6)),
+        "authors_time_in_circle_per_delivery_min": circle,
+        "dropoff_time_mean_s": None if circle is None else round(60.0 * circle, 6),
         **provenance,
     }
 

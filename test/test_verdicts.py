@@ -4,6 +4,7 @@ class, each with a twin that must not get it, and the invariants (hypothesis).""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from hypothesis import strategies as st
 from swarm_sim.compare.reference import evaluate_reference, evaluate_reference_relations
 from swarm_sim.compare.report import reference_marks
 from swarm_sim.compare.verdicts import (
+    CODE,
     CONTRADICTS,
     DIRECTION,
     HOLDS,
@@ -174,6 +176,24 @@ def test_a_relation_is_judged_against_the_size_the_authors_code_shows():
     assert evaluate_reference_relations([UP_50], ours, rows("C", 1, around(1.0))) == {}
 
 
+def test_a_claim_their_code_counts_its_own_way_is_judged_on_their_count_on_both_sides():
+    """Ours counts `m` by another rule than the authors' code; against their runs both sides are
+    judged on their count (`code_measure`), never ours against theirs."""
+    def counted(strategy, mine, theirs, seed):
+        return [{**r, "m": 9.0 * r["m"], "theirs": t} for r, t in
+                zip(rows(strategy, 1, mine), around(theirs, 2.0, seed=seed))]
+
+    ours = counted("A", around(100.0, 2.0), 100.0, 4) + counted("B", around(150.0, 2.0, seed=1), 160.0, 5)
+    ref = [{k: v for k, v in r.items() if k != "m"} for r in
+           counted("A", around(100.0, 2.0, seed=2), 100.0, 6) + counted("B", around(150.0, 2.0, seed=3), 160.0, 7)]
+    theirs, mine = evaluate_reference_relations([replace(UP_50, code_measure="theirs")], ours, ref)["rel"]
+    assert theirs.cells[0].effect == pytest.approx(60.0) and mine.cells[0].effect == pytest.approx(60.0)
+    assert (theirs.verdict, mine.verdict) == (HOLDS, HOLDS)
+    assert evaluate_reference_relations([UP_50], ours, ref) == {}  # their rows hold no `m`
+    level = replace(LEVEL_100, code_measure="theirs")
+    assert evaluate_reference([level], ours, ref)[("lvl", 1)].means == pytest.approx((100.0, 100.0))
+
+
 def test_the_authors_code_runs_are_drawn_with_their_interval():
     ref = rows("A", 1, around(100.0, 2.0)) + rows("A", 2, [7.0]) + rows("B", None, [3.0, 5.0])
     marks = reference_marks(ref, "m", ["A", "B"], [1, 2, 3])
@@ -257,6 +277,33 @@ def test_the_report_counts_every_claim_once_and_renders_the_reference_column(tmp
     dup = [*sweeps, SimpleNamespace(comparison=comparison, claims=(LEVEL_100,), rows=data, extra={})]
     with pytest.raises(ValueError, match="repeat"):
         report_verdicts({"authors": dup}, tmp_path, {"authors": "authors' robots"})
+
+
+def test_a_claim_that_fails_is_shown_beside_the_authors_codes_verdict_on_it(tmp_path):
+    """The causes table says whether the authors' own code, run here, misses the claim too."""
+    from types import SimpleNamespace
+
+    from swarm_sim.compare.verdict_report import report_verdicts
+
+    comparison = SimpleNamespace(name="toy", help="a toy paper", rules=())
+    double = Claim("up100", RELATION, "B is twice A", "Sec. 2", "m", "A", (1,), b="B", size=100.0)
+    sweeps = [SimpleNamespace(comparison=comparison, claims=(double,), extra={},
+                              rows=rows("A", 1, around(100.0)) + rows("B", 1, around(150.0, seed=1)))]
+    ref = tmp_path / "reference" / "toy"
+    ref.mkdir(parents=True)
+    for their_b, verdict in ((148.0, DIRECTION), (200.0, HOLDS)):
+        (ref / "results.jsonl").write_text("".join(json.dumps({**r, "reference": True}) + "\n" for r in
+                                                   rows("A", 1, around(100.0, seed=5))
+                                                   + rows("B", 1, around(their_b, seed=6))))
+        text = "\n".join(report_verdicts({"authors": sweeps}, tmp_path, {"authors": "authors' robots"}))
+        assert f"| `up100` | direction only | {verdict} | *open*: no cause named |" in text
+    # a cause graded "the authors' code too" is checked against their runs: here they hold
+    code = Cause(CODE, "their code misses it too", "reference/toy", 20)
+    sweeps[0].claims = (replace(double, causes=(("*", code),)),)
+    with pytest.raises(ValueError, match="up100: its cause says the authors' code misses it too, but their runs"):
+        report_verdicts({"authors": sweeps}, tmp_path, {"authors": "authors' robots"})
+    with pytest.raises(ValueError, match="at least 10 seeds"):
+        Cause(CODE, "their code misses it too", "reference/toy", 3)
 
 
 def test_the_readme_states_the_reports_counts():

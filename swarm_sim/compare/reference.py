@@ -95,12 +95,18 @@ def against_reference(claim: Claim, ours: Sequence[float], reference: Sequence[f
                        reason="inside" if inside else "outside")
 
 
+def on_code_measure(claims: Sequence[Claim]) -> list[Claim]:
+    """`claims` on the field their authors' code counts them by (`Claim.code_measure`), so that
+    both sides of a judgement against its runs count alike."""
+    return [replace(c, measure=c.code_measure) if c.code_measure else c for c in claims]
+
+
 def evaluate_reference(claims: Sequence[Claim], rows: Mapping[str, Sequence[dict]] | Sequence[dict],
                        reference: Sequence[dict]) -> dict[tuple[str, object], CellVerdict]:
     """(claim id, cell) -> our level cell judged against the authors' code's runs, Holm-corrected
     over the paper's level cells that have reference runs."""
     found = []
-    for c in claims:
+    for c in on_code_measure(claims):
         if c.kind != LEVEL:
             continue
         mine = rows[c.id] if isinstance(rows, Mapping) else rows
@@ -137,8 +143,9 @@ def evaluate_reference_relations(claims: Sequence[Claim], rows: Mapping[str, Seq
                                  reference: Sequence[dict]) -> dict[str, tuple[Verdict, Verdict]]:
     """claim id -> (the authors' code's runs judged against the paper, ours judged against the
     authors' code's runs) for every relation and trend with a cell the reference runs cover; each
-    verdict keeps only those cells. Each of the two is one Holm family."""
-    theirs = [v for v in evaluate([c for c in claims if c.kind != LEVEL], reference)
+    verdict keeps only those cells, both sides on the claim's `Claim.code_measure`. Each of the two
+    is one Holm family."""
+    theirs = [v for v in evaluate([c for c in on_code_measure(claims) if c.kind != LEVEL], reference)
               if any(math.isfinite(cv.effect) for cv in v.cells)]
     theirs = [replace(v, cells=tuple(cv for cv in v.cells if math.isfinite(cv.effect))) for v in theirs]
     theirs = [replace(v, verdict=worst(cv.verdict for cv in v.cells)) for v in theirs]

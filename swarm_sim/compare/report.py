@@ -173,6 +173,12 @@ def reference_runs(rows: Sequence[dict]) -> Iterator[None]:
         _REFERENCE.reset(token)
 
 
+def reference_rows() -> Sequence[dict]:
+    """The authors' code's runs of the current `reference_runs` block (none outside one), for a
+    comparison that derives its figures' fields from its rows (a unit) on theirs too."""
+    return _REFERENCE.get()
+
+
 def boxplot_figure(
     panels: Sequence[tuple[str, str]],
     rows: Sequence[dict],

@@ -27,6 +27,7 @@ from swarm_sim.compare.report import REFERENCE_LABEL, fmt_p, md_table
 from swarm_sim.compare.verdicts import (
     ALPHA,
     BOOTSTRAP,
+    CODE,
     GRADES,
     HOLDS,
     LEVEL,
@@ -279,7 +280,8 @@ def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> 
         intro += (" Where the authors' code was run here, its runs are judged against the paper "
                   f"(*{REFERENCE_LABEL}*) and ours against its runs (*ours vs authors' code*: the size and direction "
                   "their runs show take the paper's place; where their difference is not significant, \"no "
-                  "difference\"), in the cells their runs cover.")
+                  "difference\"), in the cells their runs cover; where their controller counts the measure its own "
+                  "way (a collision rule), both sides are judged on their count.")
     lines = ["## Relations and trends", "", intro, ""]
     for name, per in papers.items():
         lines += [f"### {name}", ""]
@@ -299,7 +301,8 @@ def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> 
             if ref:
                 theirs = next((per[m].relations[c.id][0] for m in models if m in per and c.id in per[m].relations),
                               None)
-                row.append(_cells(theirs) if theirs else "—")
+                counted = f"(their count, `{c.code_measure}`) " if c.code_measure else ""
+                row.append(counted + _cells(theirs) if theirs else "—")
             for m in models:
                 if m not in per:
                     row += ["—"] * (3 if ref else 2)
@@ -325,11 +328,18 @@ def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> lis
     lines = ["## Causes of the claims that do not hold", "",
              "Each claim that does not hold on a robot model, with its cause and the cause's grade: "
              f"*{GRADES['measured']}* (that factor alone switched, at least 10 seeds, the gap closes by half or the "
-             f"verdict flips; numbers in FACTORS.md), *{GRADES['partial']}* (a factor sweep points to it, with fewer "
+             f"verdict flips; numbers in FACTORS.md), *{GRADES['code']}* (the authors' own code, run here, at least "
+             "10 runs a cell, misses it too: checked against its runs' verdict), "
+             f"*{GRADES['partial']}* (a factor sweep points to it, with fewer "
              f"seeds or without closing the gap), *{GRADES['open']}* (not measured; what the text says is a lead, "
              "not a cause). The evidence is in CAUSES.md below.", ""]
+    if any(per[m].relations for per in papers.values() for m in per):
+        lines[-2] += (f" Where the authors' code was run here, *{REFERENCE_LABEL}* is its runs' verdict against the "
+                      "paper on the same relation or trend: a claim their own code misses too is a gap between the "
+                      "paper and its code.")
     for name, per in papers.items():
         body, grades = [], {}
+        ref = any(per[m].relations for m in models if m in per)
         first = per[models[0]].verdicts if models[0] in per else []
         for i, v in enumerate(first):
             mine = {m: per[m].verdicts[i] for m in models if m in per}
@@ -337,6 +347,11 @@ def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> lis
             if not failing:
                 continue
             causes = {m: v.claim.cause(m) for m in failing}
+            theirs = next((per[m].relations[v.claim.id][0].verdict for m in models
+                           if m in per and v.claim.id in per[m].relations), "—")
+            if any(c is not None and c.grade == CODE for c in causes.values()) and theirs == HOLDS:
+                raise ValueError(f"{name}: claim {v.claim.id}: its cause says the authors' code misses it too, "
+                                 f"but their runs' verdict is {theirs}")
             for m, cause in causes.items():
                 grade = cause.grade if cause else OPEN
                 grades[(m, grade)] = grades.get((m, grade), 0) + 1
@@ -346,13 +361,15 @@ def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> lis
                 texts.setdefault(key, []).append(title[m])
             cause_text = "<br>".join((f"{', '.join(who)}: " if len(texts) > 1 else "") + f"*{GRADES[g]}*: {t}"
                                      for (g, t), who in texts.items())
-            body.append([f"`{v.claim.id}`", *(mine[m].verdict if m in mine else "—" for m in models), cause_text])
+            body.append([f"`{v.claim.id}`", *(mine[m].verdict if m in mine else "—" for m in models),
+                         *([theirs] if ref else []), cause_text])
         if not body:
             continue
         summary = "; ".join(f"{title[m]}: " + ", ".join(f"{grades.get((m, g), 0)} {GRADES[g]}" for g in GRADES)
                             for m in models)
         lines += [f"### {name}", "", f"Claims not holding, by the grade of their cause: {summary}.", ""]
-        lines += md_table(["claim", *(f"verdict ({title[m]})" for m in models), "cause (grade)"], body) + [""]
+        lines += md_table(["claim", *(f"verdict ({title[m]})" for m in models), *([REFERENCE_LABEL] if ref else []),
+                           "cause (grade)"], body) + [""]
     return lines
 
 

@@ -64,26 +64,30 @@ LEVEL_BAND = 0.25
 BOOTSTRAP = 2000
 MEASURED_SEEDS = 10
 
-MEASURED, PARTIAL, OPEN = "measured", "partial", "open"
-GRADES: dict[str, str] = {MEASURED: "one factor, measured", PARTIAL: "partial", OPEN: "open"}
+MEASURED, CODE, PARTIAL, OPEN = "measured", "code", "partial", "open"
+GRADES: dict[str, str] = {MEASURED: "one factor, measured", CODE: "the authors' code too", PARTIAL: "partial",
+                          OPEN: "open"}
 
 
 @dataclass(frozen=True)
 class Cause:
     """Why a claim does not hold, graded. *measured* needs the factor switched alone, its seeds
-    (at least `MEASURED_SEEDS`) and where FACTORS.md gives the numbers."""
+    (at least `MEASURED_SEEDS`) and where FACTORS.md gives the numbers; *code*: the authors' own
+    code, run here (``results/reference/<paper>``, at least `MEASURED_SEEDS` runs a cell), misses
+    the claim too, which the report checks against their runs' verdict."""
 
     grade: str
     text: str
     factor: str = ""
-    """The factor sweep (``results/factors/<group>/<factor>``) that measured it."""
+    """The factor sweep (``results/factors/<group>/<factor>``) that measured it; *code*: the
+    reference runs (``results/reference/<paper>``)."""
     seeds: int = 0
 
     def __post_init__(self) -> None:
         if self.grade not in GRADES:
             raise ValueError(f"cause grade {self.grade!r}: must be one of {', '.join(GRADES)}")
-        if self.grade == MEASURED and (self.seeds < MEASURED_SEEDS or not self.factor):
-            raise ValueError(f"a measured cause needs its factor and at least {MEASURED_SEEDS} seeds "
+        if self.grade in (MEASURED, CODE) and (self.seeds < MEASURED_SEEDS or not self.factor):
+            raise ValueError(f"a {GRADES[self.grade]} cause needs its runs and at least {MEASURED_SEEDS} seeds "
                              f"(got {self.factor!r}, {self.seeds})")
 
 
@@ -126,6 +130,10 @@ class Claim:
     causes: tuple[tuple[str, Cause], ...] = ()
     """(robot model, cause) for the models on which it does not hold; model ``*``: any."""
     note: str = ""
+    code_measure: str = ""
+    """The rows' field holding `measure` as the authors' code counts it, where that count is not
+    ours (a collision rule of their controller): the claim is put to their runs, and ours against
+    them, on this field (`swarm_sim.compare.reference`); empty: `measure`."""
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

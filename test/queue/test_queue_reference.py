@@ -73,11 +73,22 @@ def test_the_printed_line_becomes_a_row_in_our_schema():
     row = qa.row("queue_qse", 48, 123456, printed, 60.0, {"commit": "c" * 40, "reference": True})
     assert row["resources_delivered"] == 69 and row["total_resources"] == 320
     assert row["resources_collected_pct"] == pytest.approx(21.5625)
-    assert row["authors_collision_time_total_min"] == 21.27
-    assert row["authors_collision_time_per_robot_s"] == pytest.approx(60 * 21.27 / 48)
+    # their print is half the time their rule fired; the row holds the whole, as our count does
+    assert row["authors_collision_time_total_min"] == pytest.approx(2 * 21.27)
+    assert row["authors_collision_time_per_robot_s"] == pytest.approx(2 * 60 * 21.27 / 48)
+    assert row["dropoff_time_mean_s"] == pytest.approx(60 * 6.33)
     assert row["sim_seconds"] == 1080.0 and row["real_time_factor"] == 18.0
     assert row["reference"] is True and row["mode"] == "reference"
     json.dumps(row)
+
+
+def test_a_run_that_delivered_nothing_has_no_drop_off_time():
+    """Their per-delivery circle time of a run without a delivery prints as nan: no number, not NaN."""
+    printed = qa.parse_line(PRINTED.replace("69.00", "0.00").replace("6.33", "nan"))
+    row = qa.row("queue_qse", 48, 123456, printed, 60.0, {})
+    assert row["dropoff_time_mean_s"] is None and row["authors_time_in_circle_per_delivery_min"] is None
+    assert row["authors_collision_time_total_min"] == pytest.approx(2 * 21.27)
+    json.dumps(row, allow_nan=False)
 
 
 @pytest.mark.parametrize("text, why", [("", "0 'Resource Collected' lines"),
