@@ -12,7 +12,8 @@ Choices where the paper leaves a detail open:
   ``robots.count`` (the paper's ids are 1-based).
 * **Path**: ``ddsa_path(depot centre, r, i, gap, arena half-side - arena_margin)`` (the
   default stem: robot i starts at centre + (0, (i-1) g), where robot i-1's first leg ends; it
-  drives there from its start cell). The path is walked leg by leg with `go_to_point_twist`
+  drives there from its start cell; ``controller.spiral.ddsa_stem: shared`` starts every robot at
+  the depot centre, as the authors' code does). The path is walked leg by leg with `go_to_point_twist`
   toward the point ``controller.spiral.waypoint_gaps`` gaps (one, the DDSA authors' waypoint
   spacing) ahead of the progress on the current leg (the leg's end when nearer), so a robot
   pushed off its lane steers back onto it instead of cutting across to a far corner; a
@@ -247,7 +248,8 @@ class DdsaBehaviour:
         sp = SpiralConfig.of(scenario)
         half = scenario.arena.size / 2.0 - sp.arena_margin
         center = (float(scenario.depot.center[0]), float(scenario.depot.center[1]))
-        self.path = SpiralPath(ddsa_path(center, r, i, sp.gap, half))
+        shared = sp.ddsa_stem == "shared"
+        self.path = SpiralPath(ddsa_path(center, r, i, sp.gap, half, include_shared_stem=shared))
         """This robot's spiral [m, world frame]."""
         self._wp = [(float(x), float(y)) for x, y in self.path.waypoints]
         self._cum = [float(c) for c in self.path.cumulative]
@@ -256,6 +258,9 @@ class DdsaBehaviour:
         self._avoidance = LaneAvoidance(scenario, self._drive)
         tol = min(scenario.controller.arrival_tolerance, sp.gap / 4.0)
         self._wp_tol2 = tol**2
+        self._start_tol2 = float(scenario.depot.radius) ** 2 if shared else self._wp_tol2
+        """The path's first point counts as reached within this [m^2]: with the shared stem it is the
+        depot centre, reached anywhere in the depot disc (``controller.spiral.ddsa_stem``)."""
         self._carrot = sp.gap * sp.waypoint_gaps
         self._arrival2 = scenario.controller.arrival_tolerance**2
         self._center = center
@@ -354,7 +359,7 @@ class DdsaBehaviour:
         # Advance past every waypoint already reached (several on a degenerate path).
         while self._next < n:
             tx, ty = wp[self._next]
-            if (tx - x) ** 2 + (ty - y) ** 2 >= self._wp_tol2:
+            if (tx - x) ** 2 + (ty - y) ** 2 >= (self._start_tol2 if self._next == 0 else self._wp_tol2):
                 break
             self._progress = max(self._progress, self._cum[self._next])
             self._next += 1
@@ -410,7 +415,7 @@ class DdsaBehaviour:
         pose = obs.pose
         s = self._found_s if self._found_s is not None else self._progress
         tx, ty = (float(v) for v in self.path.point_at(s))
-        if (tx - pose.x) ** 2 + (ty - pose.y) ** 2 < self._wp_tol2:
+        if (tx - pose.x) ** 2 + (ty - pose.y) ** 2 < (self._start_tol2 if s <= 0.0 else self._wp_tol2):
             self._found_s = None
             self._progress = s
             self._next = max(self.path.next_waypoint_index(s), 0)

@@ -88,6 +88,33 @@ def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():
         DdsaBehaviour(BASE, "robot_4")
 
 
+def test_shared_stem_starts_every_spiral_at_the_depot_centre_over_the_lower_robots_first_legs():
+    assert SpiralConfig.of(BASE).ddsa_stem == "own"
+    s = generic_scenario("ddsa", ["controller.spiral.ddsa_stem=shared"], robots__count=4)
+    half = s.arena.size / 2 - SpiralConfig.of(s).arena_margin
+    centre = np.asarray(s.depot.center, dtype=float)
+    for k in range(4):
+        own, shared = behaviour(robot=f"robot_{k}").path.waypoints, behaviour(s, f"robot_{k}").path.waypoints
+        np.testing.assert_allclose(shared, ddsa_path(centre, 4, k + 1, 0.18, half, include_shared_stem=True))
+        np.testing.assert_allclose(shared[0], centre)  # the authors' first target: the nest
+        np.testing.assert_allclose(shared[1], centre + [0.0, (k + 1) * 0.18])  # i gaps out on one line
+        np.testing.assert_allclose(own[0], centre + [0.0, k * 0.18])  # the default: where robot i-1's leg ends
+        np.testing.assert_allclose(own[1:], shared[1:])
+    with pytest.raises(ScenarioError, match="controller.spiral.ddsa_stem"):
+        generic_scenario("ddsa", ["controller.spiral.ddsa_stem=centre"])
+
+
+@pytest.mark.parametrize("offset, reached", [(0.9, True), (1.1, False)])
+def test_shared_stem_start_is_reached_anywhere_in_the_depot_disc(offset, reached):
+    """Their TargetHit: the nest target is hit once IsInTheNest, not within the waypoint tolerance."""
+    s = generic_scenario("ddsa", ["controller.spiral.ddsa_stem=shared"], robots__count=4)
+    b = behaviour(s, "robot_2")
+    r = offset * s.depot.radius
+    assert r > min(s.controller.arrival_tolerance, 0.18 / 4)  # beyond the ordinary waypoint tolerance
+    b.step(obs(0, s.depot.center[0] + r, s.depot.center[1], 0.0))
+    assert b.next_waypoint == (1 if reached else 0)
+
+
 def test_follows_the_first_legs_of_its_spiral():
     b = behaviour(robot="robot_2")
     u = Unicycle(0.4, -0.4, 0.0)  # a start cell off the path
