@@ -65,6 +65,14 @@ class QueueConfig(Section):
     ``CollisionDetection``). With cells released on arrival a dense line moves as a caterpillar,
     each robot waiting for the one ahead to finish its move."""
 
+    brake_patience: float = 3.0
+    """[s] a robot on the queue's lines (queued or leaving) that has been braked this long swerves
+    round what blocks it, by its model's avoidance, for a second. Our addition, a deadlock breaker
+    (two robots braking face to face, one pushed off its line, would wait for each other for
+    good). The queue authors' robots on their path never swerve: ``CPFA_controller::
+    CollisionDetection`` only calls ``Stop()`` in FOLLOWING_ENTRY_PATH and EXITING (Tameem786/
+    Collision_Free_CPFA, branches main and CPFA-2.0); one beyond the run's duration is that rule."""
+
     seek_timeout: float = 120.0
     """Tail joining: a searcher that has not joined after this long [s, sim time] falls back to
     entry-point joining. Our addition, against livelock: the paper's searcher only switches to its

@@ -514,10 +514,12 @@ def make_layout(
 
 def check_queue(scenario: Scenario) -> None:
     """The queue strategies' check (`swarm_controllers.queue.registration`; ValueError naming the
-    parameter): the searchers' give-up time is positive and the queue layout fits the depot."""
+    parameter): the searchers' give-up time and the brake patience are positive and the queue
+    layout fits the depot."""
     q = QueueConfig.of(scenario)
-    if not q.seek_timeout > 0:
-        raise ValueError("controller.queue.seek_timeout: must be positive")
+    for key in ("seek_timeout", "brake_patience"):
+        if not getattr(q, key) > 0:
+            raise ValueError(f"controller.queue.{key}: must be positive")
     try:
         geometry = DepotGeometryConfig.from_scenario(scenario)
         geometry.validate()

@@ -41,7 +41,7 @@ Phases of a delivery, and the choices the paper leaves open:
   it reaches. It does not swerve in the queue (the slots are the manager's, and swerving would
   take it into a neighbouring lane); it only brakes when something is right in front (on a robot
   model with a path rule of its own, the authors' foot-bot, that rule: `PATH_CONE`), and
-  swerves round it only after `BRAKE_PATIENCE` (a deadlock breaker). At the
+  swerves round it only after ``controller.queue.brake_patience`` (a deadlock breaker). At the
   dock it waits for the world to drop its resource (T_unload), reports ``unloaded``, and goes
   on as granted (a robot whose resource was dropped on the way, in a dock's zone it stood in for
   T_unload, reports ``unloaded`` on reaching its dock). At the last exit slot (on the perimeter) it reports that slot and drives out
@@ -92,9 +92,9 @@ PATH_CONE = 30.0
 heading, on a robot model with a path rule of its own (`swarm_controllers.motion.Drive.path_stop`):
 the queue authors' ``GoStraightAngleRangeInDegreesInRegion`` (Artglz and Tameem786/
 Collision_Free_CPFA, ``CPFA_controller::CollisionDetection``)."""
-BRAKE_PATIENCE = 3.0
-"""A robot braked this long [s] swerves round what blocks it (two robots braking face to face,
-e.g. one pushed off its line, would otherwise wait for each other forever)."""
+SWERVE_TIME = 1.0
+"""[s] how long a robot whose brake patience ran out (`QueueConfig.brake_patience`) swerves before
+it tries its line again."""
 
 
 class Phase(Enum):
@@ -141,7 +141,8 @@ class QueueBehaviour:
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
-        "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_phase", "_query_at", "_to_point",
+        "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_patience", "_phase", "_query_at",
+        "_to_point",
         "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
         "rejections", "robot",
     )
@@ -164,6 +165,7 @@ class QueueBehaviour:
         self._gamma = scenario.robots.radio_range
         self._tail = queue.joining == "tail"
         self._seek_time = queue.seek_timeout
+        self._patience = queue.brake_patience
         self._keep_out = self._R + KEEP_OUT_BAND
         """Non-carriers stay outside this radius about the depot centre [m]."""
         self._detour_far = self._drive.blind_legs
@@ -263,11 +265,11 @@ class QueueBehaviour:
             linear, angular = self._leaving(obs, r)
             if self._phase is _FORAGING:
                 return self._forage(obs, r, out)
-        if phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= BRAKE_PATIENCE:
+        if phase is _TO_ENTRY or phase is _SEEKING or obs.t - self._braked_since >= self._patience:
             override = self._avoid.update(obs.ranges)
             if override is not None:
                 linear, angular = override.linear, override.angular
-            if obs.t - self._braked_since >= BRAKE_PATIENCE + 1.0:
+            if obs.t - self._braked_since >= self._patience + SWERVE_TIME:
                 self._braked_since = math.inf  # swerved for a second: try the line again
         elif (phase is _QUEUED or phase is _LEAVING) and self._line_drive.path_stop(obs.ranges, PATH_CONE):
             linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())

@@ -286,6 +286,29 @@ def test_a_ray_at_the_float32_brake_range_does_not_brake_and_one_below_does():
     assert b.step(Observation("robot_0", 2 * 10**9, pose, 0.0, 0.0, scan, ForagingSense((), True))).linear == 0.0
 
 
+@pytest.mark.parametrize("patience", [3.0, 100000.0])
+def test_a_queued_robot_braked_past_its_patience_swerves_and_one_with_the_authors_rule_stands(patience):
+    """``controller.queue.brake_patience``: blocked right in front, a queued robot stands; once braked
+    that long it swerves round the block (our deadlock breaker), and with a patience beyond the run
+    (the queue authors' robots on their path: ``Stop()`` only) it stands for good."""
+    from swarm_sim.scenario import ScenarioError
+
+    b = QueueBehaviour(generic_scenario("queue_qmt", [f"controller.queue.brake_patience={patience}"]), "robot_0",
+                       np.random.default_rng(0))
+    b._phase, b._line, b._cell, b._grant = Phase.QUEUED, "entry_line_0", 1, ("entry_line_0", 3)
+    _, pose = _queued_robot()
+    scan = np.full(24, np.inf, dtype=np.float32)
+    scan[12] = 0.05  # a robot right in front of it
+    twists = [(c.linear, c.angular) for c in
+              (b.step(Observation("robot_0", k * 10**8, pose, 0.0, 0.0, scan, ForagingSense((), True)))
+               for k in range(1, 101))]  # 10 s
+    braked = twists[0]  # standing, turned toward its slot
+    assert braked[0] == 0.0 and set(twists[:29]) == {braked}  # its first 3 s either way
+    assert (set(twists[29:]) != {braked}) == (patience < 10.0)
+    with pytest.raises(ScenarioError, match="controller.queue.brake_patience"):
+        generic_scenario("queue_qmt", ["controller.queue.brake_patience=0"])
+
+
 def test_a_robot_that_lost_its_resource_on_the_way_reports_unloaded_at_its_dock():
     """A carrier that stood T_unload in a dock's zone on the way lost its resource there: at its own
     dock it says unloaded at once (the manager refuses an unload anywhere but the dock, and the
