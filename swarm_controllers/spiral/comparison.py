@@ -331,6 +331,11 @@ SPIRAL_RULES: tuple[Rule, ...] = (
          "a point every 3 search gaps (`generateSpiralPath`): `3`", "code"),
     Rule("mdbsa_c, mdbsa_d", "controller.spiral.next_walk_at", "not stated",
          "a new walk by way of (0.1, 0.1) (`SetTarget(CVector2(0.1, 0.1))`): `depot`", "code"),
+    Rule("ddsa", "controller.spiral.ddsa_stem",
+         "Sec. III: spirals \"starting from the central collection zone\"; \"each robot moves to its designated "
+         "path\"", "every robot's first target is the nest, then its first leg of i gaps out from it over the lower "
+         "robots' (DDSA `ReachSpiralTargets`, `generatePattern`): `shared`", "code",
+         "ours before 2026-11-29: `own`, robot i starting where robot i-1's first leg ends (factor `ddsa_own_stem`)"),
 )
 
 

@@ -65,16 +65,19 @@ class SpiralConfig(Section):
     robot yields again, and a chain of robots each yielding to the next can stand for good (issue
     37: 3 of 20 DDSA runs at 32 robots before this became the default; CAUSES.md)."""
 
-    ddsa_stem: Literal["own", "shared"] = "own"
-    """DDSA: where robot i's spiral starts. ``own``: at the depot centre + (0, (i-1) g), where robot
-    i-1's first leg ends, so no leg is walked twice (`geometry.ddsa_path`'s default stem). ``shared``:
-    eqs. (1)-(2) read literally, as the DDSA authors' code walks them: every robot first drives to
-    the depot centre, reached anywhere in the depot disc (their first target is the nest position,
-    and ``TargetHit`` takes ``GetTarget() == NestPosition && IsInTheNest()``), then walks its first
-    leg of i gaps out from it along one line, over robots 1..i-1's first legs (``generatePattern`` /
+    ddsa_stem: Literal["own", "shared"] = "shared"
+    """DDSA: where robot i's spiral starts. ``shared`` (the default, the authors' code): eqs. (1)-(2)
+    read literally, as the DDSA authors' code walks them: every robot first drives to the depot
+    centre, reached anywhere in the depot disc (their first target is the nest position, and
+    ``TargetHit`` takes ``GetTarget() == NestPosition && IsInTheNest()``), then walks its first leg
+    of i gaps out from it along one line, over robots 1..i-1's first legs (``generatePattern`` /
     ``calcDistanceToTravel``: F^N = i on circuit 1, each step relative to the last target;
     MARSLab-UTRGV/DDSA-Distributed-Deterministic-Spiral-Search-Algorithm, luki-dev,
-    ``source/DSA/DSA_controller.cpp`` ``ReachSpiralTargets``, ``source/DSA/DSA_loop_functions.cpp``)."""
+    ``source/DSA/DSA_controller.cpp`` ``ReachSpiralTargets``, ``source/DSA/DSA_loop_functions.cpp``).
+    The text agrees as far as it goes (Sec. III: spirals "starting from the central collection
+    zone"). ``own``: ours before 2026-11-29, at the depot centre + (0, (i-1) g), where robot i-1's
+    first leg ends, so no leg is walked twice and nobody passes through the nest to start
+    (`geometry.ddsa_path`'s default stem; Sec. III: "each robot moves to its designated path")."""
 
     SECTION: ClassVar[str] = "spiral"
 

@@ -10,10 +10,11 @@ Choices where the paper leaves a detail open:
 
 * **Robot numbering**: robot index k (``robot_k``) is DDSA robot i = k + 1 of r =
   ``robots.count`` (the paper's ids are 1-based).
-* **Path**: ``ddsa_path(depot centre, r, i, gap, arena half-side - arena_margin)`` (the
-  default stem: robot i starts at centre + (0, (i-1) g), where robot i-1's first leg ends; it
-  drives there from its start cell; ``controller.spiral.ddsa_stem: shared`` starts every robot at
-  the depot centre, as the authors' code does). The path is walked leg by leg with `go_to_point_twist`
+* **Path**: ``ddsa_path(depot centre, r, i, gap, arena half-side - arena_margin)``, every robot's
+  from the depot centre (reached anywhere in the depot) and out over the lower robots' first legs,
+  as the authors' code walks it (``controller.spiral.ddsa_stem: shared``); ``own`` starts robot i
+  at centre + (0, (i-1) g), where robot i-1's first leg ends, and drives there from its start
+  cell. The path is walked leg by leg with `go_to_point_twist`
   toward the point ``controller.spiral.waypoint_gaps`` gaps (one, the DDSA authors' waypoint
   spacing) ahead of the progress on the current leg (the leg's end when nearer), so a robot
   pushed off its lane steers back onto it instead of cutting across to a far corner; a

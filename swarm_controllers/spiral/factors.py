@@ -41,14 +41,15 @@ LANE_UNJAM_OFF = Factor("lane_unjam_off", "the lane rule's timeout yields again 
                         "instead of starting the model's avoidance turn at the lane hit the model's detection "
                         "missed; today's other rules",
                         ("--strategies", "ddsa", "mdbsa_c", *AUTHORS, "--set", "controller.spiral.lane_unjam=false"))
-# Issue 37's surplus of our DDSA over the authors' run here: their every robot starts its spiral at the nest
-# centre (first target the nest, reached inside it) and walks its first leg out over the lower robots' first legs
-# (generatePattern, ReachSpiralTargets: DDSA repository, luki-dev, source/DSA/), so the start, the shared stem and
-# the carriers all meet in the 0.18 m nest. DDSA only (MDBSA has no such stem).
-SHARED_STEM = Factor("ddsa_shared_stem", "DDSA's spirals all start at the depot centre, reached anywhere in the "
-                     "depot, with robot i's first leg of i gaps over robots 1..i-1's (eqs. (1)-(2) read literally, "
-                     "the authors' generatePattern and first target) instead of at centre + (0, (i-1) g); today's "
-                     "other rules", ("--strategies", "ddsa", *AUTHORS, "--set", "controller.spiral.ddsa_stem=shared"))
+# Issue 37's surplus of our DDSA over the authors' run here (12-99 % at 8-32 robots) was where the spirals start:
+# their every robot starts at the nest centre (first target the nest, reached inside it) and walks its first leg
+# out over the lower robots' first legs (generatePattern, ReachSpiralTargets: DDSA repository, luki-dev,
+# source/DSA/), so the start, the shared stem and the carriers all meet in the 0.18 m nest. The default since
+# 2026-11-29 (controller.spiral.ddsa_stem: shared); this factor is ours before. DDSA only (MDBSA has no such stem).
+OWN_STEM = Factor("ddsa_own_stem", "DDSA's spirals start where the lower robot's first leg ends, centre + (0, (i-1) "
+                  "g), no leg walked twice (ours before 2026-11-29) instead of all at the depot centre over one "
+                  "another's first legs (the authors' code); today's other rules",
+                  ("--strategies", "ddsa", *AUTHORS, "--set", "controller.spiral.ddsa_stem=own"))
 # The MDBSA rules adopted on 2026-11-27 (afternoon), each switched off alone on today's defaults
 # (5 seeds): compare with the main sweep's MDBSA runs, not with this group's older baseline.
 MDBSA_RULES = (
@@ -74,6 +75,6 @@ GROUPS = (
     ), baseline="baseline/exp1"),
     # Experiment 2 (8-32 robots, 16 regions), where MDBSA-C is to collect about 44 % less than DDSA.
     FactorGroup("spiral2", ("spiral", "--experiment", "2"), "spiral/exp2/results.jsonl", "all",
-                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD, LANE_UNJAM_OFF, SHARED_STEM),
+                (BASELINE, CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD, LANE_UNJAM_OFF, OWN_STEM),
                 baseline="baseline/exp2"),
 )

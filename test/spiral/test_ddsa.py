@@ -82,23 +82,23 @@ def test_registered_and_config_defaults():
 def test_path_is_robot_i_plus_1_of_r_clipped_by_margin():
     b = behaviour(robot="robot_2")
     half = BASE.arena.size / 2 - SpiralConfig.of(BASE).arena_margin
-    np.testing.assert_allclose(b.path.waypoints, ddsa_path((0.0, 0.0), 4, 3, 0.18, half))
+    np.testing.assert_allclose(b.path.waypoints, ddsa_path((0.0, 0.0), 4, 3, 0.18, half, include_shared_stem=True))
     assert np.all(np.abs(b.path.waypoints) <= half + 1e-9)
     with pytest.raises(ValueError):
         DdsaBehaviour(BASE, "robot_4")
 
 
 def test_shared_stem_starts_every_spiral_at_the_depot_centre_over_the_lower_robots_first_legs():
-    assert SpiralConfig.of(BASE).ddsa_stem == "own"
-    s = generic_scenario("ddsa", ["controller.spiral.ddsa_stem=shared"], robots__count=4)
+    assert SpiralConfig.of(BASE).ddsa_stem == "shared"  # the authors' code's
+    s = generic_scenario("ddsa", ["controller.spiral.ddsa_stem=own"], robots__count=4)
     half = s.arena.size / 2 - SpiralConfig.of(s).arena_margin
     centre = np.asarray(s.depot.center, dtype=float)
     for k in range(4):
-        own, shared = behaviour(robot=f"robot_{k}").path.waypoints, behaviour(s, f"robot_{k}").path.waypoints
+        shared, own = behaviour(robot=f"robot_{k}").path.waypoints, behaviour(s, f"robot_{k}").path.waypoints
         np.testing.assert_allclose(shared, ddsa_path(centre, 4, k + 1, 0.18, half, include_shared_stem=True))
         np.testing.assert_allclose(shared[0], centre)  # the authors' first target: the nest
         np.testing.assert_allclose(shared[1], centre + [0.0, (k + 1) * 0.18])  # i gaps out on one line
-        np.testing.assert_allclose(own[0], centre + [0.0, k * 0.18])  # the default: where robot i-1's leg ends
+        np.testing.assert_allclose(own[0], centre + [0.0, k * 0.18])  # ours before: where robot i-1's leg ends
         np.testing.assert_allclose(own[1:], shared[1:])
     with pytest.raises(ScenarioError, match="controller.spiral.ddsa_stem"):
         generic_scenario("ddsa", ["controller.spiral.ddsa_stem=centre"])
