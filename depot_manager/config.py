@@ -20,6 +20,11 @@ class QueueConfig(Section):
     """Endpoint finding (sec. V): entry-point joining or tail joining."""
     lane_spacing: float = 0.20
     """Distance between adjacent queue lanes [m] (sec. VII)."""
+    slot_pitch: float | None = None
+    """Distance between a line's cells along it [m]; None: `lane_spacing`. The paper gives none and
+    the queue authors' code has no cells: their robots on the path stop for what their proximity
+    ring reads ahead, so a standing line's robots stand about a ring's reach apart (the foot-bot:
+    0.085 + 0.1 + 0.085 = 0.27 m centre to centre)."""
     inner_rule: Literal["own", "any"] = "own"
     """Single-queue inner-queue rules (sec. IV-A: dispatch only if no robot is between the
     inner entry point and the dock; leave the dock only if none is between it and the exit

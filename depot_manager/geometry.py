@@ -69,7 +69,7 @@ class DepotGeometryConfig:
         return cls(
             depot_center=tuple(d.center), depot_radius=d.radius, perimeter_radius=k.perimeter_radius,
             docks=k.docks, lane_spacing=QueueConfig.of(scenario).lane_spacing,
-            robot_diameter=scenario.robots.diameter,
+            robot_diameter=scenario.robots.diameter, slot_pitch=QueueConfig.of(scenario).slot_pitch,
         )
 
     @property

@@ -69,6 +69,16 @@ QST_QUEUED_CONTINUOUS = Factor("queued_motion_continuous", "the motion lead narr
                                "foraging and seeking (controller.queue.queued_motion=continuous; a diagnostic, not "
                                "the authors' rule)",
                                ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous"))
+# Inside the motion lead (2026-11-29): the queue authors' robots on their path never swerve, and their lines have no
+# cells (their robots stand about a ring's reach apart, 0.27 m centre to centre).
+QST_NEVER_SWERVE = Factor("never_swerve", "a robot braked on the queue's lines stands until the way is clear "
+                          "(controller.queue.brake_patience beyond the run: the authors' CPFA_controller::"
+                          "CollisionDetection only calls Stop() on the path) instead of swerving after 3 s (ours)",
+                          ("--robot-model", "authors", "--set", "controller.queue.brake_patience=100000"))
+QST_PITCH = Factor("slot_pitch_0.3", "the lines' cells 0.3 m apart (controller.queue.slot_pitch; about the 0.27 m at "
+                   "which the authors' robots stop behind one another by their proximity ring) instead of 0.2 m (the "
+                   "lane spacing; the paper gives none)",
+                   ("--robot-model", "authors", "--set", "controller.queue.slot_pitch=0.3"))
 
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
@@ -82,7 +92,7 @@ GROUPS = (
                 (BASELINE, MOTION_GENERIC, TURN, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
-                 QST_QUEUED_CONTINUOUS),
+                 QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
                 (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS), strategies=("queue_qse",)),

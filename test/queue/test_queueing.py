@@ -309,6 +309,21 @@ def test_a_queued_robot_braked_past_its_patience_swerves_and_one_with_the_author
         generic_scenario("queue_qmt", ["controller.queue.brake_patience=0"])
 
 
+def test_the_slot_pitch_key_spaces_the_lines_cells_and_is_checked():
+    """``controller.queue.slot_pitch`` (the paper gives none; default the lane spacing): the cells
+    along every line lie one pitch apart; one below the robot's diameter is refused by name."""
+    from swarm_sim.scenario import ScenarioError
+
+    for pitch in (None, 0.3):
+        s = generic_scenario("queue_qst", [] if pitch is None else [f"controller.queue.slot_pitch={pitch}"])
+        b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
+        for line in b._entry_lines:
+            gaps = np.linalg.norm(np.diff(np.asarray(b._slots[line]), axis=0), axis=1)
+            np.testing.assert_allclose(gaps[:-1], pitch or 0.2, atol=1e-6)  # the last one ends where the line does
+    with pytest.raises(ScenarioError, match="slot_pitch"):
+        generic_scenario("queue_qst", ["controller.queue.slot_pitch=0.1"])
+
+
 def test_a_robot_that_lost_its_resource_on_the_way_reports_unloaded_at_its_dock():
     """A carrier that stood T_unload in a dock's zone on the way lost its resource there: at its own
     dock it says unloaded at once (the manager refuses an unload anywhere but the dock, and the
