@@ -142,9 +142,8 @@ class QueueBehaviour:
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join", "_keep_out", "_lane",
         "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_patience", "_phase", "_query_at",
-        "_to_point",
-        "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until",
-        "rejections", "robot",
+        "_to_point", "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail",
+        "_yield_until", "rejections", "robot",
     )
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
