@@ -70,6 +70,18 @@ class QueueConfig(Section):
     ``CollisionDetection``). With cells released on arrival a dense line moves as a caterpillar,
     each robot waiting for the one ahead to finish its move."""
 
+    return_leg: Literal["centre", "rim"] = "centre"
+    """Where a carrier's return leg from foraging aims, on a robot whose legs run blind (the
+    foot-bot's stop-turn-go: a FORWARD runs its whole distance whatever the queue asks meanwhile):
+    ``centre``, the depot centre (the CPFA's nest), so a leg under way when the carrier enters the
+    perimeter, starts seeking or joins a line drives on across the lanes toward the depot until
+    something stops it; ``rim``, `swarm_controllers.cpfa.behaviour.RIM_MARGIN` outside the
+    perimeter, as the queue authors' carriers do: ``CPFA_controller::Returning`` (Tameem786/
+    Collision_Free_CPFA, branch CPFA-2.0) aims a carrier outside the red circle at ``safeDistance =
+    redCircleRadius + 0.1`` on its side, and inside it at ``redCircleRadius * 0.5 + 0.1``, where it
+    boards (our seeker's own leg, to one lane outside the inner region). No effect on a robot that
+    re-aims every tick."""
+
     brake_patience: float = 3.0
     """[s] a robot on the queue's lines (queued or leaving) that has been braked this long swerves
     round what blocks it, by its model's avoidance, for a second. Our addition, a deadlock breaker

@@ -195,7 +195,7 @@ class CpfaBehaviour:
         "_heading", "_hold", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
         "_leg_x", "_leg_y", "_mode", "_nest", "_nest_r2", "_omega", "_to_point",
         "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
-        "_rim", "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
+        "_rim", "_rim_carriers", "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
         "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
         "_threshold", "_trips", "_update_avoidance", "robot",
     )
@@ -203,13 +203,15 @@ class CpfaBehaviour:
     def __init__(
         self, scenario: Scenario, robot: RobotId, rng: np.random.Generator,
         *, keep_out: float | None = None, perimeter: float | None = None, drive: Drive | None = None,
+        carrier_rim: bool = False,
     ) -> None:
         """keep_out [m]: radius of a disc about the depot centre the robot stays out of unless
         carrying (the queue strategies' perimeter): random sites and walk legs avoid it and a
         give-up return ends at its edge. None: the depot disc (the plain CPFA). perimeter [m]: the
         queue strategies' perimeter radius, given with keep_out: a give-up return's blind leg ends
         `RIM_MARGIN` outside it. drive: the robot's motion layer when another behaviour owns it
-        (the queue strategies'; default: the robot model's, `swarm_controllers.motion.drive_for`)."""
+        (the queue strategies'; default: the robot model's, `swarm_controllers.motion.drive_for`).
+        carrier_rim: a carrier's return leg ends there too (`depot_manager.config.QueueConfig.return_leg`)."""
         cfg = CpfaConfig.of(scenario)
         dt = scenario.sim.dt
         self.robot = robot
@@ -249,6 +251,8 @@ class CpfaBehaviour:
         self._rim = perimeter + RIM_MARGIN if perimeter is not None and self._drive.blind_legs else 0.0
         """[m] where a give-up return's blind leg ends (0: it aims at the centre and arrives at the
         keep-out radius, re-aiming on the way)."""
+        self._rim_carriers = carrier_rim
+        """A carrier's blind leg ends at `_rim` too, not at the centre (``QueueConfig.return_leg``)."""
         docks_mode = keep_out is None and scenario.depot.delivery == "docks"
         zones = delivery_zones(scenario) if docks_mode else ()
         self._docks = [z.center for z in zones]
@@ -463,7 +467,7 @@ class CpfaBehaviour:
             return self._departing(obs, steering)
         if d2 < self._arrival2 or not steering:
             return _IDLE  # at the centre, waiting for the drop (or the avoidance drives)
-        if self._rim and not self._carrying:  # a blind leg to the centre would cross the perimeter
+        if self._rim and (not self._carrying or self._rim_carriers):  # a blind leg to the centre: across the perimeter
             k = self._rim / math.sqrt(d2)
             return self._to_point(x, y, pose.yaw, nx + (x - nx) * k, ny + (y - ny) * k)
         return self._to_point(x, y, pose.yaw, nx, ny)

@@ -171,7 +171,7 @@ class QueueBehaviour:
         """Check a non-carrier's path against the disc from any distance, not only near it: a
         blind leg started far out would cross the perimeter (``_forage``)."""
         self._cpfa = CpfaBehaviour(scenario, robot, rng, keep_out=self._keep_out, perimeter=self._R,
-                                   drive=self._drive)
+                                   drive=self._drive, carrier_rim=queue.return_leg == "rim")
         self._cpfa_step = self._cpfa.step
         self._avoid = self._drive.avoidance(0.1)
         self._layout, self._cells, self._slots, self._docks = _queues(

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from depot_manager.config import DockingConfig, QueueConfig
 from depot_manager.protocol import DepotGrant, RadioQuery, RadioReply, Refusal
 from swarm_controllers.avoidance import ray_angles
+from swarm_controllers.cpfa.behaviour import CpfaState
 from swarm_controllers.queue.behaviour import (
     BRAKE_CONE,
     BRAKE_RANGE,
@@ -410,3 +411,35 @@ def test_queued_motion_continuous_drives_the_lines_only_with_the_generic_steerin
         # a continuous drive turns and goes at once; stop-turn-go first stands for its plan
         lin, ang = b._line_to_point(0.0, 0.0, 0.0, 1.0, 0.3)
         assert (lin > 0 and ang > 0) == (motion == "continuous")
+
+
+@pytest.mark.parametrize("leg", ["centre", "rim"])
+def test_a_foot_bot_carriers_return_leg_ends_where_return_leg_says(leg):
+    """``controller.queue.return_leg``: a foot-bot's legs run blind, so a carrier's return leg aimed
+    at the depot centre (``centre``) carries it on past the inner region's boundary, where its
+    seek stops, once it has asked to join there; aimed just outside the perimeter (``rim``, the
+    queue authors' ``CPFA_controller::Returning``) it ends there and the seek's own leg stops at
+    the boundary. Poses integrated from the commands, nothing around."""
+    s = load_footbot_qst([f"controller.queue.return_leg={leg}"])
+    b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
+    b._cpfa._carrying, b._cpfa._state = True, CpfaState.RETURNING
+    x, y, yaw, dt = 3.0, 0.0, math.pi, s.sim.dt
+    empty = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
+    r_min = math.inf
+    for k in range(1, 400):  # 40 s
+        c = b.step(Observation("robot_0", k * s.dt_ns, Pose2D(x, y, yaw), 0.0, 0.0, empty, ForagingSense((), True)))
+        yaw += c.angular * dt
+        x, y = x + c.linear * dt * math.cos(yaw), y + c.linear * dt * math.sin(yaw)
+        r_min = min(r_min, math.hypot(x, y))
+    boundary = b._layout.inner_radius + b._lane
+    assert b.phase in (Phase.JOINING, Phase.QUEUED)  # it asked for a cell at the boundary either way
+    if leg == "centre":
+        assert r_min < 0.6  # on across the innermost lane, toward the depot
+    else:
+        assert boundary - 0.05 < r_min < boundary + 0.1
+
+
+def load_footbot_qst(overrides):
+    from swarm_sim.scenario import load_scenario
+
+    return load_scenario("queue_qst", ["robots.model=footbot_cpfa", "robots.count=1", *overrides])
