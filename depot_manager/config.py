@@ -82,6 +82,16 @@ class QueueConfig(Section):
     boards (our seeker's own leg, to one lane outside the inner region). No effect on a robot that
     re-aims every tick."""
 
+    entry_reach: float = 0.05
+    """[m] a queued robot counts a cell of an entry line (not a dock) as reached within this
+    distance, reports it and drives on to the next (docks and the other lines: 0.05 m,
+    `swarm_controllers.queue.behaviour.SLOT_TOLERANCE`). The queue authors' robots take a waypoint
+    of their path as reached within 0.1 m (``CPFA_controller::FollowingEntryPath``: "Waypoint
+    reached threshold", Tameem786/Collision_Free_CPFA, branch CPFA-2.0). On the foot-bot a robot
+    halted by its path stop behind the one ahead stands ~0.1 m short of its cell (the ring's reach,
+    0.27 m centre to centre, against 0.2 m cells): within 0.05 m it has not reached it, so the cell
+    behind it is not released to its follower until the robot ahead moves on."""
+
     brake_patience: float = 3.0
     """[s] a robot on the queue's lines (queued or leaving) that has been braked this long swerves
     round what blocks it, by its model's avoidance, for a second. Our addition, a deadlock breaker

@@ -514,12 +514,14 @@ def make_layout(
 
 def check_queue(scenario: Scenario) -> None:
     """The queue strategies' check (`swarm_controllers.queue.registration`; ValueError naming the
-    parameter): the searchers' give-up time and the brake patience are positive and the queue
-    layout fits the depot."""
+    parameter): the searchers' give-up time and the brake patience are positive, the entry reach
+    within half a cell, and the queue layout fits the depot."""
     q = QueueConfig.of(scenario)
     for key in ("seek_timeout", "brake_patience"):
         if not getattr(q, key) > 0:
             raise ValueError(f"controller.queue.{key}: must be positive")
+    if not 0 < q.entry_reach <= (q.lane_spacing if q.slot_pitch is None else q.slot_pitch) / 2:
+        raise ValueError("controller.queue.entry_reach: must be positive and at most half the slot pitch")
     try:
         geometry = DepotGeometryConfig.from_scenario(scenario)
         geometry.validate()

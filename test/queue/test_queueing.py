@@ -443,3 +443,28 @@ def load_footbot_qst(overrides):
     from swarm_sim.scenario import load_scenario
 
     return load_scenario("queue_qst", ["robots.model=footbot_cpfa", "robots.count=1", *overrides])
+
+
+@pytest.mark.parametrize("reach", [0.05, 0.1])
+def test_a_queued_robot_reaches_an_entry_cell_within_entry_reach_and_a_dock_within_the_slot_tolerance(reach):
+    """``controller.queue.entry_reach`` (the queue authors' 0.1 m waypoint threshold): 8 cm short
+    of its next entry-line cell a queued robot has reached it (reports it) with 0.1 and not with
+    0.05; 8 cm short of its dock it has not reached it either way (it must stand in the dock's zone)."""
+    from depot_manager.protocol import DepotReport, ReportKind
+
+    s = generic_scenario("queue_qmt", [f"controller.queue.entry_reach={reach}"])
+    empty = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
+    b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
+    dock_line, dock_cell = next(iter(sorted(b._docks)))
+    for line, cell, dock in (("entry_line_0", 2, False), (dock_line, dock_cell, True)):
+        b._phase, b._line, b._cell, b._grant = Phase.QUEUED, line, cell - 1, (line, cell)
+        (x1, y1), (x2, y2) = b._slots[line][cell - 1:cell + 1]
+        yaw = math.atan2(y2 - y1, x2 - x1)
+        pose = Pose2D(x2 - 0.08 * math.cos(yaw), y2 - 0.08 * math.sin(yaw), yaw)
+        sent = b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, empty, ForagingSense((), True))).messages
+        reached = any(isinstance(m, DepotReport) and m.kind is ReportKind.AT and m.cell == cell for m in sent)
+        assert reached == (reach == 0.1 and not dock)
+    from swarm_sim.scenario import ScenarioError
+
+    with pytest.raises(ScenarioError, match="controller.queue.entry_reach"):
+        generic_scenario("queue_qmt", ["controller.queue.entry_reach=0.11"])  # over half a 0.2 m cell
