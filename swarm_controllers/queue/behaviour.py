@@ -183,8 +183,8 @@ class QueueBehaviour:
         )
         self._exit_lines = {line.name for line in self._layout.exit_lines}
         self._entry_reach = {line: queue.entry_reach for line in self._entry_lines}
-        """How near a queued robot must come to a cell of a line to have reached it, for the lines
-        that differ from `SLOT_TOLERANCE` (`QueueConfig.entry_reach`; never for a dock)."""
+        """How near a queued robot must come to a cell of an entry line to have reached it
+        (`QueueConfig.entry_reach`); a dock's cell and the other lines': `SLOT_TOLERANCE`."""
         self._innermost = _innermost_arc(self._cells, self._entry_lines, self._center, self._lane) \
             if queue.boarding == "innermost" else None
         """``boarding: innermost``: the innermost arc's cells, as (line, cell index, x, y) arrays."""

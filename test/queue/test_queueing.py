@@ -420,7 +420,8 @@ def test_a_foot_bot_carriers_return_leg_ends_where_return_leg_says(leg):
     seek stops, once it has asked to join there; aimed just outside the perimeter (``rim``, the
     queue authors' ``CPFA_controller::Returning``) it ends there and the seek's own leg stops at
     the boundary. Poses integrated from the commands, nothing around."""
-    s = load_footbot_qst([f"controller.queue.return_leg={leg}"])
+    s = generic_scenario("queue_qst", ["robots.model=footbot_cpfa", "robots.count=1",
+                                       f"controller.queue.return_leg={leg}"])
     b = QueueBehaviour(s, "robot_0", np.random.default_rng(0))
     b._cpfa._carrying, b._cpfa._state = True, CpfaState.RETURNING
     x, y, yaw, dt = 3.0, 0.0, math.pi, s.sim.dt
@@ -439,18 +440,13 @@ def test_a_foot_bot_carriers_return_leg_ends_where_return_leg_says(leg):
         assert boundary - 0.05 < r_min < boundary + 0.1
 
 
-def load_footbot_qst(overrides):
-    from swarm_sim.scenario import load_scenario
-
-    return load_scenario("queue_qst", ["robots.model=footbot_cpfa", "robots.count=1", *overrides])
-
-
 @pytest.mark.parametrize("reach", [0.05, 0.1])
 def test_a_queued_robot_reaches_an_entry_cell_within_entry_reach_and_a_dock_within_the_slot_tolerance(reach):
     """``controller.queue.entry_reach`` (the queue authors' 0.1 m waypoint threshold): 8 cm short
     of its next entry-line cell a queued robot has reached it (reports it) with 0.1 and not with
     0.05; 8 cm short of its dock it has not reached it either way (it must stand in the dock's zone)."""
     from depot_manager.protocol import DepotReport, ReportKind
+    from swarm_sim.scenario import ScenarioError
 
     s = generic_scenario("queue_qmt", [f"controller.queue.entry_reach={reach}"])
     empty = np.full(s.sensors.scan.rays, np.inf, dtype=np.float32)
@@ -464,7 +460,5 @@ def test_a_queued_robot_reaches_an_entry_cell_within_entry_reach_and_a_dock_with
         sent = b.step(Observation("robot_0", 10**9, pose, 0.0, 0.0, empty, ForagingSense((), True))).messages
         reached = any(isinstance(m, DepotReport) and m.kind is ReportKind.AT and m.cell == cell for m in sent)
         assert reached == (reach == 0.1 and not dock)
-    from swarm_sim.scenario import ScenarioError
-
     with pytest.raises(ScenarioError, match="controller.queue.entry_reach"):
         generic_scenario("queue_qmt", ["controller.queue.entry_reach=0.11"])  # over half a 0.2 m cell
