@@ -79,6 +79,13 @@ QST_PITCH = Factor("slot_pitch_0.3", "the lines' cells 0.3 m apart (controller.q
                    "which the authors' robots stop behind one another by their proximity ring) instead of 0.2 m (the "
                    "lane spacing; the paper gives none)",
                    ("--robot-model", "authors", "--set", "controller.queue.slot_pitch=0.3"))
+QST_RETURN_RIM = Factor("return_leg_rim", "a carrier's blind return leg ends 0.1 m outside the perimeter "
+                        "(controller.queue.return_leg=rim: the authors' CPFA_controller::Returning, safeDistance = "
+                        "redCircleRadius + 0.1) instead of at the depot centre, across the lanes",
+                        ("--robot-model", "authors", "--set", "controller.queue.return_leg=rim"))
+QST_ENTRY_REACH = Factor("entry_reach_0.1", "an entry-line cell counts as reached within 0.1 m (controller.queue."
+                         "entry_reach: the authors' FollowingEntryPath waypoint threshold) instead of 0.05 m",
+                         ("--robot-model", "authors", "--set", "controller.queue.entry_reach=0.1"))
 
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
@@ -92,7 +99,7 @@ GROUPS = (
                 (BASELINE, MOTION_GENERIC, TURN, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
-                 QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH),
+                 QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
                 (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS), strategies=("queue_qse",)),
