@@ -49,7 +49,9 @@ _QST48_MOTION = Cause(MEASURED, "the foot-bot's stop-turn-go motion rule on our 
                                "with it everywhere (`motion_generic`); the authors' code run here, 37.6 %, moves its "
                                "foot-bots by the same rule, so it costs ours this only together with something else of "
                                "our queue, not isolated yet (its cells released on departure, boarding at the "
-                               "innermost arc, no give-up: none moved it; FACTORS.md, CAUSES.md)",
+                               "innermost arc, no give-up, the return leg ending at the rim, cells 0.3 m apart, a "
+                               "cell reached within 0.1 m: none closes it; never swerving, their path rule, halves "
+                               "ours; FACTORS.md, CAUSES.md)",
                       "qst48/queued_motion_continuous", 10)
 LINE_MOTION_STEPS: tuple[tuple[str, int, float, float, float], ...] = (
     ("queue_qse", 48, 13.1, 19.9, 17.7), ("queue_qse", 64, 11.6, 22.2, 18.3), ("queue_qse", 80, 9.5, 24.1, 16.3),
