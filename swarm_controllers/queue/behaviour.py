@@ -141,10 +141,9 @@ class QueueBehaviour:
         "_R", "_avoid", "_brake_range", "_braked_since", "_carrying", "_cell", "_cells",
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_entry_reach", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join",
-        "_keep_out", "_lane",
-        "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_patience", "_phase", "_query_at",
-        "_to_point", "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots", "_stamp_ns", "_tail",
-        "_yield_until", "rejections", "robot",
+        "_keep_out", "_lane", "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_patience",
+        "_phase", "_query_at", "_to_point", "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots",
+        "_stamp_ns", "_tail", "_yield_until", "rejections", "robot",
     )
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
@@ -182,7 +181,7 @@ class QueueBehaviour:
             [math.atan2(p[1] - self._center[1], p[0] - self._center[0]) for p in self._layout.entry_points]
         )
         self._exit_lines = {line.name for line in self._layout.exit_lines}
-        self._entry_reach = {line: queue.entry_reach for line in self._entry_lines}
+        self._entry_reach = queue.entry_reach
         """How near a queued robot must come to a cell of an entry line to have reached it
         (`QueueConfig.entry_reach`); a dock's cell and the other lines': `SLOT_TOLERANCE`."""
         self._innermost = _innermost_arc(self._cells, self._entry_lines, self._center, self._lane) \
@@ -485,7 +484,8 @@ class QueueBehaviour:
             return 0.0, 0.0
         line, cell = nxt
         tx, ty = self._slots[line][cell]
-        reach = SLOT_TOLERANCE if (line, cell) in self._docks else self._entry_reach.get(line, SLOT_TOLERANCE)
+        on_entry = line in self._entry_lines and (line, cell) not in self._docks
+        reach = self._entry_reach if on_entry else SLOT_TOLERANCE
         if math.hypot(tx - x, ty - y) <= reach:
             self._line, self._cell = line, cell
             out.append(DepotReport(obs.stamp_ns, self.robot, ReportKind.AT, line, cell))
