@@ -102,13 +102,13 @@ GROUPS = (
                  QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
-                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS), strategies=("queue_qse",)),
+                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qse",)),
     # Q_SE at 112 robots, where ours is furthest from the authors' code run here (21.4 %; ours 7.9 %).
     FactorGroup("qse112", ("queue", "--robots", "112", "--strategies", "queue_qse"), "queue/results.jsonl", "112",
-                (QSE_BASELINE, QST_QUEUED_CONTINUOUS), strategies=("queue_qse",)),
+                (QSE_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qse",)),
     # Q_ST at 112 robots (the authors' CPFA-2.0 run here: 34.8 %; ours 17.2 %): the motion step of qst48.
     FactorGroup("qst112", ("queue", "--robots", "112", "--strategies", "queue_qst"), "queue/results.jsonl", "112",
-                (QST_BASELINE, QST_QUEUED_CONTINUOUS), strategies=("queue_qst",)),
+                (QST_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qst",)),
     # The same step at the sizes between (Table II's other cells); for Q_SE, where it carries ours past
     # the authors' code, also the cells released on departure (their robots follow waypoints, no cells).
     *(FactorGroup(f"{label}{n}", ("queue", "--robots", str(n), "--strategies", strategy), "queue/results.jsonl",
