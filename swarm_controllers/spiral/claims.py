@@ -13,7 +13,7 @@ MDBSA-D's margin is not a two-sample test: its band (+100 … +200 %) is checked
 
 from __future__ import annotations
 
-from swarm_sim.compare.verdicts import CODE, LEVEL, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
+from swarm_sim.compare.verdicts import CODE, LEVEL, MEASURED, OPEN, PARTIAL, RELATION, TREND, Cause, Claim
 
 RES, COL, PCT = "resources_per_robot", "collision_time_per_robot_s", "resources_collected_pct"
 _C, _D = "MDBSA_{Centralized}", "MDBSA_{Distributed}"
@@ -28,12 +28,19 @@ _D_MARGIN_CODE = Cause(CODE, "the authors' code run here misses the paper's rang
 _D_COLLISION_CODE = Cause(CODE, "the authors' code run here misses it at 8 and 14 robots too (-59 / -61 %, past the "
                                 "paper's -58 %; 20 runs a cell), ours at 8 (-66 %); against their runs ours holds at "
                                 "8-20 robots and is direction only at 26-32 (-53 % where theirs is -25 … -27 %: our "
-                                "DDSA's collision time is twice theirs, see exp1.col.C>DDSA)", "reference/spiral", 20)
-_DDSA_COLLISION = Cause(OPEN, "our DDSA's collision time per robot is about twice the authors' run here (experiment "
-                              "1: 50 against 22 s; 2: 56-140 against 30-65 s; 3: 65-76 against 31-43 s) where our "
-                              "MDBSA's is within 20 % of theirs in experiment 1, so MDBSA's margins under DDSA are "
-                              "wider; what doubles DDSA's is not measured (their spirals start at the nest as ours "
-                              "now do; ARGoS's 2-D contacts, which push without a counted avoidance, are a candidate)")
+                                "DDSA's collision time is twice theirs, by our lane rule: exp1.col.C>DDSA)",
+                          "reference/spiral", 20)
+_LANE_RULE = ("our lane rule (a searcher yields to what is in its own lane ahead; this project's, not the authors'): "
+              "with it off (factor `lane_yield_off`, 10 seeds) our DDSA's collision time per robot is 27 s in "
+              "experiment 1 (on: 48; the authors' code here: 22) and 36 / 48 / 56 / 60 / 66 s at 8-32 robots in "
+              "experiment 2 (on: 56-140; theirs 30 / 45 / 57 / 61 / 65), while MDBSA's hardly moves; but with it off "
+              "our DDSA collects 11 % more than theirs in experiment 1 and 11-83 % more in experiment 2, so what "
+              "their DDSA loses without a lane rule is not isolated (CAUSES.md)")
+_DDSA_COLLISION = Cause(MEASURED, f"{_LANE_RULE}; with it off MDBSA-C's collision time is 87-210 % above DDSA's "
+                                  "(theirs 158-345 %)", "spiral1/lane_yield_off", 10)
+_DDSA_COLLISION_D = Cause(PARTIAL, f"{_LANE_RULE}; with it off MDBSA-D's margin is -7.5 / -51 % at 4 / 64 regions "
+                                   "(on: -63 / -63 %; theirs -28 / -10 %; the paper -33 %)",
+                          "spiral1/lane_yield_off", 10)
 _C_SURPLUS = Cause(OPEN, "our MDBSA-C collects more than the authors' run here (experiment 1, 64 regions: 61 against "
                          "56; experiment 3: 57-60 against 42-47, +21-37 %) where our DDSA is within 2 % (experiment 1) "
                          "and -2 … +15 % (experiment 3) of theirs, so its margin under DDSA is narrower; the cone, the "
@@ -75,7 +82,7 @@ def _claims() -> dict[int, tuple[Claim, ...]]:
               causes=(("*", _CEILING),), note=avg),
         Claim("exp1.col.D<DDSA.4,64", RELATION, "MDBSA-D spends about 33 % less time in collisions than DDSA "
               "(4, 64 regions)", "Sec. VI, Fig. 6", COL, "ddsa", (4, 64), b="mdbsa_d", sign=-1, size=-33.0,
-              causes=(("authors", _DDSA_COLLISION), *idle), note=col1),
+              causes=(("authors", _DDSA_COLLISION_D), *idle), note=col1),
         Claim("exp1.col.D<DDSA.16", RELATION, "MDBSA-D spends about 72 % less time in collisions than DDSA "
               "(16 regions)", "Sec. VI, Fig. 6", COL, "ddsa", (16,), b="mdbsa_d", sign=-1, size=-72.0,
               causes=idle, note=col1),

@@ -71,7 +71,7 @@ GROUPS = (
         Factor("motion_generic", "motion rule: today's generic robot, same body and speeds", ("--robot-model", "generic")),
         Factor("turn_2.29", "turn rate 2.29 rad/s (wheels at 16 cm/s) instead of 1.143",
                (*AUTHORS, "--set", "robots.platform.max_angular_speed=2.2857")),
-        CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES,
+        CONE, REGIONS, DDSA_TURN, START, *MDBSA_RULES, LANE_YIELD,
     ), baseline="baseline/exp1"),
     # Experiment 2 (8-32 robots, 16 regions), where MDBSA-C is to collect about 44 % less than DDSA.
     FactorGroup("spiral2", ("spiral", "--experiment", "2"), "spiral/exp2/results.jsonl", "all",
