@@ -44,7 +44,10 @@ _DDSA_COLLISION_D = Cause(PARTIAL, f"{_LANE_RULE}; with it off MDBSA-D's margin 
 _C_SURPLUS = Cause(OPEN, "our MDBSA-C collects more than the authors' run here (experiment 1, 64 regions: 61 against "
                          "56; experiment 3: 57-60 against 42-47, +21-37 %) where our DDSA is within 2 % (experiment 1) "
                          "and -2 … +15 % (experiment 3) of theirs, so its margin under DDSA is narrower; the cone, the "
-                         "region order and the partner radio are the authors' already; not measured")
+                         "region order and the partner radio are the authors' already. Traced in their code (6 seeds): "
+                         "their robots drive 23 m per delivery against our 15-18, the extra near the nest; their "
+                         "pickup rules, return to the find and start grid, switched on their side, move nothing; "
+                         "not isolated (CAUSES.md)")
 _IDLE = Cause(PARTIAL, "generic robot: idle partners never settle within the region centre's radius and push on "
                        "(20 seeds, traced at seed 0; not a one-factor sweep)")
 _GENERIC_CONE = Cause(OPEN, "generic robot: the cone changes only what it counts, its avoidance steers by "
