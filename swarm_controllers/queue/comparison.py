@@ -74,7 +74,8 @@ ALPHA = 0.05
 def with_minutes(rows: Sequence[dict]) -> list[dict]:
     """Rows with the collision times per robot in minutes added (`COLLISION_MIN`,
     `AUTHORS_COLLISION_MIN`), where they have them."""
-    pairs = (("collision_time_per_robot_s", COLLISION_MIN), ("authors_collision_time_per_robot_s", AUTHORS_COLLISION_MIN))
+    pairs = (("collision_time_per_robot_s", COLLISION_MIN),
+             ("authors_collision_time_per_robot_s", AUTHORS_COLLISION_MIN))
     return [{**r, **{m: r[s] / 60.0 for s, m in pairs if isinstance(r.get(s), (int, float))}} for r in rows]
 
 

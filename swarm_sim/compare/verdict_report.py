@@ -273,6 +273,12 @@ def _against(cv: CellVerdict | None) -> list[str]:
     return [mean, f"{cv.effect:+.1f} % [{cv.ci[0]:+.1f}, {cv.ci[1]:+.1f}]: {_verdict(cv)}"]
 
 
+def _theirs(per: Mapping, models: list[str], claim_id: str) -> Verdict | None:
+    """The authors' code's runs judged against the paper on one relation or trend (`Judged.relations`),
+    None where they were not run or do not cover it."""
+    return next((per[m].relations[claim_id][0] for m in models if m in per and claim_id in per[m].relations), None)
+
+
 def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> list[str]:
     intro = ("Each cell: B against A in % of A [95 % bootstrap interval], the Holm-corrected p, the cell's verdict; "
              "a trend's cell is its first → last.")
@@ -299,8 +305,7 @@ def _relations(papers: Mapping, models: list[str], title: Mapping[str, str]) -> 
             who = f"{c.b} vs {c.a}" if c.b else c.a
             row = [f"`{c.id}`: {c.text} ({who})", c.where, c.kind, c.paper_text()]
             if ref:
-                theirs = next((per[m].relations[c.id][0] for m in models if m in per and c.id in per[m].relations),
-                              None)
+                theirs = _theirs(per, models, c.id)
                 counted = f"(their count, `{c.code_measure}`) " if c.code_measure else ""
                 row.append(counted + _cells(theirs) if theirs else "—")
             for m in models:
@@ -347,8 +352,8 @@ def _causes(papers: Mapping, models: list[str], title: Mapping[str, str]) -> lis
             if not failing:
                 continue
             causes = {m: v.claim.cause(m) for m in failing}
-            theirs = next((per[m].relations[v.claim.id][0].verdict for m in models
-                           if m in per and v.claim.id in per[m].relations), "—")
+            judged_theirs = _theirs(per, models, v.claim.id)
+            theirs = judged_theirs.verdict if judged_theirs else "—"
             if any(c is not None and c.grade == CODE for c in causes.values()) and theirs == HOLDS:
                 raise ValueError(f"{name}: claim {v.claim.id}: its cause says the authors' code misses it too, "
                                  f"but their runs' verdict is {theirs}")
