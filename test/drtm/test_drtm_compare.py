@@ -116,3 +116,43 @@ def test_a_relations_cause_is_graded_by_how_much_of_the_gap_its_factor_closes(mo
         monkeypatch.setitem(claims.RELATION_STEPS, ("oae_total", "body_0.07"), steps)
         cause = claims._step_cause("oae_total", "body_0.07", (0, 1), paper)
         assert cause.grade == grade and cause.seeds == 10 and "drtm31,drtm41/body_0.07" == cause.factor
+
+
+def test_the_level_steps_are_the_committed_factor_runs():
+    """`LEVEL_STEPS` lists exactly the factors whose runs (results/factors, committed) close at least
+    half of a level cell's gap, with their means: a rerun or an edit that moves one shows here."""
+    import json
+    from collections import defaultdict
+    from pathlib import Path
+
+    from swarm_controllers.drtm import claims
+
+    root = Path(__file__).resolve().parents[2] / "results" / "factors"
+
+    def means(group: str, factor: str) -> dict:
+        runs = defaultdict(list)
+        for line in (root / group / factor / "results.jsonl").read_text().splitlines():
+            row = json.loads(line)
+            if row["seed"] < 10:
+                runs[(row["cell"], row["strategy"])].append(row)
+        return {k: {m: scale * float(np.mean([r[m] for r in rows])) for m, (_, _, scale) in claims.DRTM_METRICS.items()}
+                for k, rows in runs.items()}
+
+    found = {}
+    for cell, c in enumerate(claims.DRTM_CONDITIONS):
+        group = claims._GROUPS[cell]
+        base = means(group, "baseline")
+        factors = {d.name: means(group, d.name) for d in (root / group).iterdir()
+                   if d.is_dir() and d.name != "baseline"}
+        for model in claims.DRTM_STRATEGIES:
+            for metric in claims.DRTM_METRICS:
+                paper, b = claims.PAPER[c.section][model][metric], base[(cell, model)][metric]
+                closing = {f: m[(cell, model)][metric] for f, m in factors.items()
+                           if (cell, model) in m and abs(m[(cell, model)][metric] - paper) <= abs(b - paper) / 2}
+                if closing:
+                    found[(cell, model, metric)] = (b, closing)
+    assert set(found) == set(claims.LEVEL_STEPS)
+    for key, (b, closing) in found.items():
+        stored_base, stored = claims.LEVEL_STEPS[key]
+        assert abs(stored_base - b) < 0.01 and set(dict(stored)) == set(closing), key
+        assert all(abs(v - closing[f]) < 0.01 for f, v in stored), key
