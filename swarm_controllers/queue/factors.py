@@ -1,6 +1,7 @@
 """The queue paper's factor groups (`swarm_sim.factor_sweeps`, run by ``scripts/factors``): at 48
 and at 112 robots, the authors' robot against one factor changed at a time."""
 
+from swarm_controllers.queue.claims import QUEUE_SIZES
 from swarm_sim.factor_sweeps import Factor, FactorGroup
 
 # footbot_cpfa and the generic queue robot share body (0.17 m), speed (0.16 m/s) and turn rate
@@ -109,13 +110,14 @@ GROUPS = (
     # Q_ST at 112 robots (the authors' CPFA-2.0 run here: 34.8 %; ours 17.2 %): the motion step of qst48.
     FactorGroup("qst112", ("queue", "--robots", "112", "--strategies", "queue_qst"), "queue/results.jsonl", "112",
                 (QST_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qst",)),
-    # Q_ME and Q_MT at both ends of Table II (no code of the authors has them, so the gap is to the paper): the
-    # motion steps of qst48 at 10 seeds, where queue48 / queue112 had the whole motion rule at 2.
+    # Q_ME and Q_MT (no code of the authors has them, so the gap is to the paper): the motion steps of qst48 at
+    # 10 seeds, where queue48 / queue112 had the whole motion rule at 2; the lines' motion alone at both ends only.
     *(FactorGroup(f"{label}{n}", ("queue", "--robots", str(n), "--strategies", strategy), "queue/results.jsonl",
                   str(n), (Factor("baseline", f"the shipped {name} on the authors' robot (footbot_cpfa: {strategy}.yaml)",
-                                  ("--robot-model", "authors")), QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS),
+                                  ("--robot-model", "authors")), QST_MOTION_GENERIC,
+                           *((QST_QUEUED_CONTINUOUS,) if n in (48, 112) else ())),
                   strategies=(strategy,))
-      for n in (48, 112)
+      for n in QUEUE_SIZES
       for label, strategy, name in (("qme", "queue_qme", "Q_ME"), ("qmt", "queue_qmt", "Q_MT"))),
     # The same step at the sizes between (Table II's other cells); for Q_SE, where it carries ours past
     # the authors' code, also the cells released on departure (their robots follow waypoints, no cells).
