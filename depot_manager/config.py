@@ -58,6 +58,16 @@ class QueueConfig(Section):
     paper's nor the authors' (their foot-bots run stop-turn-go on the path too): it tells how much
     of the motion rule's cost falls on the queue rather than on foraging."""
 
+    line_stop: Literal["model", "brake", "ring"] = "model"
+    """What halts a robot on the queue's lines (queued or leaving) for what is ahead of it:
+    ``model``, its robot model's path rule where it has one (the foot-bot's: the queue authors'
+    ``CPFA_controller::CollisionDetection``, a ``Stop()`` for any proximity reading within +-30 deg of
+    the heading, `swarm_controllers.queue.behaviour.PATH_CONE`), else our brake (the scan within
+    `BRAKE_RANGE` of the front, `BRAKE_CONE`); ``brake``, our brake on every model; ``ring``, the
+    authors' rule on every model, read from its scan as a proximity ring. A diagnostic beside
+    `queued_motion`: together they split the cost of the motion on the lines into the steering and
+    the stop rule."""
+
     cell_release: Literal["arrival", "departure"] = "arrival"
     """When a robot's cell on an entry line may be granted to the robot behind it: on its
     ``arrival`` at its next cell (the depot manager's cells are never shared), or on its

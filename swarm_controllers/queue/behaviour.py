@@ -64,6 +64,7 @@ from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
 from swarm_controllers.motion import ContinuousDrive, drive_for
+from swarm_controllers.robots.ring import RingSensor
 from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
 from swarm_sim.messaging import per_inbox
@@ -95,6 +96,23 @@ Collision_Free_CPFA, ``CPFA_controller::CollisionDetection``)."""
 SWERVE_TIME = 1.0
 """[s] how long a robot whose brake patience ran out (`QueueConfig.brake_patience`) swerves before
 it tries its line again."""
+
+
+def _no_path_rule(ranges: np.ndarray, cone: float) -> None:
+    """``line_stop: brake``: no path rule, our brake decides."""
+    return None
+
+
+def _ring_stop(scenario: Scenario, drive):
+    """``line_stop: ring``: the drive's own path rule, and where it has none the authors' (a ``Stop()``
+    for the proximity ring's readings within the cone), read from the scan."""
+    blocks = RingSensor(scenario).blocks
+
+    def stop(ranges: np.ndarray, cone: float) -> bool:
+        own = drive.path_stop(ranges, cone)
+        return blocks(ranges, cone) if own is None else own
+
+    return stop
 
 
 class Phase(Enum):
@@ -142,8 +160,8 @@ class QueueBehaviour:
         "_center", "_cpfa", "_cpfa_step", "_docks", "_entry", "_entry_angles", "_entry_lines",
         "_detour_far", "_drive", "_entry_reach", "_exit_lines", "_front", "_gamma", "_goal", "_grant", "_join",
         "_keep_out", "_lane", "_last", "_layout", "_leave_to", "_line", "_line_drive", "_line_to_point", "_patience",
-        "_phase", "_query_at", "_to_point", "_retry_at", "_rng", "_innermost", "_seek_time", "_seek_until", "_slots",
-        "_stamp_ns", "_tail", "_yield_until", "rejections", "robot",
+        "_path_stop", "_phase", "_query_at", "_to_point", "_retry_at", "_rng", "_innermost", "_seek_time",
+        "_seek_until", "_slots", "_stamp_ns", "_tail", "_yield_until", "rejections", "robot",
     )
 
     def __init__(self, scenario: Scenario, robot: RobotId, rng: np.random.Generator) -> None:
@@ -158,6 +176,10 @@ class QueueBehaviour:
         self._line_drive = ContinuousDrive(scenario) if queue.queued_motion == "continuous" else self._drive
         """How the robot drives along the queue's lines (`QueueConfig.queued_motion`)."""
         self._line_to_point = self._line_drive.to_point
+        self._path_stop = (_no_path_rule if queue.line_stop == "brake" else
+                           _ring_stop(scenario, self._line_drive) if queue.line_stop == "ring"
+                           else self._line_drive.path_stop)
+        """The stop rule on the lines (`QueueConfig.line_stop`): True stopped, False not, None: brake."""
         self._center = (float(depot.center[0]), float(depot.center[1]))
         self._R = DockingConfig.of(scenario).perimeter_radius
         self._lane = queue.lane_spacing
@@ -273,7 +295,7 @@ class QueueBehaviour:
                 linear, angular = override.linear, override.angular
             if obs.t - self._braked_since >= self._patience + SWERVE_TIME:
                 self._braked_since = math.inf  # swerved for a second: try the line again
-        elif (phase is _QUEUED or phase is _LEAVING) and self._line_drive.path_stop(obs.ranges, PATH_CONE):
+        elif (phase is _QUEUED or phase is _LEAVING) and self._path_stop(obs.ranges, PATH_CONE):
             linear = angular = 0.0  # the robot model's own rule on a path (the authors' foot-bot: Stop())
             self._braked_since = min(self._braked_since, obs.t)
         elif linear > 0.0 and min(obs.ranges[self._front].tolist()) < self._brake_range:

@@ -87,6 +87,16 @@ QST_RETURN_RIM = Factor("return_leg_rim", "a carrier's blind return leg ends 0.1
 QST_ENTRY_REACH = Factor("entry_reach_0.1", "an entry-line cell counts as reached within 0.1 m (controller.queue."
                          "entry_reach: the authors' FollowingEntryPath waypoint threshold) instead of 0.05 m",
                          ("--robot-model", "authors", "--set", "controller.queue.entry_reach=0.1"))
+# The motion lead split in two (2026-11-29): the steering on the lines and the rule that halts a robot there.
+QST_LINE_BRAKE = Factor("line_stop_brake", "stop-turn-go on the lines with our brake (the scan within 0.08 m ahead, "
+                        "+-25 deg) instead of the authors' path stop (any ring reading within +-30 deg; "
+                        "controller.queue.line_stop=brake; a diagnostic)",
+                        ("--robot-model", "authors", "--set", "controller.queue.line_stop=brake"))
+QST_CONTINUOUS_RING = Factor("continuous_ring_stop", "the generic robot's continuous steering on the lines with the "
+                             "authors' path stop kept (controller.queue.queued_motion=continuous, "
+                             "controller.queue.line_stop=ring; a diagnostic)",
+                             ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous",
+                              "--set", "controller.queue.line_stop=ring"))
 
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
@@ -100,7 +110,8 @@ GROUPS = (
                 (BASELINE, MOTION_GENERIC, TURN, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
-                 QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH),
+                 QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH, QST_LINE_BRAKE,
+                 QST_CONTINUOUS_RING),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
                 (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qse",)),

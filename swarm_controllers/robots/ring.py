@@ -49,3 +49,10 @@ class RingSensor:
                 x += value * cos[i]
                 y += value * sin[i]
         return x, y
+
+    def blocks(self, ranges: np.ndarray | Sequence[float], cone: float) -> bool:
+        """The readings' vector is non-zero and within `cone` [deg] of the heading: the queue
+        authors' path stop (``CPFA_controller::CollisionDetection``, ``GoStraightAngleRangeInDegreesInRegion``)."""
+        x, y = self.vector(ranges)
+        norm = math.hypot(x, y)
+        return norm > 0.0 and x >= math.cos(math.radians(cone)) * norm

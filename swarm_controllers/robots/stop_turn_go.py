@@ -155,9 +155,7 @@ class StopTurnGo:
     def path_stop(self, ranges: np.ndarray, cone: float) -> bool:
         """The queue authors' rule on a path: something within `cone` [deg] of the heading stops the
         robot and drops the move under way (``Stop()``); call it after the tick's motion was asked."""
-        x, y = self._ring.vector(ranges)
-        norm = hypot(x, y)
-        if not (norm > 0.0 and x >= math.cos(math.radians(cone)) * norm):
+        if not self._ring.blocks(ranges, cone):
             return False
         self._next = (_EMPTY, max(self._state[1] - self._dt, 0.0), False)
         return True

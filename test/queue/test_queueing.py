@@ -462,3 +462,25 @@ def test_a_queued_robot_reaches_an_entry_cell_within_entry_reach_and_a_dock_with
         assert reached == (reach == 0.1 and not dock)
     with pytest.raises(ScenarioError, match="controller.queue.entry_reach"):
         generic_scenario("queue_qmt", ["controller.queue.entry_reach=0.11"])  # over half a 0.2 m cell
+
+
+@pytest.mark.parametrize("motion", ["model", "continuous"])
+def test_line_stop_chooses_the_rule_that_halts_a_robot_on_the_lines(motion):
+    """``controller.queue.line_stop`` (a diagnostic): ``model`` is the line drive's own path rule (the
+    foot-bot's stop-turn-go: the authors' ring cone; continuous steering: none, so our brake);
+    ``brake`` is never a path rule; ``ring`` is the authors' cone on either drive. A robot 0.22 m
+    dead ahead (centre to centre; the scan reads its near side) is within the ring's reach; one
+    abeam is outside the cone."""
+    from swarm_controllers.avoidance import ray_angles
+    from swarm_sim.registry import make_behaviour
+
+    for stop, want in (("model", True if motion == "model" else None), ("brake", None), ("ring", True)):
+        s = generic_scenario("queue_qst", ["robots.count=2", "robots.model=footbot_cpfa",
+                                           f"controller.queue.queued_motion={motion}",
+                                           f"controller.queue.line_stop={stop}"])
+        b = make_behaviour(s, "robot_0", np.random.default_rng(0))
+        angles = np.asarray(ray_angles(s.sensors.scan))
+        for bearing, hit in ((0.0, want), (math.pi / 2, None if want is None else False)):
+            ranges = np.full(len(angles), np.inf, dtype=np.float32)
+            ranges[int(np.argmin(np.abs(np.angle(np.exp(1j * (angles - bearing))))))] = 0.22 - 0.085  # its near side
+            assert b._path_stop(ranges, 30.0) == hit, (stop, bearing)
