@@ -17,7 +17,7 @@ REPO = Path(__file__).resolve().parents[1]
 def test_each_paper_declares_its_groups_in_its_own_package():
     found = groups()
     assert set(found) == {"queue48", "queue112", "qst48", "qse48", "qse112", "qst112", "qse64", "qst64", "qse80",
-                          "qst80", "qse96", "qst96", *(f"q{s}{n}" for s in ("me", "mt") for n in (48, 64, 80, 96, 112)), "drtm31", "drtm41",
+                          "qst80", "qse96", "qst96", *(f"q{s}{n}" for s in ("me", "mt") for n in (48, 64, 80, 96, 112)), "cpfa48", "drtm31", "drtm41",
                           "drtm43", "spiral1", "spiral2", "caging", "cagingplan", "cagingdistance"}
     for group in found.values():
         names = [f.name for f in group.factors]

@@ -32,7 +32,8 @@ Rules, in the paper's words, and how they are realised here:
   find): the world picks a resource up when an empty robot reaches it; on the tick
   `obs.sensed.carrying` turns True the robot records the site (its own position) and
   c = len(obs.sensed.resources), the *other* resources within the detection radius (the carried one
-  no longer lies on the floor). ARGoS counts the found one as well (its density starts at 1).
+  no longer lies on the floor); ARGoS counts the found one as well (its density starts at 1:
+  `CpfaConfig.density_counts_find`).
   No survey pause: sensing the neighbourhood is instantaneous here (later ARGoS versions
   disable their 4 s survey wait too). Then RETURNING.
 * **Return to nest**: straight for the depot centre. The world drops the resource when the
@@ -195,8 +196,8 @@ class CpfaBehaviour:
         "_heading", "_hold", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
         "_leg_x", "_leg_y", "_mode", "_nest", "_nest_r2", "_omega", "_to_point",
         "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
-        "_rim", "_rim_carriers", "_search_in_steps", "_search_legs", "_search_step", "_search_t0", "_site",
-        "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
+        "_count_find", "_rim", "_rim_carriers", "_search_in_steps", "_search_legs", "_search_step", "_search_t0",
+        "_site", "_site_clearance2", "_site_count", "_stamp_ns", "_state", "_step2", "_target",
         "_threshold", "_trips", "_update_avoidance", "robot",
     )
 
@@ -275,6 +276,7 @@ class CpfaBehaviour:
         self._search_legs = 0
         """Walk legs drawn since the current search began."""
         self._search_in_steps = cfg.informed_search_time == "steps"
+        self._count_find = int(cfg.density_counts_find)
         self._site: tuple[float, float] | None = None
         """Where the last resource was found, until used for site fidelity or given up."""
         self._site_count = 0
@@ -479,7 +481,7 @@ class CpfaBehaviour:
         # Plain floats: the site travels in a PheromoneMessage, whose repr orders the mailbox;
         # a numpy scalar would print differently from the float a graph receiver decodes.
         self._site = (float(obs.pose.x), float(obs.pose.y))
-        self._site_count = len(obs.sensed.resources)
+        self._site_count = len(obs.sensed.resources) + self._count_find
         self._state = CpfaState.RETURNING
 
     def _at_nest(self, obs: Observation, delivered: bool) -> tuple[object, ...]:

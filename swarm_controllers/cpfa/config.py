@@ -82,6 +82,14 @@ class CpfaConfig(Section):
     began (CPFA-ROS), or walk steps taken since (the ARGoS CPFA: ``SearchTime++`` per step,
     ``CPFA_controller::Searching``; the queue paper's authors' code)."""
 
+    density_counts_find: bool = False
+    """Whether the local resource density c at a find counts the resource just picked up (c = 1 +
+    the others in reach), as the ARGoS CPFA does (``CPFA_controller::SetLocalResourceDensity``:
+    ``ResourceDensity = 1``, then one per food within ``sqrt(2 x SearchRadiusSquared)`` = sqrt(2) x 4
+    x ``FoodRadius`` of the robot: 0.283 m in the queue authors' experiment, where the reach is
+    ``sensors.resource_detection_radius``), or the others only (H&M's c: the resources seen near
+    the find). It sets the chances of laying pheromone and of site fidelity, POIS(c, lambda)."""
+
     SECTION: ClassVar[str] = "cpfa"
 
     def __post_init__(self) -> None:

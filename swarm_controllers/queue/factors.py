@@ -98,6 +98,21 @@ QST_CONTINUOUS_RING = Factor("continuous_ring_stop", "the generic robot's contin
                              ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous",
                               "--set", "controller.queue.line_stop=ring"))
 
+# The CPFA's local resource density as the authors' code counts it (2026-11-29): a trace of their Q_ST
+# (CPFA-2.0, 48 robots) has 95 % of their deliveries go back to the find's site (ResourceDensity 1 + the food
+# within sqrt(2) x 4 x FoodRadius = 0.283 m, median 4 at a pickup, so POIS(c, 1.376) ~ 0.96), ours 24 % (c = the
+# others within the 0.13 m detection radius: 0 at 92 of 98 pickups).
+DENSITY_ARGS = ("--set", "sensors.resource_detection_radius=0.2828",
+                "--set", "controller.cpfa.density_counts_find=true")
+DENSITY = Factor("density_authors", "the CPFA's local resource density counted as the authors' code does: 1 + the "
+                 "food within 0.283 m of the find (CPFA_controller::SetLocalResourceDensity; sensors."
+                 "resource_detection_radius=0.2828, controller.cpfa.density_counts_find=true) instead of the other "
+                 "food within the 0.13 m detection radius", ("--robot-model", "authors", *DENSITY_ARGS))
+DENSITY_LINES = Factor("density_authors_lines_continuous", "the authors' density count (density_authors) and the "
+                       "generic robot's continuous steering and brake on the queue's lines (queued_motion_continuous) "
+                       "together", ("--robot-model", "authors", *DENSITY_ARGS, "--set",
+                                    "controller.queue.queued_motion=continuous"))
+
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
                       ("--robot-model", "authors"))
@@ -108,25 +123,33 @@ GROUPS = (
     # At 112 robots, where the strategies' order is the paper's headline.
     FactorGroup("queue112", ("queue", "--robots", "112"), "queue/results.jsonl", "112",
                 (BASELINE, MOTION_GENERIC, TURN, CPFA_DOCKS_03, QST_JOIN, QST_NO_GIVE_UP)),
+    # The CPFA baseline at 48 robots (10 seeds; queue48 has it at 2).
+    FactorGroup("cpfa48", ("queue", "--robots", "48", "--strategies", "queue_cpfa"), "queue/results.jsonl", "48",
+                (Factor("baseline", "the shipped CPFA on the authors' robot (footbot_cpfa: queue_cpfa.yaml)",
+                        ("--robot-model", "authors")), DENSITY), strategies=("queue_cpfa",)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
                  QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH, QST_LINE_BRAKE,
-                 QST_CONTINUOUS_RING),
+                 QST_CONTINUOUS_RING, DENSITY, DENSITY_LINES),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
-                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qse",)),
+                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES),
+                strategies=("queue_qse",)),
     # Q_SE at 112 robots, where ours is furthest from the authors' code run here (21.4 %; ours 7.9 %).
     FactorGroup("qse112", ("queue", "--robots", "112", "--strategies", "queue_qse"), "queue/results.jsonl", "112",
-                (QSE_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qse",)),
+                (QSE_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES),
+                strategies=("queue_qse",)),
     # Q_ST at 112 robots (the authors' CPFA-2.0 run here: 34.8 %; ours 17.2 %): the motion step of qst48.
     FactorGroup("qst112", ("queue", "--robots", "112", "--strategies", "queue_qst"), "queue/results.jsonl", "112",
-                (QST_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM), strategies=("queue_qst",)),
+                (QST_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES),
+                strategies=("queue_qst",)),
     # Q_ME and Q_MT (no code of the authors has them, so the gap is to the paper): the motion steps of qst48 at
     # 10 seeds, where queue48 / queue112 had the whole motion rule at 2; the lines' motion alone at both ends only.
     *(FactorGroup(f"{label}{n}", ("queue", "--robots", str(n), "--strategies", strategy), "queue/results.jsonl",
-                  str(n), (Factor("baseline", f"the shipped {name} on the authors' robot (footbot_cpfa: {strategy}.yaml)",
-                                  ("--robot-model", "authors")), QST_MOTION_GENERIC,
-                           *((QST_QUEUED_CONTINUOUS,) if n in (48, 112) else ())),
+                  str(n), (Factor("baseline", f"the shipped {name} on the authors' robot (footbot_cpfa: "
+                                          f"{strategy}.yaml)", ("--robot-model", "authors")), QST_MOTION_GENERIC,
+                           *((QST_QUEUED_CONTINUOUS,) if n in (48, 112) else ()),
+                           *((DENSITY,) if n == 48 else ())),
                   strategies=(strategy,))
       for n in QUEUE_SIZES
       for label, strategy, name in (("qme", "queue_qme", "Q_ME"), ("qmt", "queue_qmt", "Q_MT"))),

@@ -342,6 +342,16 @@ def test_returns_when_carrying_and_records_the_site():
     assert cmd.linear == pytest.approx(MAX_V) and abs(cmd.angular) < 1e-9
 
 
+def test_the_density_counts_the_find_as_argos_does_when_asked():
+    """``density_counts_find``: c = 1 + the others in reach (ARGoS's ResourceDensity), so a lone find
+    still gives site fidelity a chance of POIS(1, lambda_sf) rather than POIS(0, lambda_sf)."""
+    for counts, want in ((False, 3), (True, 4)):
+        b = behaviour(scenario(probability_of_switching_to_searching=1.0, density_counts_find=counts))
+        b.step(obs(0, 3.0, 2.0))
+        b.step(obs(1, 3.0, 2.0, 0.0, carrying=True, resources=((3.1, 2.0), (3.0, 2.1), (2.9, 2.0))))
+        assert b.site_count == want
+
+
 def test_a_find_while_travelling_also_sends_it_home():
     b = behaviour(scenario(probability_of_switching_to_searching=0.0))
     b.step(obs(0, 1.0, 1.0, carrying=True))
