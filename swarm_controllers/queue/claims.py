@@ -82,8 +82,14 @@ def _line_motion(s: str, n: int, base: float, cont: float, ref: float) -> Cause:
 _LINE_MOTION = {(s, n): _line_motion(s, n, *values) for s, n, *values in LINE_MOTION_STEPS}
 WHOLE_MOTION_STEPS: tuple[tuple[str, int, float, tuple[tuple[str, float], ...]], ...] = (
     ("queue_qme", 48, 33.28, (("motion_generic", 50.34), ("queued_motion_continuous", 36.31))),
+    ("queue_qme", 64, 40.94, (("motion_generic", 62.69),)),
+    ("queue_qme", 80, 45.75, (("motion_generic", 74.25),)),
+    ("queue_qme", 96, 44.25, (("motion_generic", 81.72),)),
     ("queue_qme", 112, 44.75, (("motion_generic", 84.16), ("queued_motion_continuous", 54.72))),
     ("queue_qmt", 48, 40.09, (("motion_generic", 60.81), ("queued_motion_continuous", 52.16))),
+    ("queue_qmt", 64, 47.34, (("motion_generic", 75.5),)),
+    ("queue_qmt", 80, 47.31, (("motion_generic", 85.69),)),
+    ("queue_qmt", 96, 51.38, (("motion_generic", 90.09),)),
     ("queue_qmt", 112, 55.34, (("motion_generic", 88.19), ("queued_motion_continuous", 78.25))),
 )
 """Q_ME and Q_MT, which no code of the authors has, against the paper (groups ``qme<n>`` / ``qmt<n>``,
