@@ -28,6 +28,8 @@ Rules, in the paper's words, and how they are realised here:
   [s]. Searches at a remembered site (site fidelity) or at a pheromone waypoint are informed:
   they start almost undirected and relax to the uninformed walk. ARGoS counts t in search
   steps, CPFA-ROS in seconds (`CpfaConfig.informed_search_time` chooses; seconds by default).
+  The ARGoS CPFA turns by w + (2 pi - w) exp(-lambda_id t) itself, w ~ N(0, omega), a loop about
+  the site rather than a random walk (`CpfaConfig.informed_walk`: ``turn``).
 * **Find resource, sense local density** (H&M Algorithm 1: count the resources c near the
   find): the world picks a resource up when an empty robot reaches it; on the tick
   `obs.sensed.carrying` turns True the robot records the site (its own position) and
@@ -193,7 +195,7 @@ class CpfaBehaviour:
     # robots within noise; issue 14).
     __slots__ = (
         "_arrival2", "_avoidance", "_blocked2", "_bound", "_carrying", "_dock_r2", "_docks", "_drive",
-        "_heading", "_hold", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
+        "_heading", "_hold", "_informed_turn", "_keep_out2", "_lambda_id", "_lambda_lp", "_lambda_pd", "_lambda_sf",
         "_leg_x", "_leg_y", "_mode", "_nest", "_nest_r2", "_omega", "_to_point",
         "_own_unechoed", "_p_return", "_p_switch", "_pheromones", "_random", "_rng",
         "_count_find", "_rim", "_rim_carriers", "_search_in_steps", "_search_legs", "_search_step", "_search_t0",
@@ -277,6 +279,7 @@ class CpfaBehaviour:
         """Walk legs drawn since the current search began."""
         self._search_in_steps = cfg.informed_search_time == "steps"
         self._count_find = int(cfg.density_counts_find)
+        self._informed_turn = cfg.informed_walk == "turn"
         self._site: tuple[float, float] | None = None
         """Where the last resource was found, until used for site fidelity or given up."""
         self._site_count = 0
@@ -426,16 +429,21 @@ class CpfaBehaviour:
         """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
         pose = obs.pose
         x, y, yaw = pose.x, pose.y, pose.yaw
+        turn = None
         if self._mode is _UNINFORMED:
             sigma = self._omega
         else:
             t = self._search_legs if self._search_in_steps else obs.t - self._search_t0
-            sigma = informed_search_sigma(self._omega, self._lambda_id, t)
+            if self._informed_turn:
+                sigma, turn = self._omega, math.exp(-self._lambda_id * t)
+            else:
+                sigma = informed_search_sigma(self._omega, self._lambda_id, t)
         self._search_legs += 1
         step, bound = self._search_step, self._bound
         normal = self._rng.normal
         for _ in range(_LEG_REDRAWS):
-            heading = yaw + normal(0.0, sigma)
+            w = normal(0.0, sigma)
+            heading = yaw + (w if turn is None else remainder(w + (_TWO_PI - w) * turn, _TWO_PI))
             end_x = x + step * math.cos(heading)
             end_y = y + step * math.sin(heading)
             nx, ny = self._nest

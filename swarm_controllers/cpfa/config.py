@@ -82,6 +82,13 @@ class CpfaConfig(Section):
     began (CPFA-ROS), or walk steps taken since (the ARGoS CPFA: ``SearchTime++`` per step,
     ``CPFA_controller::Searching``; the queue paper's authors' code)."""
 
+    informed_walk: Literal["sigma", "turn"] = "sigma"
+    """How an informed search turns at each step: ``sigma``, by a draw of N(0, sigma) with sigma =
+    omega + (4 pi - omega) exp(-lambda_id t) (H&M's informed-walk equation: a wide random walk
+    relaxing to the uninformed one); ``turn``, as the ARGoS CPFA does (``CPFA_controller::Searching``
+    and ``GetExponentialDecay``, Tameem786/Collision_Free_CPFA): by w + (2 pi - w) exp(-lambda_id t)
+    wrapped to [-pi, pi], w a draw of N(0, omega), so the turn is nearly fixed, none at the first
+    step, then about -1.8, pi, 2.2, 1.6 ... rad: a loop about the site that opens as t grows."""
     density_counts_find: bool = False
     """Whether the local resource density c at a find counts the resource just picked up (c = 1 +
     the others in reach), as the ARGoS CPFA does (``CPFA_controller::SetLocalResourceDensity``:

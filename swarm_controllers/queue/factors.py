@@ -112,6 +112,14 @@ DENSITY_LINES = Factor("density_authors_lines_continuous", "the authors' density
                        "generic robot's continuous steering and brake on the queue's lines (queued_motion_continuous) "
                        "together", ("--robot-model", "authors", *DENSITY_ARGS, "--set",
                                     "controller.queue.queued_motion=continuous"))
+# The informed search as the authors' code turns it, with their density count: the CPFA as their code runs it.
+CPFA_ARGS = (*DENSITY_ARGS, "--set", "controller.cpfa.informed_walk=turn")
+CPFA_CODE = Factor("cpfa_authors", "the CPFA's density count (density_authors) and its informed search turning as the "
+                   "authors' code does (controller.cpfa.informed_walk=turn: CPFA_controller::Searching, "
+                   "GetExponentialDecay) instead of H&M's N(0, sigma(t))", ("--robot-model", "authors", *CPFA_ARGS))
+CPFA_CODE_LINES = Factor("cpfa_authors_lines_continuous", "the CPFA as the authors' code runs it (cpfa_authors) and "
+                         "the generic robot's continuous steering and brake on the queue's lines together",
+                         ("--robot-model", "authors", *CPFA_ARGS, "--set", "controller.queue.queued_motion=continuous"))
 
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
@@ -126,15 +134,15 @@ GROUPS = (
     # The CPFA baseline at 48 robots (10 seeds; queue48 has it at 2).
     FactorGroup("cpfa48", ("queue", "--robots", "48", "--strategies", "queue_cpfa"), "queue/results.jsonl", "48",
                 (Factor("baseline", "the shipped CPFA on the authors' robot (footbot_cpfa: queue_cpfa.yaml)",
-                        ("--robot-model", "authors")), DENSITY), strategies=("queue_cpfa",)),
+                        ("--robot-model", "authors")), DENSITY, CPFA_CODE), strategies=("queue_cpfa",)),
     FactorGroup("qst48", ("queue", "--robots", "48", "--strategies", "queue_qst"), "queue/results.jsonl", "48",
                 (QST_BASELINE, QST_MOTION_GENERIC, QST_NO_GIVE_UP, QST_DEPARTURE, QST_INNERMOST,
                  QST_QUEUED_CONTINUOUS, QST_NEVER_SWERVE, QST_PITCH, QST_RETURN_RIM, QST_ENTRY_REACH, QST_LINE_BRAKE,
-                 QST_CONTINUOUS_RING, DENSITY, DENSITY_LINES),
+                 QST_CONTINUOUS_RING, DENSITY, DENSITY_LINES, CPFA_CODE, CPFA_CODE_LINES),
                 strategies=("queue_qst",)),
     FactorGroup("qse48", ("queue", "--robots", "48", "--strategies", "queue_qse"), "queue/results.jsonl", "48",
-                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES),
-                strategies=("queue_qse",)),
+                (QSE_BASELINE, QST_MOTION_GENERIC, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES,
+                 CPFA_CODE, CPFA_CODE_LINES), strategies=("queue_qse",)),
     # Q_SE at 112 robots, where ours is furthest from the authors' code run here (21.4 %; ours 7.9 %).
     FactorGroup("qse112", ("queue", "--robots", "112", "--strategies", "queue_qse"), "queue/results.jsonl", "112",
                 (QSE_BASELINE, QST_QUEUED_CONTINUOUS, QST_RETURN_RIM, DENSITY, DENSITY_LINES),

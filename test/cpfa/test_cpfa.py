@@ -327,6 +327,25 @@ def test_informed_search_sigma_decays_per_the_formula():
     assert spy.sigmas[-1][1] < 1.0  # ... and relaxes toward omega
 
 
+def test_the_argos_informed_walk_turns_by_the_decaying_angle():
+    """``informed_walk: turn`` (the ARGoS CPFA's Searching): the step-t turn is w + (2 pi - w)
+    exp(-lambda t) wrapped to [-pi, pi], w ~ N(0, omega): none at the first step, then a loop."""
+    s = scenario(informed_walk="turn", informed_search_time="steps")
+    cfg = CpfaConfig.of(s)
+    b = behaviour(s)
+    b._mode = SearchMode.SITE_FIDELITY
+    turns = []
+    for t in range(6):
+        b._search_legs = t
+        b._new_leg(obs(t, 2.0, 2.0, 0.3))
+        turns.append(math.remainder(b._heading - 0.3, 2 * math.pi))
+        decay = math.exp(-cfg.rate_of_informed_search_decay * t)
+        want = math.remainder(2 * math.pi * decay, 2 * math.pi)
+        spread = 4 * cfg.uninformed_search_variation * (1 - decay)  # w's weight is 1 - decay
+        assert abs(math.remainder(turns[-1] - want, 2 * math.pi)) <= spread + 1e-9
+    assert turns[0] == pytest.approx(0.0, abs=1e-12) and len({round(t, 1) for t in turns}) == len(turns)
+
+
 # ------------------------------------------------------------------------------ finds and trips
 
 
