@@ -51,7 +51,10 @@ _QST48_MOTION = Cause(MEASURED, "the foot-bot's stop-turn-go motion rule on our 
                                "our queue, not isolated yet (its cells released on departure, boarding at the "
                                "innermost arc, no give-up, the return leg ending at the rim, cells 0.3 m apart, a "
                                "cell reached within 0.1 m: none closes it; never swerving, their path rule, halves "
-                               "ours; FACTORS.md, CAUSES.md)",
+                               "ours). Of the 13.7 points, the steering is about 8 and the stop rule about 6 "
+                               "(`continuous_ring_stop` 26.6 %, `line_stop_brake` 24.1 %); with their CPFA's density "
+                               "count on top (1 + the food within 0.283 m, `density_authors_lines_continuous`) 33.8 %, "
+                               "-10 % of theirs (FACTORS.md, CAUSES.md)",
                       "qst48/queued_motion_continuous", 10)
 LINE_MOTION_STEPS: tuple[tuple[str, int, float, float, float], ...] = (
     ("queue_qse", 48, 13.1, 19.9, 17.7), ("queue_qse", 64, 11.6, 22.2, 18.3), ("queue_qse", 80, 9.5, 24.1, 16.3),
@@ -124,7 +127,10 @@ _CPFA_REF = Cause(PARTIAL, "ours is 10-12 % under the authors' CPFA run here (th
                            "and 80 robots; at 64, 96 and 112 the Holm-corrected test does not clear it); that code itself collects 11-17 % less than Table II "
                            "(12.7 / 11.6 / 10.9 / 10.0 / 9.6 %), so the rest of the gap lies between the paper and the authors' "
                            "code as run here, whose Table II set-up for the CPFA is not published. With the text's "
-                           "four docks instead (factor `cpfa_docks_0.3`, queue48 / queue112, 10 seeds) ours collects 35.9 / 14.3 % at 48 / 112 robots (11.8 / 8.9 % on the same seeds)")
+                           "four docks instead (factor `cpfa_docks_0.3`, queue48 / queue112, 10 seeds) ours collects 35.9 / 14.3 % at 48 / 112 robots (11.8 / 8.9 % on the same seeds). With the local "
+                           "resource density counted as their code counts it (1 + the food within 0.283 m; factor "
+                           "`density_authors`, cpfa48, 10 seeds) ours collects 12.8 % at 48 robots (11.8 % on the same "
+                           "seeds), theirs 12.7 %")
 _CPFA_GENERIC = Cause(OPEN, "generic robot: its CPFA jams harder at the 0.19 m nest as robots are added (17.5 % at 48 "
                             "robots, 5.0 % at 112: -71 %, where the foot-bot's falls by 24 % and the authors' code's by "
                             "24 %); what in its continuous steering and avoidance does it is not measured")

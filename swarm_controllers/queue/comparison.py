@@ -275,6 +275,19 @@ QUEUE_RULES: tuple[Rule, ...] = (
     Rule("queue_qst", "controller.queue.seek_timeout",
          "no give-up", "no give-up", "neither",
          "ours: a seeker falls back to the entry point after 120 s (factor `qst_no_give_up`)"),
+    Rule("queue_cpfa, queue_qse, queue_qst, queue_qme, queue_qmt", "controller.cpfa.density_counts_find",
+         "the CPFA by citation (Hecker & Moses): c, the resources in the find's neighbourhood; read here as the "
+         "other food within the detection radius, 0.13 m (`false`)",
+         "`CPFA_controller::SetLocalResourceDensity` (Tameem786 and Artglz/Collision_Free_CPFA): 1 + every food "
+         "within sqrt(2) x 4 x FoodRadius = 0.283 m (`true` with `sensors.resource_detection_radius=0.2828`)",
+         "text", "pending: their count sends 95 % of their deliveries back to the site, ours 24 % (CAUSES.md); the "
+                 "shipped runs (1000) are not yet rerun with it; factor `density_authors`"),
+    Rule("queue_cpfa, queue_qse, queue_qst, queue_qme, queue_qmt", "controller.cpfa.informed_walk",
+         "Hecker & Moses: each informed step turns by a draw of N(0, sigma), sigma = omega + (4 pi - omega) "
+         "exp(-lambda_id t) (`sigma`)",
+         "`CPFA_controller::Searching`, `GetExponentialDecay`: by w + (2 pi - w) exp(-lambda_id t), w ~ N(0, "
+         "omega), a loop about the site (`turn`)",
+         "text", "pending, as the row above; factor `cpfa_authors` (both)"),
 )
 
 
