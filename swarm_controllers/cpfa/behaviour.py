@@ -426,7 +426,8 @@ class CpfaBehaviour:
         return self._hold(remainder(self._heading - obs.pose.yaw, _TWO_PI), self._search_step - math.sqrt(done2))
 
     def _new_leg(self, obs: Observation) -> None:
-        """Next leg of the correlated random walk: heading = yaw + N(0, sigma)."""
+        """Next leg of the correlated random walk: heading = yaw + N(0, sigma), or the ARGoS CPFA's
+        informed turn (`CpfaConfig.informed_walk`)."""
         pose = obs.pose
         x, y, yaw = pose.x, pose.y, pose.yaw
         turn = None

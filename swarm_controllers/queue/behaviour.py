@@ -63,7 +63,7 @@ from depot_manager.protocol import DepotGrant, DepotReport, RadioQuery, RadioRep
 from swarm_controllers.api import new_command
 from swarm_controllers.avoidance import ray_angles, ray_window
 from swarm_controllers.cpfa.behaviour import CpfaBehaviour
-from swarm_controllers.motion import ContinuousDrive, drive_for
+from swarm_controllers.motion import ContinuousDrive, Drive, drive_for
 from swarm_controllers.robots.ring import RingSensor
 from swarm_msgs_py.types import BehaviourStatus, Command, Observation, RobotId, slot_constructor
 from swarm_sim.inbound import Reason, Rejections
@@ -103,7 +103,7 @@ def _no_path_rule(ranges: np.ndarray, cone: float) -> None:
     return None
 
 
-def _ring_stop(scenario: Scenario, drive):
+def _ring_stop(scenario: Scenario, drive: Drive):
     """``line_stop: ring``: the drive's own path rule, and where it has none the authors' (a ``Stop()``
     for the proximity ring's readings within the cone), read from the scan."""
     blocks = RingSensor(scenario).blocks
