@@ -71,9 +71,13 @@ def _child(role: str, number: int, seconds: float) -> int:
     )
     ready = time.monotonic()
     # Transient local: a late checker still gets each worker's samples after matching.
-    # Deep: one keyless reader history holds the samples of every writer.
+    # Deep: one keyless reader history holds the samples of every writer, all replayed at once on
+    # matching (3 from each of SCALE workers: 120). With depth 100 a checker spinning slowly on a
+    # busy machine lost the oldest before it took them, and with them every sample of a few workers
+    # (CI, 2026-11-29: workers 0, 2 and 12 missing after 240 s; a checker made to sleep 5 s before
+    # spinning misses worker 0 with depth 100 and hears all 40 with this depth).
     qos = QoSProfile(
-        depth=100,
+        depth=10 * (SCALE + 1),
         reliability=ReliabilityPolicy.RELIABLE,
         durability=DurabilityPolicy.TRANSIENT_LOCAL,
     )
