@@ -82,7 +82,8 @@ def _line_motion(s: str, n: int, base: float, cont: float, ref: float) -> Cause:
     return Cause(MEASURED if closes else PARTIAL, text, f"{group}/queued_motion_continuous", 10)
 
 
-_LINE_MOTION = {(s, n): _line_motion(s, n, *values) for s, n, *values in LINE_MOTION_STEPS}
+_STEP_CAUSES = {(s, n): _line_motion(s, n, *values) for s, n, *values in LINE_MOTION_STEPS}
+"""A level cell's cause by its measured motion step: `LINE_MOTION_STEPS`, then `WHOLE_MOTION_STEPS`."""
 WHOLE_MOTION_STEPS: tuple[tuple[str, int, float, tuple[tuple[str, float], ...]], ...] = (
     ("queue_qme", 48, 33.28, (("motion_generic", 50.34), ("queued_motion_continuous", 36.31))),
     ("queue_qme", 64, 40.94, (("motion_generic", 62.69),)),
@@ -120,7 +121,7 @@ def _whole_motion(s: str, n: int, base: float, steps: tuple[tuple[str, float], .
     return Cause(MEASURED if closing else PARTIAL, text, f"{group}/{(closing or [steps[0][0]])[0]}", 10)
 
 
-_LINE_MOTION.update({(s, n): _whole_motion(s, n, base, steps) for s, n, base, steps in WHOLE_MOTION_STEPS})
+_STEP_CAUSES.update({(s, n): _whole_motion(s, n, base, steps) for s, n, base, steps in WHOLE_MOTION_STEPS})
 _CPFA_REF = Cause(PARTIAL, "ours is 10-12 % under the authors' CPFA run here (the plain CPFA in their "
                            "repositories, one nest at the centre; results/reference/queue/): -10 / -10 / -12 / -11 / -12 % "
                            "at 48-112 robots, 20 runs each, every 95 % interval inside the ±25 % band (holds at 48 "
@@ -155,7 +156,7 @@ _CPFA_CAUSES = (("authors", _CPFA_REF), ("generic", _CPFA_GENERIC))
 
 def _on(cause: Cause) -> tuple[tuple[str, Cause], ...]:
     """The models a cause applies to: the motion rule is the foot-bot's only."""
-    return (("authors", cause),) if cause in (_MOTION, _QST48_MOTION, *_LINE_MOTION.values()) else (("*", cause),)
+    return (("authors", cause),) if cause in (_MOTION, _QST48_MOTION, *_STEP_CAUSES.values()) else (("*", cause),)
 
 
 def _pair_sizes(a: str, b: str) -> tuple[tuple[int, float], ...]:
@@ -168,7 +169,7 @@ def _levels() -> list[Claim]:
     for s in QUEUE_STRATEGIES:
         for n in QUEUE_SIZES:
             causes = (_CPFA_CAUSES if s == "queue_cpfa" else
-                      _on(_QST48_MOTION if (s, n) == ("queue_qst", 48) else _LINE_MOTION.get((s, n), _MOTION)))
+                      _on(_QST48_MOTION if (s, n) == ("queue_qst", 48) else _STEP_CAUSES.get((s, n), _MOTION)))
             out.append(Claim(f"T2.{QUEUE_LABELS[s]}.{n}", LEVEL, f"{QUEUE_LABELS[s]} collects {PAPER_TABLE_II[s][n]} % "
                              f"with {n} robots", "Table II", PCT, s, (n,), value=PAPER_TABLE_II[s][n], unit="%",
                              note=TEXT_COUNTS.get((s, n), ""), causes=causes))

@@ -4,6 +4,12 @@ and at 112 robots, the authors' robot against one factor changed at a time."""
 from swarm_controllers.queue.claims import QUEUE_SIZES
 from swarm_sim.factor_sweeps import Factor, FactorGroup
 
+
+def _authors(*settings: str) -> tuple[str, ...]:
+    """A factor's arguments: the authors' robot with these ``--set KEY=VALUE`` settings."""
+    return ("--robot-model", "authors", *(a for s in settings for a in ("--set", s)))
+
+
 # footbot_cpfa and the generic queue robot share body (0.17 m), speed (0.16 m/s) and turn rate
 # (1.143 rad/s): they differ in the motion rule, the ring and planarity only.
 BASELINE = Factor("baseline", "the authors' robot (footbot_cpfa: stop-turn-go, the CPFA lineage's collision turn, "
@@ -12,10 +18,10 @@ MOTION_GENERIC = Factor("motion_generic", "motion rule: today's generic robot (c
                         "and brake), same body and speeds", ("--robot-model", "generic"))
 TURN = Factor("turn_2.29", "turn rate: the wheels at RobotForwardSpeed (16 cm/s) when turning, 2.29 rad/s, instead "
               "of RobotRotationSpeed's 8 cm/s",
-              ("--robot-model", "authors", "--set", "robots.platform.max_angular_speed=2.2857"))
+              _authors("robots.platform.max_angular_speed=2.2857"))
 STEP = Factor("step_0.16", "collision step: SearchStepSize 0.16 m (BaseController's default) instead of the "
               "experiment files' 0.08 m",
-              ("--robot-model", "authors", "--set", "robots.stop_turn_go.collision_step=0.16"))
+              _authors("robots.stop_turn_go.collision_step=0.16"))
 # The CPFA baseline's nest. Shipped (queue_cpfa.yaml, since 2026-11-29): one nest at the centre, 0.189 m,
 # a delivery on arrival, as the plain CPFA in the authors' repositories (Artglz/Collision_Free_CPFA main). The
 # paper's text has every robot unload at a dock (sec. III): four docks at the queue authors'
@@ -59,67 +65,64 @@ QST_DEPARTURE = Factor("cell_release_departure", "moving along the line: a robot
                        "robot behind once it holds a grant beyond it, which closes up to its path stop "
                        "(controller.queue.cell_release=departure: the authors' robots follow waypoints with no cells, "
                        "CPFA-2.0 CPFA_controller::FollowingEntryPath) instead of on its arrival at the next cell",
-                       ("--robot-model", "authors", "--set", "controller.queue.cell_release=departure"))
+                       _authors("controller.queue.cell_release=departure"))
 QST_INNERMOST = Factor("boarding_innermost", "where a carrier boards: straight in, at the innermost arc's nearest "
                        "cell, no radio (controller.queue.boarding=innermost: the authors' CPFA-2.0 "
                        "CPFA_controller::Returning boards the fifth arc, r = 1.0 m) instead of by the queued "
                        "robots' radio replies on the way in (sec. V-B)",
-                       ("--robot-model", "authors", "--set", "controller.queue.boarding=innermost"))
+                       _authors("controller.queue.boarding=innermost"))
 QST_QUEUED_CONTINUOUS = Factor("queued_motion_continuous", "the motion lead narrowed: the generic robot's continuous "
                                "steering and brake on the queue's lines only, the foot-bot's stop-turn-go while "
                                "foraging and seeking (controller.queue.queued_motion=continuous; a diagnostic, not "
                                "the authors' rule)",
-                               ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous"))
+                               _authors("controller.queue.queued_motion=continuous"))
 # Inside the motion lead (2026-11-29): the queue authors' robots on their path never swerve, and their lines have no
 # cells (their robots stand about a ring's reach apart, 0.27 m centre to centre).
 QST_NEVER_SWERVE = Factor("never_swerve", "a robot braked on the queue's lines stands until the way is clear "
                           "(controller.queue.brake_patience beyond the run: the authors' CPFA_controller::"
                           "CollisionDetection only calls Stop() on the path) instead of swerving after 3 s (ours)",
-                          ("--robot-model", "authors", "--set", "controller.queue.brake_patience=100000"))
+                          _authors("controller.queue.brake_patience=100000"))
 QST_PITCH = Factor("slot_pitch_0.3", "the lines' cells 0.3 m apart (controller.queue.slot_pitch; about the 0.27 m at "
                    "which the authors' robots stop behind one another by their proximity ring) instead of 0.2 m (the "
                    "lane spacing; the paper gives none)",
-                   ("--robot-model", "authors", "--set", "controller.queue.slot_pitch=0.3"))
+                   _authors("controller.queue.slot_pitch=0.3"))
 QST_RETURN_RIM = Factor("return_leg_rim", "a carrier's blind return leg ends 0.1 m outside the perimeter "
                         "(controller.queue.return_leg=rim: the authors' CPFA_controller::Returning, safeDistance = "
                         "redCircleRadius + 0.1) instead of at the depot centre, across the lanes",
-                        ("--robot-model", "authors", "--set", "controller.queue.return_leg=rim"))
+                        _authors("controller.queue.return_leg=rim"))
 QST_ENTRY_REACH = Factor("entry_reach_0.1", "an entry-line cell counts as reached within 0.1 m (controller.queue."
                          "entry_reach: the authors' FollowingEntryPath waypoint threshold) instead of 0.05 m",
-                         ("--robot-model", "authors", "--set", "controller.queue.entry_reach=0.1"))
+                         _authors("controller.queue.entry_reach=0.1"))
 # The motion lead split in two (2026-11-29): the steering on the lines and the rule that halts a robot there.
 QST_LINE_BRAKE = Factor("line_stop_brake", "stop-turn-go on the lines with our brake (the scan within 0.08 m ahead, "
                         "+-25 deg) instead of the authors' path stop (any ring reading within +-30 deg; "
                         "controller.queue.line_stop=brake; a diagnostic)",
-                        ("--robot-model", "authors", "--set", "controller.queue.line_stop=brake"))
+                        _authors("controller.queue.line_stop=brake"))
 QST_CONTINUOUS_RING = Factor("continuous_ring_stop", "the generic robot's continuous steering on the lines with the "
                              "authors' path stop kept (controller.queue.queued_motion=continuous, "
                              "controller.queue.line_stop=ring; a diagnostic)",
-                             ("--robot-model", "authors", "--set", "controller.queue.queued_motion=continuous",
-                              "--set", "controller.queue.line_stop=ring"))
+                             _authors("controller.queue.queued_motion=continuous", "controller.queue.line_stop=ring"))
 
 # The CPFA's local resource density as the authors' code counts it (2026-11-29): a trace of their Q_ST
 # (CPFA-2.0, 48 robots) has 95 % of their deliveries go back to the find's site (ResourceDensity 1 + the food
 # within sqrt(2) x 4 x FoodRadius = 0.283 m, median 4 at a pickup, so POIS(c, 1.376) ~ 0.96), ours 24 % (c = the
 # others within the 0.13 m detection radius: 0 at 92 of 98 pickups).
-DENSITY_ARGS = ("--set", "sensors.resource_detection_radius=0.2828",
-                "--set", "controller.cpfa.density_counts_find=true")
+DENSITY_SETS = ("sensors.resource_detection_radius=0.2828", "controller.cpfa.density_counts_find=true")
 DENSITY = Factor("density_authors", "the CPFA's local resource density counted as the authors' code does: 1 + the "
                  "food within 0.283 m of the find (CPFA_controller::SetLocalResourceDensity; sensors."
                  "resource_detection_radius=0.2828, controller.cpfa.density_counts_find=true) instead of the other "
-                 "food within the 0.13 m detection radius", ("--robot-model", "authors", *DENSITY_ARGS))
+                 "food within the 0.13 m detection radius", _authors(*DENSITY_SETS))
 DENSITY_LINES = Factor("density_authors_lines_continuous", "the authors' density count (density_authors) and the "
                        "generic robot's continuous steering and brake on the queue's lines (queued_motion_continuous) "
-                       "together", ("--robot-model", "authors", *DENSITY_ARGS, "--set",
-                                    "controller.queue.queued_motion=continuous"))
+                       "together", _authors(*DENSITY_SETS, "controller.queue.queued_motion=continuous"))
 # The informed search as the authors' code turns it, with their density count: the CPFA as their code runs it.
-CPFA_ARGS = (*DENSITY_ARGS, "--set", "controller.cpfa.informed_walk=turn")
+CPFA_SETS = (*DENSITY_SETS, "controller.cpfa.informed_walk=turn")
 CPFA_CODE = Factor("cpfa_authors", "the CPFA's density count (density_authors) and its informed search turning as the "
                    "authors' code does (controller.cpfa.informed_walk=turn: CPFA_controller::Searching, "
-                   "GetExponentialDecay) instead of H&M's N(0, sigma(t))", ("--robot-model", "authors", *CPFA_ARGS))
+                   "GetExponentialDecay) instead of H&M's N(0, sigma(t))", _authors(*CPFA_SETS))
 CPFA_CODE_LINES = Factor("cpfa_authors_lines_continuous", "the CPFA as the authors' code runs it (cpfa_authors) and "
                          "the generic robot's continuous steering and brake on the queue's lines together",
-                         ("--robot-model", "authors", *CPFA_ARGS, "--set", "controller.queue.queued_motion=continuous"))
+                         _authors(*CPFA_SETS, "controller.queue.queued_motion=continuous"))
 
 # Q_SE at 48 robots against the authors' branch main run here (17.7 %; ours 12.5 %): the same motion steps.
 QSE_BASELINE = Factor("baseline", "the shipped Q_SE on the authors' robot (footbot_cpfa: queue_qse.yaml)",
